@@ -1,0 +1,445 @@
+/*
+ * embra.h - the C ABI of embra, a unified constraint solver for interactive form finding.
+ *
+ * This header is the manual. embra simulates cloth, membranes, rods, solids and fabrication
+ * constraints as particles under constraints, stepped with XPBD (extended position based dynamics)
+ * in substeps. A host (a CAD plugin, a Python or C# script, the `embra` command) builds a world,
+ * steps it every frame and reads the positions back.
+ *
+ * HOW TO START
+ *
+ *     if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) { ...header and library disagree... }
+ *     embra_world* world = NULL;
+ *     embra_solver_def solver = embra_default_solver_def();
+ *     solver.gravity[2] = +9.81;                       // reversed gravity: the Gaudi paradigm
+ *     embra_world_create(&world, &solver);
+ *
+ *     embra_body_def body = embra_default_body_def();   // a cloth from a triangle mesh
+ *     body.vertex_count = n; body.positions = xyz;      // double[3 * n], metres
+ *     body.triangle_count = t; body.triangles = tri;    // int32_t[3 * t], 0-based
+ *     body.material.mass = 1.0;                          // kg, spread over the area
+ *     embra_body_id cloth; int32_t first = 0;
+ *     embra_body_create(world, &body, &cloth, &first);  // stretch + bend constraints generated
+ *
+ *     embra_pin_def pin = embra_default_pin_def();       // hold a corner where it is
+ *     pin.particle = first + corner; memcpy(pin.target, &xyz[3 * corner], sizeof pin.target);
+ *     embra_pin_id corner_pin; embra_pin_create(world, &pin, &corner_pin);
+ *
+ *     for (;;) {                                         // every frame
+ *       embra_world_step(world);
+ *       embra_world_get_positions(world, out_xyz, 3 * n, first, n);
+ *     }
+ *     embra_world_destroy(world);
+ *
+ * UNITS
+ *   SI by convention: metres, kilograms, seconds, newtons, radians. Compliance is the inverse of
+ *   stiffness (0 = rigid): m/N for lengths, rad/(N m) for angles, m^3/N for volumes, m/N for pins.
+ *
+ * ERRORS
+ *   Every function that can fail returns an embra_status: EMBRA_OK (0) or a negative code. The
+ *   message of the last failure on the calling thread is embra_last_error_message(), never NULL.
+ *   A refused call changes nothing: every argument is checked before anything is modified.
+ *   No exception, abort or C++ object ever crosses this boundary. Numerical trouble in a step
+ *   (a non-finite position) restores the world to its state before the step, returns
+ *   EMBRA_ERROR_NUMERICAL and records an embra_warning.
+ *
+ * THREADING
+ *   One thread at a time per world. Different worlds may be used from different threads at once.
+ *   The last-error message is per thread.
+ *
+ * IDS AND INDICES
+ *   Groups, pins and colliders are small value ids {index, generation}: a destroyed object's id
+ *   is refused with EMBRA_ERROR_STALE_ID, never reused. A zeroed id ({0, 0}) means "none" or
+ *   "the default" where a field says so. Particles are dense int32 indices into the world, in
+ *   creation order: a body's particles are [first, first + vertex_count).
+ *
+ * BUFFERS
+ *   Bulk data is flat xyz double arrays owned by the caller. Reads take the buffer's capacity in
+ *   doubles; too small a buffer returns EMBRA_ERROR_BUFFER_TOO_SMALL and writes nothing.
+ *
+ * DEFS
+ *   Anything with more than three parameters is an embra_*_def struct. Get one from its
+ *   embra_default_*_def() function, change the fields you need, pass its address. The first field
+ *   is the struct's version; fields are only ever appended.
+ *
+ * STABILITY
+ *   EMBRA_ABI_VERSION changes only when a compiled host would break. Call embra_check_abi() first.
+ */
+#ifndef EMBRA_EMBRA_H
+#define EMBRA_EMBRA_H
+
+#include <stdint.h>
+
+#include "embra/embra_export.h"
+#include "embra/embra_version.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------------------------------------
+ * Status codes
+ * ------------------------------------------------------------------------------------------- */
+
+typedef int32_t embra_status;
+enum {
+  EMBRA_OK = 0,
+  EMBRA_ERROR_INVALID_ARGUMENT = -1, /* null, out of range, non-finite, wrong count, degenerate */
+  EMBRA_ERROR_STALE_ID = -2,         /* an id of a destroyed object, or of another world */
+  EMBRA_ERROR_BUFFER_TOO_SMALL = -3, /* an output buffer cannot hold the result; nothing written */
+  EMBRA_ERROR_SCHEMA = -4,           /* a JSON document does not match its schema */
+  EMBRA_ERROR_VERSION = -5,          /* header and library (or a def's version) disagree */
+  EMBRA_ERROR_LOCKED = -6,           /* the world is in use by a call in progress */
+  EMBRA_ERROR_NUMERICAL = -7,        /* the step produced a non-finite state; world restored */
+  EMBRA_ERROR_INTERNAL = -8          /* a bug in embra, or out of memory; message says which */
+};
+
+/* The message of the last failed call on this thread ("" if none). Never NULL; valid until the
+ * next embra call on this thread. */
+EMBRA_API const char* embra_last_error_message(void);
+
+/* A short constant name for a status code, e.g. "EMBRA_ERROR_STALE_ID". Never NULL. */
+EMBRA_API const char* embra_status_name(embra_status status);
+
+/* ---------------------------------------------------------------------------------------------
+ * Versions
+ * ------------------------------------------------------------------------------------------- */
+
+/* The library's version as MAJOR * 10000 + MINOR * 100 + PATCH. */
+EMBRA_API int32_t embra_version(void);
+/* The library's version as a string "MAJOR.MINOR.PATCH". Never NULL, static. */
+EMBRA_API const char* embra_version_string(void);
+/* The library's ABI version (the SONAME's number). */
+EMBRA_API int32_t embra_abi_version(void);
+/* EMBRA_OK when `header_abi_version` (pass EMBRA_ABI_VERSION) matches the library, else
+ * EMBRA_ERROR_VERSION. Hosts call this once before anything else. */
+EMBRA_API embra_status embra_check_abi(int32_t header_abi_version);
+
+/* ---------------------------------------------------------------------------------------------
+ * Ids
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct embra_world embra_world; /* opaque; create and destroy with the functions below */
+
+typedef struct embra_group_id {
+  uint32_t index;
+  uint32_t generation;
+} embra_group_id;
+typedef struct embra_body_id {
+  uint32_t index;
+  uint32_t generation;
+} embra_body_id;
+typedef struct embra_pin_id {
+  uint32_t index;
+  uint32_t generation;
+} embra_pin_id;
+typedef struct embra_collider_id {
+  uint32_t index;
+  uint32_t generation;
+} embra_collider_id;
+
+/* ---------------------------------------------------------------------------------------------
+ * World and solver settings
+ * ------------------------------------------------------------------------------------------- */
+
+#define EMBRA_SOLVER_DEF_VERSION 1
+typedef struct embra_solver_def {
+  int32_t version;     /* EMBRA_SOLVER_DEF_VERSION */
+  int32_t substeps;    /* substeps per frame, [1, 10000]; default 8 */
+  double dt;           /* s per frame (per embra_world_step), > 0; default 1/60 */
+  int32_t iterations;  /* passes over the ordered groups per substep, [1, 10000]; default 1 */
+  int32_t reserved0;   /* 0 */
+  double gravity[3];   /* m/s^2; default {0, 0, -9.81} (z up). Any direction: negate to hang */
+  double damping;      /* 1/s, velocity decay rate applied to every particle; >= 0; default 0 */
+  double settle_speed; /* m/s: a frame is "settled" when no particle moves faster; default 1e-3 */
+} embra_solver_def;
+
+EMBRA_API embra_solver_def embra_default_solver_def(void);
+
+/* Creates an empty world with a default group (order 0, weight 1) and a contact group
+ * (order 1000, weight 1). `def` may be NULL for the defaults. On failure *out_world is NULL. */
+EMBRA_API embra_status embra_world_create(embra_world** out_world, const embra_solver_def* def);
+/* Destroys a world and everything in it. NULL is accepted and ignored. */
+EMBRA_API void embra_world_destroy(embra_world* world);
+
+/* Reads or replaces the solver settings (between steps). */
+EMBRA_API embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* out_def);
+EMBRA_API embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* def);
+/* Sets gravity (m/s^2) between steps; reversing it is the Gaudi paradigm. */
+EMBRA_API embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]);
+
+typedef struct embra_world_counts {
+  int32_t particles;
+  int32_t bodies;
+  int32_t groups;    /* live groups, including the default and contact groups */
+  int32_t pins;      /* live pins */
+  int32_t colliders; /* live colliders */
+  int32_t reserved0;
+  int64_t constraints; /* all constraints in live groups (pins and contacts not counted) */
+} embra_world_counts;
+
+EMBRA_API embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts);
+
+/* ---------------------------------------------------------------------------------------------
+ * Groups: the paper's "preferred order of evaluation" and "importance weight"
+ *
+ * Every constraint belongs to a group. In each substep the groups are projected in increasing
+ * `order` (ties in creation order), each `weight` times in a row, and that whole pass is repeated
+ * `iterations` times. Put collisions last so they take precedence (the contact group's order is
+ * 1000); give a group a higher weight to make it win over the others.
+ * ------------------------------------------------------------------------------------------- */
+
+#define EMBRA_GROUP_DEF_VERSION 1
+typedef struct embra_group_def {
+  int32_t version; /* EMBRA_GROUP_DEF_VERSION */
+  int32_t order;   /* any int32; lower goes first; default 0 */
+  int32_t weight;  /* projections per pass, [1, 1000]; default 1 */
+} embra_group_def;
+
+EMBRA_API embra_group_def embra_default_group_def(void);
+EMBRA_API embra_status embra_group_create(embra_world* world, const embra_group_def* def, embra_group_id* out_group);
+/* Destroys a group and all its constraints. The default and contact groups cannot be destroyed;
+ * a group that still holds soft pins is refused. */
+EMBRA_API embra_status embra_group_destroy(embra_world* world, embra_group_id group);
+EMBRA_API embra_status embra_group_set_order(embra_world* world, embra_group_id group, int32_t order);
+EMBRA_API embra_status embra_group_set_weight(embra_world* world, embra_group_id group, int32_t weight);
+EMBRA_API embra_status embra_world_default_group(const embra_world* world, embra_group_id* out_group);
+EMBRA_API embra_status embra_world_contact_group(const embra_world* world, embra_group_id* out_group);
+
+/* ---------------------------------------------------------------------------------------------
+ * Bodies: simplicial complexes (points, edges, triangles, tetrahedra) with a material
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct embra_material {
+  double mass;               /* kg for the whole body, spread by lumped length/area/volume; used
+                                when > 0. Default 0 (use density) */
+  double density;            /* kg per unit of the body's highest-dimension measure (kg/m for
+                                rods, kg/m^2 for cloth, kg/m^3 for solids); default 1 */
+  double stretch_compliance; /* m/N on every edge; 0 = inextensible (default) */
+  double shear_compliance;   /* rad/(N m) on triangle corner angles; default 0 */
+  double bend_compliance;    /* rad/(N m) on dihedral angles; default 1 (soft cloth) */
+  double volume_compliance;  /* m^3/N on tetrahedra; default 0 */
+  double damping;            /* 1/s velocity decay of the body's particles; default 0 */
+  double thickness;          /* m; particles keep half of it off colliders; default 0 */
+  double friction_static;    /* against colliders (geometric mean with the collider's); 0.5 */
+  double friction_dynamic;   /* 0.3 */
+} embra_material;
+
+/* Which constraints embra_body_create generates from the elements (bit flags). */
+enum {
+  EMBRA_GENERATE_STRETCH = 1, /* a distance constraint on every unique edge (of edges, triangles
+                                 and tetrahedra), rest = current length */
+  EMBRA_GENERATE_SHEAR = 2,   /* an edge-angle constraint at each triangle corner */
+  EMBRA_GENERATE_BEND = 4,    /* a dihedral constraint across every edge shared by two triangles,
+                                 rest = current angle (so a curved rest shape keeps its curvature) */
+  EMBRA_GENERATE_VOLUME = 8   /* a volume constraint on every tetrahedron */
+};
+
+#define EMBRA_BODY_DEF_VERSION 1
+typedef struct embra_body_def {
+  int32_t version;          /* EMBRA_BODY_DEF_VERSION */
+  int32_t vertex_count;     /* > 0 */
+  const double* positions;  /* double[3 * vertex_count], m; required */
+  const double* masses;     /* double[vertex_count], kg (0 = immovable); NULL = from material */
+  const double* uvs;        /* double[2 * vertex_count] material coordinates, or NULL; when given,
+                               each edge's rest length is split into u and v parts so
+                               embra_body_set_rest_scale can scale the directions separately */
+  int32_t edge_count;       /* >= 0 */
+  int32_t triangle_count;   /* >= 0 */
+  const int32_t* edges;     /* int32_t[2 * edge_count], body-local vertex indices, or NULL */
+  const int32_t* triangles; /* int32_t[3 * triangle_count], or NULL */
+  const int32_t* tets;      /* int32_t[4 * tet_count], or NULL */
+  int32_t tet_count;        /* >= 0 */
+  int32_t generate;         /* EMBRA_GENERATE_* flags; default STRETCH | BEND | VOLUME */
+  embra_material material;
+  embra_group_id stretch_group; /* group of the generated constraints; {0,0} = default group */
+  embra_group_id shear_group;
+  embra_group_id bend_group;
+  embra_group_id volume_group;
+} embra_body_def;
+
+EMBRA_API embra_material embra_default_material(void);
+EMBRA_API embra_body_def embra_default_body_def(void);
+
+/* Adds a body's vertices as particles [*out_first_particle, + vertex_count) and generates its
+ * constraints. Refused (nothing added) for an index out of range, a repeated vertex within an
+ * element, a zero-length edge, a zero-area triangle, a zero-volume tetrahedron, a non-finite
+ * number or a negative material value. out_first_particle may be NULL. */
+EMBRA_API embra_status embra_body_create(embra_world* world, const embra_body_def* def, embra_body_id* out_body,
+                                         int32_t* out_first_particle);
+/* The body's particle range. */
+EMBRA_API embra_status embra_body_get_particles(const embra_world* world, embra_body_id body, int32_t* out_first,
+                                                int32_t* out_count);
+/* Scales the rest lengths of the body's generated stretch constraints (and volumes by scale^3)
+ * from the next step on: rest = scale * |(scale_u * rest_u, scale_v * rest_v, rest_other)|, where
+ * rest_u and rest_v are the parts of each edge along the body's uv directions (all of it is
+ * "other" for a body without uvs). 1, 1, 1 is the rest shape; < 1 shrinks (shrink wrap, minimal
+ * surfaces), > 1 grows (bounded growth). All >= 0 and finite. */
+EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, double scale, double scale_u,
+                                                 double scale_v);
+
+/* ---------------------------------------------------------------------------------------------
+ * Constraints, one at a time or in bulk
+ * ------------------------------------------------------------------------------------------- */
+
+typedef int32_t embra_constraint_kind;
+enum {
+  EMBRA_CONSTRAINT_DISTANCE = 0,   /* 2 particles: |x0 - x1| = rest (m). Stretch */
+  EMBRA_CONSTRAINT_EDGE_ANGLE = 1, /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 = rest
+                                      (rad, [0, pi]). Shear */
+  EMBRA_CONSTRAINT_DIHEDRAL = 2,   /* 4 particles: angle between triangles (x0,x1,x2) and (x1,x0,x3)
+                                      across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
+  EMBRA_CONSTRAINT_TET_VOLUME = 3, /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
+  EMBRA_CONSTRAINT_WELD = 4,       /* 2 particles: x0 = x1 (rest must be 0) */
+  EMBRA_CONSTRAINT_TETHER = 5      /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
+                                      pulls only when overstretched */
+};
+/* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
+EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);
+
+#define EMBRA_CONSTRAINT_DEF_VERSION 1
+typedef struct embra_constraint_def {
+  int32_t version; /* EMBRA_CONSTRAINT_DEF_VERSION */
+  embra_constraint_kind kind;
+  embra_group_id group;      /* {0,0} = default group */
+  int32_t particles[4];      /* the first embra_constraint_arity(kind) are used */
+  int32_t rest_from_current; /* 1 (default): measure rest from current positions; 0: use rest */
+  int32_t reserved0;
+  double rest;       /* rest value in the kind's unit, when rest_from_current is 0 */
+  double compliance; /* >= 0, kind's unit per newton; 0 = hard (default) */
+} embra_constraint_def;
+
+EMBRA_API embra_constraint_def embra_default_constraint_def(void);
+EMBRA_API embra_status embra_constraint_add(embra_world* world, const embra_constraint_def* def);
+
+#define EMBRA_CONSTRAINT_BATCH_DEF_VERSION 1
+typedef struct embra_constraint_batch_def {
+  int32_t version; /* EMBRA_CONSTRAINT_BATCH_DEF_VERSION */
+  embra_constraint_kind kind;
+  embra_group_id group; /* {0,0} = default group */
+  int32_t count;        /* number of constraints, > 0 */
+  int32_t reserved0;
+  const int32_t* particles;  /* int32_t[count * arity], required */
+  const double* rest;        /* double[count], or NULL to measure each from current positions */
+  const double* compliances; /* double[count], or NULL to use `compliance` for all */
+  double compliance;         /* >= 0; default 0 (hard) */
+} embra_constraint_batch_def;
+
+EMBRA_API embra_constraint_batch_def embra_default_constraint_batch_def(void);
+/* Adds all constraints of the batch or none. */
+EMBRA_API embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def);
+
+/* ---------------------------------------------------------------------------------------------
+ * Pins: a particle held at a target the host moves between steps (dragging, raising a tent)
+ * ------------------------------------------------------------------------------------------- */
+
+#define EMBRA_PIN_DEF_VERSION 1
+typedef struct embra_pin_def {
+  int32_t version;      /* EMBRA_PIN_DEF_VERSION */
+  int32_t particle;     /* world particle index */
+  double target[3];     /* m */
+  double compliance;    /* 0 (default) = hard: the particle follows the target exactly, gliding
+                           there over the substeps of the next frame; > 0 (m/N): a spring-like
+                           soft pin in `group` */
+  embra_group_id group; /* group of a soft pin; {0,0} = default group */
+} embra_pin_def;
+
+EMBRA_API embra_pin_def embra_default_pin_def(void);
+/* A particle takes at most one hard pin. */
+EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
+EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
+/* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. */
+EMBRA_API embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]);
+EMBRA_API embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]);
+
+/* ---------------------------------------------------------------------------------------------
+ * Colliders: rigid shapes the host places and moves between steps
+ * ------------------------------------------------------------------------------------------- */
+
+typedef int32_t embra_collider_shape;
+enum {
+  EMBRA_COLLIDER_PLANE = 0, /* the half-space below the plane through `position` with normal
+                               rotation * (0, 0, 1); particles stay above */
+  EMBRA_COLLIDER_SPHERE = 1 /* solid sphere of `radius` centred at `position` */
+};
+
+#define EMBRA_COLLIDER_DEF_VERSION 1
+typedef struct embra_collider_def {
+  int32_t version; /* EMBRA_COLLIDER_DEF_VERSION */
+  embra_collider_shape shape;
+  double position[3];      /* m */
+  double rotation[4];      /* unit quaternion {w, x, y, z}; default identity {1, 0, 0, 0} */
+  double radius;           /* m, sphere only, > 0; default 1 */
+  double thickness;        /* m, extra clearance; default 0 */
+  double friction_static;  /* default 0.5 */
+  double friction_dynamic; /* default 0.3 */
+} embra_collider_def;
+
+EMBRA_API embra_collider_def embra_default_collider_def(void);
+EMBRA_API embra_status embra_collider_create(embra_world* world, const embra_collider_def* def,
+                                             embra_collider_id* out_collider);
+EMBRA_API embra_status embra_collider_destroy(embra_world* world, embra_collider_id collider);
+/* Sets where the collider is at the end of the next step; it moves there along a straight path
+ * over the substeps, and particles it drags take its velocity through friction. */
+EMBRA_API embra_status embra_collider_set_transform(embra_world* world, embra_collider_id collider,
+                                                    const double position[3], const double rotation[4]);
+
+/* ---------------------------------------------------------------------------------------------
+ * Stepping and reading back
+ * ------------------------------------------------------------------------------------------- */
+
+/* Advances one frame (solver dt). EMBRA_ERROR_NUMERICAL: the state went non-finite; the world is
+ * as before the call and embra_world_get_warning says where. */
+EMBRA_API embra_status embra_world_step(embra_world* world);
+
+typedef struct embra_step_report {
+  int64_t frame;         /* frames stepped since the world was created */
+  double time;           /* simulated s */
+  double kinetic_energy; /* J */
+  double max_speed;      /* m/s, over all particles */
+  double residual_max;   /* max |C + compliance/h^2 * lambda| over all constraints (in each
+                            constraint's unit: m, rad, m^3); contacts: penetration depth */
+  double residual_rms;
+  int64_t constraint_count; /* constraints measured, including soft pins and contacts */
+  int64_t contact_count;    /* particle-collider contacts in the last substep */
+  int32_t settled;          /* 1 when max_speed <= settle_speed */
+  int32_t reserved0;
+} embra_step_report;
+
+/* The report of the last step (all zero before the first). */
+EMBRA_API embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report);
+
+typedef struct embra_group_report {
+  int64_t count;       /* constraints in the group (soft pins and contacts included) */
+  double residual_max; /* as in embra_step_report, over this group */
+  double residual_rms;
+} embra_group_report;
+
+EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_group_id group,
+                                              embra_group_report* out_report);
+
+typedef struct embra_warning {
+  int64_t frame;    /* frame of the last numerical failure, -1 if none */
+  int32_t particle; /* first non-finite particle, -1 if none */
+  int32_t reserved0;
+} embra_warning;
+
+EMBRA_API embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning);
+
+/* Copies `count` particles' positions (m) starting at `first` into out_xyz (capacity in doubles,
+ * at least 3 * count). */
+EMBRA_API embra_status embra_world_get_positions(const embra_world* world, double* out_xyz, int64_t capacity,
+                                                 int32_t first, int32_t count);
+/* Same for velocities (m/s). */
+EMBRA_API embra_status embra_world_get_velocities(const embra_world* world, double* out_xyz, int64_t capacity,
+                                                  int32_t first, int32_t count);
+/* Moves `count` particles starting at `first` to xyz (double[3 * count]); velocities are kept. */
+EMBRA_API embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count);
+/* Sets `count` particles' velocities (m/s). */
+EMBRA_API embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* EMBRA_EMBRA_H */

@@ -1,0 +1,655 @@
+// The C ABI over embra::World. Every exported function runs inside guard(): exceptions become a
+// status code and a thread-local message; nothing unwinds into the host.
+#include "embra/embra.h"
+
+#include "embra/core/world.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <string>
+
+struct embra_world {
+  embra::World world;
+};
+
+namespace {
+
+thread_local std::string g_last_error;
+
+struct Refused {
+  embra_status status;
+  std::string message;
+};
+
+[[noreturn]] void refuse(embra_status status, const std::string& message) {
+  throw Refused{status, message};
+}
+
+embra_status map(embra::ErrorCode code) {
+  switch (code) {
+    case embra::ErrorCode::invalid_argument:
+      return EMBRA_ERROR_INVALID_ARGUMENT;
+    case embra::ErrorCode::stale_id:
+      return EMBRA_ERROR_STALE_ID;
+    case embra::ErrorCode::buffer_too_small:
+      return EMBRA_ERROR_BUFFER_TOO_SMALL;
+    case embra::ErrorCode::numerical:
+      return EMBRA_ERROR_NUMERICAL;
+    case embra::ErrorCode::internal:
+      return EMBRA_ERROR_INTERNAL;
+  }
+  return EMBRA_ERROR_INTERNAL;
+}
+
+/// Runs `body`, turning every exception into a status and the thread's last-error message.
+template <class F>
+embra_status guard(const char* function, F&& body) noexcept {
+  try {
+    body();
+    return EMBRA_OK;
+  } catch (const Refused& r) {
+    g_last_error = std::string(function) + ": " + r.message;
+    return r.status;
+  } catch (const embra::Error& e) {
+    g_last_error = std::string(function) + ": " + e.what();
+    return map(e.code());
+  } catch (const std::bad_alloc&) {
+    g_last_error = std::string(function) + ": out of memory";
+    return EMBRA_ERROR_INTERNAL;
+  } catch (const std::exception& e) {
+    g_last_error = std::string(function) + ": internal error: " + e.what();
+    return EMBRA_ERROR_INTERNAL;
+  } catch (...) {
+    g_last_error = std::string(function) + ": internal error";
+    return EMBRA_ERROR_INTERNAL;
+  }
+}
+
+template <class T>
+void need(const T* p, const char* name) {
+  if (p == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(name) + " is NULL");
+}
+
+void need_version(int32_t got, int32_t want, const char* def) {
+  if (got != want)
+    refuse(EMBRA_ERROR_VERSION, std::string(def) + ".version is " + std::to_string(got) + ", this library reads " +
+                                    std::to_string(want) + " (start from its embra_default_ function)");
+}
+
+void need_count(int64_t count, const char* name) {
+  if (count < 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(name) + " is negative");
+}
+
+template <class T>
+std::span<const T> view(const T* p, int64_t n, const char* name) {
+  if (n == 0) return {};
+  need(p, name);
+  return {p, static_cast<size_t>(n)};
+}
+
+template <class T>
+embra::Id to_id(T id) {
+  return embra::Id{id.index, id.generation};
+}
+template <class T>
+T from_id(embra::Id id) {
+  return T{id.index, id.generation};
+}
+
+embra::Vec3 vec(const double* p) {
+  return embra::Vec3(p[0], p[1], p[2]);
+}
+
+embra::Settings to_settings(const embra_solver_def& d) {
+  embra::Settings s;
+  s.dt = d.dt;
+  s.substeps = d.substeps;
+  s.iterations = d.iterations;
+  s.gravity = vec(d.gravity);
+  s.damping = d.damping;
+  s.settle_speed = d.settle_speed;
+  return s;
+}
+
+embra::Material to_material(const embra_material& m) {
+  embra::Material r;
+  r.mass = m.mass;
+  r.density = m.density;
+  r.stretch_compliance = m.stretch_compliance;
+  r.shear_compliance = m.shear_compliance;
+  r.bend_compliance = m.bend_compliance;
+  r.volume_compliance = m.volume_compliance;
+  r.damping = m.damping;
+  r.thickness = m.thickness;
+  r.friction_static = m.friction_static;
+  r.friction_dynamic = m.friction_dynamic;
+  return r;
+}
+
+void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t count, const double* out) {
+  need(out, "out_xyz");
+  if (first < 0 || count < 0 || static_cast<int64_t>(first) + count > w.particle_count())
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particle range [" + std::to_string(first) + ", " +
+                                             std::to_string(static_cast<int64_t>(first) + count) + ") is outside [0, " +
+                                             std::to_string(w.particle_count()) + ")");
+  if (capacity < 3 * static_cast<int64_t>(count))
+    refuse(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer holds " + std::to_string(capacity) + " doubles, " +
+                                             std::to_string(3 * static_cast<int64_t>(count)) + " needed");
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* embra_last_error_message(void) {
+  return g_last_error.c_str();
+}
+
+const char* embra_status_name(embra_status status) {
+  switch (status) {
+    case EMBRA_OK:
+      return "EMBRA_OK";
+    case EMBRA_ERROR_INVALID_ARGUMENT:
+      return "EMBRA_ERROR_INVALID_ARGUMENT";
+    case EMBRA_ERROR_STALE_ID:
+      return "EMBRA_ERROR_STALE_ID";
+    case EMBRA_ERROR_BUFFER_TOO_SMALL:
+      return "EMBRA_ERROR_BUFFER_TOO_SMALL";
+    case EMBRA_ERROR_SCHEMA:
+      return "EMBRA_ERROR_SCHEMA";
+    case EMBRA_ERROR_VERSION:
+      return "EMBRA_ERROR_VERSION";
+    case EMBRA_ERROR_LOCKED:
+      return "EMBRA_ERROR_LOCKED";
+    case EMBRA_ERROR_NUMERICAL:
+      return "EMBRA_ERROR_NUMERICAL";
+    case EMBRA_ERROR_INTERNAL:
+      return "EMBRA_ERROR_INTERNAL";
+    default:
+      return "EMBRA_UNKNOWN_STATUS";
+  }
+}
+
+int32_t embra_version(void) {
+  return EMBRA_VERSION_MAJOR * 10000 + EMBRA_VERSION_MINOR * 100 + EMBRA_VERSION_PATCH;
+}
+const char* embra_version_string(void) {
+  return EMBRA_VERSION_STRING;
+}
+int32_t embra_abi_version(void) {
+  return EMBRA_ABI_VERSION;
+}
+
+embra_status embra_check_abi(int32_t header_abi_version) {
+  return guard("embra_check_abi", [&] {
+    if (header_abi_version != EMBRA_ABI_VERSION)
+      refuse(EMBRA_ERROR_VERSION, "the host was compiled against ABI " + std::to_string(header_abi_version) +
+                                      ", this library is ABI " + std::to_string(EMBRA_ABI_VERSION));
+  });
+}
+
+// --- world -------------------------------------------------------------------------------------
+
+embra_solver_def embra_default_solver_def(void) {
+  const embra::Settings s;
+  embra_solver_def d{};
+  d.version = EMBRA_SOLVER_DEF_VERSION;
+  d.substeps = s.substeps;
+  d.dt = s.dt;
+  d.iterations = s.iterations;
+  for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
+  d.damping = s.damping;
+  d.settle_speed = s.settle_speed;
+  return d;
+}
+
+embra_status embra_world_create(embra_world** out_world, const embra_solver_def* def) {
+  if (out_world != nullptr) *out_world = nullptr;
+  return guard("embra_world_create", [&] {
+    need(out_world, "out_world");
+    const embra_solver_def d = def ? *def : embra_default_solver_def();
+    need_version(d.version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
+    *out_world = new embra_world{embra::World(to_settings(d))};
+  });
+}
+
+void embra_world_destroy(embra_world* world) {
+  delete world;
+}
+
+embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* out_def) {
+  return guard("embra_world_get_solver", [&] {
+    need(world, "world");
+    need(out_def, "out_def");
+    const embra::Settings& s = world->world.settings();
+    embra_solver_def d = embra_default_solver_def();
+    d.substeps = s.substeps;
+    d.dt = s.dt;
+    d.iterations = s.iterations;
+    for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
+    d.damping = s.damping;
+    d.settle_speed = s.settle_speed;
+    *out_def = d;
+  });
+}
+
+embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* def) {
+  return guard("embra_world_set_solver", [&] {
+    need(world, "world");
+    need(def, "def");
+    need_version(def->version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
+    world->world.set_settings(to_settings(*def));
+  });
+}
+
+embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]) {
+  return guard("embra_world_set_gravity", [&] {
+    need(world, "world");
+    need(gravity, "gravity");
+    world->world.set_gravity(vec(gravity));
+  });
+}
+
+embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts) {
+  return guard("embra_world_get_counts", [&] {
+    need(world, "world");
+    need(out_counts, "out_counts");
+    const embra::World& w = world->world;
+    embra_world_counts c{};
+    c.particles = w.particle_count();
+    c.bodies = static_cast<int32_t>(w.body_count());
+    c.groups = static_cast<int32_t>(w.group_count());
+    c.pins = static_cast<int32_t>(w.pin_count());
+    c.colliders = static_cast<int32_t>(w.collider_count());
+    c.constraints = w.constraint_count();
+    *out_counts = c;
+  });
+}
+
+// --- groups ------------------------------------------------------------------------------------
+
+embra_group_def embra_default_group_def(void) {
+  embra_group_def d{};
+  d.version = EMBRA_GROUP_DEF_VERSION;
+  d.order = 0;
+  d.weight = 1;
+  return d;
+}
+
+embra_status embra_group_create(embra_world* world, const embra_group_def* def, embra_group_id* out_group) {
+  return guard("embra_group_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_group, "out_group");
+    need_version(def->version, EMBRA_GROUP_DEF_VERSION, "embra_group_def");
+    embra::GroupDesc d;
+    d.order = def->order;
+    d.weight = def->weight;
+    *out_group = from_id<embra_group_id>(world->world.create_group(d));
+  });
+}
+
+embra_status embra_group_destroy(embra_world* world, embra_group_id group) {
+  return guard("embra_group_destroy", [&] {
+    need(world, "world");
+    world->world.destroy_group(to_id(group));
+  });
+}
+
+embra_status embra_group_set_order(embra_world* world, embra_group_id group, int32_t order) {
+  return guard("embra_group_set_order", [&] {
+    need(world, "world");
+    world->world.set_group_order(to_id(group), order);
+  });
+}
+
+embra_status embra_group_set_weight(embra_world* world, embra_group_id group, int32_t weight) {
+  return guard("embra_group_set_weight", [&] {
+    need(world, "world");
+    world->world.set_group_weight(to_id(group), weight);
+  });
+}
+
+embra_status embra_world_default_group(const embra_world* world, embra_group_id* out_group) {
+  return guard("embra_world_default_group", [&] {
+    need(world, "world");
+    need(out_group, "out_group");
+    *out_group = from_id<embra_group_id>(world->world.default_group());
+  });
+}
+
+embra_status embra_world_contact_group(const embra_world* world, embra_group_id* out_group) {
+  return guard("embra_world_contact_group", [&] {
+    need(world, "world");
+    need(out_group, "out_group");
+    *out_group = from_id<embra_group_id>(world->world.contact_group());
+  });
+}
+
+embra_status embra_group_get_report(const embra_world* world, embra_group_id group, embra_group_report* out_report) {
+  return guard("embra_group_get_report", [&] {
+    need(world, "world");
+    need(out_report, "out_report");
+    const embra::GroupReport& r = world->world.group(to_id(group)).report;
+    *out_report = embra_group_report{r.count, r.residual_max, r.residual_rms};
+  });
+}
+
+// --- bodies ------------------------------------------------------------------------------------
+
+embra_material embra_default_material(void) {
+  const embra::Material m;
+  embra_material r{};
+  r.mass = m.mass;
+  r.density = m.density;
+  r.stretch_compliance = m.stretch_compliance;
+  r.shear_compliance = m.shear_compliance;
+  r.bend_compliance = m.bend_compliance;
+  r.volume_compliance = m.volume_compliance;
+  r.damping = m.damping;
+  r.thickness = m.thickness;
+  r.friction_static = 0.5;
+  r.friction_dynamic = 0.3;
+  return r;
+}
+
+embra_body_def embra_default_body_def(void) {
+  embra_body_def d{};
+  d.version = EMBRA_BODY_DEF_VERSION;
+  d.generate = EMBRA_GENERATE_STRETCH | EMBRA_GENERATE_BEND | EMBRA_GENERATE_VOLUME;
+  d.material = embra_default_material();
+  return d;
+}
+
+embra_status embra_body_create(embra_world* world, const embra_body_def* def, embra_body_id* out_body,
+                               int32_t* out_first_particle) {
+  return guard("embra_body_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_body, "out_body");
+    need_version(def->version, EMBRA_BODY_DEF_VERSION, "embra_body_def");
+    if (def->vertex_count <= 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.vertex_count must be > 0");
+    need_count(def->edge_count, "def.edge_count");
+    need_count(def->triangle_count, "def.triangle_count");
+    need_count(def->tet_count, "def.tet_count");
+    if (def->generate & ~0xF) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.generate has unknown flags");
+    const int64_t n = def->vertex_count;
+    embra::BodyDesc d;
+    d.positions = view(def->positions, 3 * n, "def.positions");
+    d.masses = def->masses ? std::span<const double>(def->masses, n) : std::span<const double>();
+    d.uvs = def->uvs ? std::span<const double>(def->uvs, 2 * n) : std::span<const double>();
+    d.edges = view(def->edges, 2 * static_cast<int64_t>(def->edge_count), "def.edges");
+    d.triangles = view(def->triangles, 3 * static_cast<int64_t>(def->triangle_count), "def.triangles");
+    d.tets = view(def->tets, 4 * static_cast<int64_t>(def->tet_count), "def.tets");
+    d.material = to_material(def->material);
+    d.generate = static_cast<uint32_t>(def->generate);
+    d.stretch_group = to_id(def->stretch_group);
+    d.shear_group = to_id(def->shear_group);
+    d.bend_group = to_id(def->bend_group);
+    d.volume_group = to_id(def->volume_group);
+    const embra::Id id = world->world.create_body(d);
+    *out_body = from_id<embra_body_id>(id);
+    if (out_first_particle) *out_first_particle = world->world.body(id).first_particle;
+  });
+}
+
+embra_status embra_body_get_particles(const embra_world* world, embra_body_id body, int32_t* out_first,
+                                      int32_t* out_count) {
+  return guard("embra_body_get_particles", [&] {
+    need(world, "world");
+    need(out_first, "out_first");
+    need(out_count, "out_count");
+    const embra::BodyInfo& b = world->world.body(to_id(body));
+    *out_first = b.first_particle;
+    *out_count = b.particle_count;
+  });
+}
+
+embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, double scale, double scale_u,
+                                       double scale_v) {
+  return guard("embra_body_set_rest_scale", [&] {
+    need(world, "world");
+    world->world.set_rest_scale(to_id(body), scale, scale_u, scale_v);
+  });
+}
+
+// --- constraints -------------------------------------------------------------------------------
+
+int32_t embra_constraint_arity(embra_constraint_kind kind) {
+  if (kind < 0 || kind >= embra::kKindCount) return 0;
+  return embra::arity(static_cast<embra::Kind>(kind));
+}
+
+embra_constraint_def embra_default_constraint_def(void) {
+  embra_constraint_def d{};
+  d.version = EMBRA_CONSTRAINT_DEF_VERSION;
+  d.kind = EMBRA_CONSTRAINT_DISTANCE;
+  d.rest_from_current = 1;
+  return d;
+}
+
+embra_status embra_constraint_add(embra_world* world, const embra_constraint_def* def) {
+  return guard("embra_constraint_add", [&] {
+    need(world, "world");
+    need(def, "def");
+    need_version(def->version, EMBRA_CONSTRAINT_DEF_VERSION, "embra_constraint_def");
+    const int32_t n = embra_constraint_arity(def->kind);
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + std::to_string(def->kind));
+    if (def->rest_from_current != 0 && def->rest_from_current != 1)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.rest_from_current must be 0 or 1");
+    embra::ConstraintDesc d;
+    d.kind = static_cast<embra::Kind>(def->kind);
+    d.group = to_id(def->group);
+    d.particles = std::span<const int32_t>(def->particles, static_cast<size_t>(n));
+    if (!def->rest_from_current) d.rest = std::span<const double>(&def->rest, 1);
+    d.uniform_compliance = def->compliance;
+    world->world.add_constraints(d);
+  });
+}
+
+embra_constraint_batch_def embra_default_constraint_batch_def(void) {
+  embra_constraint_batch_def d{};
+  d.version = EMBRA_CONSTRAINT_BATCH_DEF_VERSION;
+  d.kind = EMBRA_CONSTRAINT_DISTANCE;
+  return d;
+}
+
+embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def) {
+  return guard("embra_constraints_add", [&] {
+    need(world, "world");
+    need(def, "def");
+    need_version(def->version, EMBRA_CONSTRAINT_BATCH_DEF_VERSION, "embra_constraint_batch_def");
+    const int32_t n = embra_constraint_arity(def->kind);
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + std::to_string(def->kind));
+    if (def->count <= 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.count must be > 0");
+    embra::ConstraintDesc d;
+    d.kind = static_cast<embra::Kind>(def->kind);
+    d.group = to_id(def->group);
+    d.particles = view(def->particles, static_cast<int64_t>(def->count) * n, "def.particles");
+    if (def->rest) d.rest = std::span<const double>(def->rest, static_cast<size_t>(def->count));
+    if (def->compliances) d.compliance = std::span<const double>(def->compliances, static_cast<size_t>(def->count));
+    d.uniform_compliance = def->compliance;
+    world->world.add_constraints(d);
+  });
+}
+
+// --- pins --------------------------------------------------------------------------------------
+
+embra_pin_def embra_default_pin_def(void) {
+  embra_pin_def d{};
+  d.version = EMBRA_PIN_DEF_VERSION;
+  return d;
+}
+
+embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin) {
+  return guard("embra_pin_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_pin, "out_pin");
+    need_version(def->version, EMBRA_PIN_DEF_VERSION, "embra_pin_def");
+    embra::PinDesc d;
+    d.particle = def->particle;
+    d.target = vec(def->target);
+    d.compliance = def->compliance;
+    d.group = to_id(def->group);
+    *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
+  });
+}
+
+embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
+  return guard("embra_pin_destroy", [&] {
+    need(world, "world");
+    world->world.destroy_pin(to_id(pin));
+  });
+}
+
+embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]) {
+  return guard("embra_pin_set_target", [&] {
+    need(world, "world");
+    need(target, "target");
+    world->world.set_pin_target(to_id(pin), vec(target));
+  });
+}
+
+embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]) {
+  return guard("embra_pin_get_target", [&] {
+    need(world, "world");
+    need(out_target, "out_target");
+    const embra::Vec3& t = world->world.pin(to_id(pin)).target;
+    for (int k = 0; k < 3; ++k) out_target[k] = t[k];
+  });
+}
+
+// --- colliders ---------------------------------------------------------------------------------
+
+embra_collider_def embra_default_collider_def(void) {
+  const embra::ColliderDesc c;
+  embra_collider_def d{};
+  d.version = EMBRA_COLLIDER_DEF_VERSION;
+  d.shape = EMBRA_COLLIDER_PLANE;
+  d.rotation[0] = 1.0;
+  d.radius = c.radius;
+  d.thickness = c.thickness;
+  d.friction_static = c.friction_static;
+  d.friction_dynamic = c.friction_dynamic;
+  return d;
+}
+
+namespace {
+Eigen::Quaterniond quat(const double* wxyz) {
+  return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+}
+}  // namespace
+
+embra_status embra_collider_create(embra_world* world, const embra_collider_def* def, embra_collider_id* out_collider) {
+  return guard("embra_collider_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_collider, "out_collider");
+    need_version(def->version, EMBRA_COLLIDER_DEF_VERSION, "embra_collider_def");
+    embra::ColliderDesc d;
+    d.shape = static_cast<embra::ColliderShape>(def->shape);
+    d.position = vec(def->position);
+    d.rotation = quat(def->rotation);
+    d.radius = def->radius;
+    d.thickness = def->thickness;
+    d.friction_static = def->friction_static;
+    d.friction_dynamic = def->friction_dynamic;
+    *out_collider = from_id<embra_collider_id>(world->world.create_collider(d));
+  });
+}
+
+embra_status embra_collider_destroy(embra_world* world, embra_collider_id collider) {
+  return guard("embra_collider_destroy", [&] {
+    need(world, "world");
+    world->world.destroy_collider(to_id(collider));
+  });
+}
+
+embra_status embra_collider_set_transform(embra_world* world, embra_collider_id collider, const double position[3],
+                                          const double rotation[4]) {
+  return guard("embra_collider_set_transform", [&] {
+    need(world, "world");
+    need(position, "position");
+    need(rotation, "rotation");
+    world->world.set_collider_transform(to_id(collider), vec(position), quat(rotation));
+  });
+}
+
+// --- stepping ----------------------------------------------------------------------------------
+
+embra_status embra_world_step(embra_world* world) {
+  return guard("embra_world_step", [&] {
+    need(world, "world");
+    world->world.step();
+  });
+}
+
+embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report) {
+  return guard("embra_world_get_report", [&] {
+    need(world, "world");
+    need(out_report, "out_report");
+    const embra::StepReport& r = world->world.report();
+    embra_step_report o{};
+    o.frame = r.frame;
+    o.time = r.time;
+    o.kinetic_energy = r.kinetic_energy;
+    o.max_speed = r.max_speed;
+    o.residual_max = r.residual_max;
+    o.residual_rms = r.residual_rms;
+    o.constraint_count = r.constraint_count;
+    o.contact_count = r.contact_count;
+    o.settled = r.settled ? 1 : 0;
+    *out_report = o;
+  });
+}
+
+embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
+  return guard("embra_world_get_warning", [&] {
+    need(world, "world");
+    need(out_warning, "out_warning");
+    const embra::Warning& w = world->world.warning();
+    *out_warning = embra_warning{w.frame, w.particle, 0};
+  });
+}
+
+embra_status embra_world_get_positions(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                       int32_t count) {
+  return guard("embra_world_get_positions", [&] {
+    need(world, "world");
+    read_range(world->world, capacity, first, count, out_xyz);
+    const auto& x = world->world.positions();
+    for (int32_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = x[first + i][k];
+  });
+}
+
+embra_status embra_world_get_velocities(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                        int32_t count) {
+  return guard("embra_world_get_velocities", [&] {
+    need(world, "world");
+    read_range(world->world, capacity, first, count, out_xyz);
+    const auto& v = world->world.velocities();
+    for (int32_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = v[first + i][k];
+  });
+}
+
+embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count) {
+  return guard("embra_world_set_positions", [&] {
+    need(world, "world");
+    need_count(count, "count");
+    world->world.set_positions(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count) {
+  return guard("embra_world_set_velocities", [&] {
+    need(world, "world");
+    need_count(count, "count");
+    world->world.set_velocities(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+}  // extern "C"

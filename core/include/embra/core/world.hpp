@@ -1,0 +1,326 @@
+// The embra engine: a world of particles, bodies, constraint groups, pins and colliders, stepped
+// with XPBD (Macklin et al. 2016) in substeps (Macklin et al. 2019).
+//
+// Model and state are kept apart: topology, rest values and compliances live in the constraint
+// arrays and bodies; positions, velocities and Lagrange multipliers are the state. Every mutating
+// call validates all of its input first and throws embra::Error before touching anything, so a
+// refused call leaves the world exactly as it was.
+#pragma once
+
+#include "embra/core/constraint_math.hpp"
+
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace embra {
+
+/// Error categories; the C ABI maps them one to one onto its status codes.
+enum class ErrorCode : int32_t {
+  invalid_argument = 1,
+  stale_id = 2,
+  buffer_too_small = 3,
+  numerical = 4,
+  internal = 5,
+};
+
+class Error : public std::runtime_error {
+ public:
+  Error(ErrorCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  ErrorCode code() const { return code_; }
+
+ private:
+  ErrorCode code_;
+};
+
+/// A value id: slot index plus generation, so a destroyed object's id is refused, never reused.
+struct Id {
+  uint32_t index = 0;
+  uint32_t generation = 0;  // 0 is never a live generation: a zeroed Id is "none"
+  bool is_null() const { return generation == 0; }
+  friend bool operator==(const Id&, const Id&) = default;
+};
+
+/// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
+enum class Kind : int32_t {
+  distance = 0,    // |x0 - x1| = rest                          (stretch)
+  edge_angle = 1,  // angle at x0 between x1 - x0 and x2 - x0  (shear)
+  dihedral = 2,    // angle between (x0,x1,x2) and (x1,x0,x3)  (bend)
+  tet_volume = 3,  // signed volume of (x0,x1,x2,x3) = rest
+  weld = 4,        // x0 = x1
+  tether = 5,      // |x0 - x1| <= rest  (long-range attachment, unilateral)
+};
+constexpr int kKindCount = 6;
+int arity(Kind kind);
+const char* kind_name(Kind kind);
+
+struct Material {
+  double mass = 0.0;                // kg for the whole body; used when > 0
+  double density = 1.0;             // kg per unit of the body's measure (length, area or volume) otherwise
+  double stretch_compliance = 0.0;  // m/N (0 = inextensible)
+  double shear_compliance = 0.0;    // rad/(N m)
+  double bend_compliance = 1.0;     // rad/(N m)
+  double volume_compliance = 0.0;   // m^3/N
+  double damping = 0.0;             // 1/s, velocity decay rate
+  double thickness = 0.0;           // m, shell thickness: particles keep half of it off colliders
+  double friction_static = 0.0;
+  double friction_dynamic = 0.0;
+};
+
+enum GenerateFlags : uint32_t {
+  generate_stretch = 1u << 0,
+  generate_shear = 1u << 1,
+  generate_bend = 1u << 2,
+  generate_volume = 1u << 3,
+};
+
+struct BodyDesc {
+  std::span<const double> positions;   // 3 per vertex
+  std::span<const double> masses;      // optional, 1 per vertex (kg; 0 = immovable)
+  std::span<const double> uvs;         // optional, 2 per vertex: material u/v for rest-scale per u/v
+  std::span<const int32_t> edges;      // 2 per edge, body-local vertex indices
+  std::span<const int32_t> triangles;  // 3 per triangle
+  std::span<const int32_t> tets;       // 4 per tetrahedron
+  Material material;
+  uint32_t generate = generate_stretch | generate_bend | generate_volume;
+  Id stretch_group, shear_group, bend_group, volume_group;  // null = the default group
+};
+
+struct ConstraintDesc {
+  Kind kind = Kind::distance;
+  Id group;                            // null = the default group
+  std::span<const int32_t> particles;  // arity(kind) per constraint, world particle indices
+  std::span<const double> rest;        // one per constraint; empty = measured from current positions
+  std::span<const double> compliance;  // one per constraint; empty = `uniform_compliance` for all
+  double uniform_compliance = 0.0;
+};
+
+struct GroupDesc {
+  int32_t order = 0;   // groups are projected in increasing order (ties: creation order)
+  int32_t weight = 1;  // projections of the group per solver iteration (>= 1)
+  std::string name;
+};
+
+struct PinDesc {
+  int32_t particle = 0;
+  Vec3 target = Vec3::Zero();
+  double compliance = 0.0;  // 0 = hard (the particle follows the target exactly), else m/N
+  Id group;                 // group of a soft pin; null = the default group
+};
+
+enum class ColliderShape : int32_t { plane = 0, sphere = 1 };
+
+struct ColliderDesc {
+  ColliderShape shape = ColliderShape::plane;
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  // plane normal = local +z
+  double radius = 1.0;                                           // sphere radius (m)
+  double thickness = 0.0;                                        // extra clearance kept by particles (m)
+  double friction_static = 0.5;
+  double friction_dynamic = 0.3;
+};
+
+struct Settings {
+  double dt = 1.0 / 60.0;  // s per frame (one call to step)
+  int32_t substeps = 8;
+  int32_t iterations = 1;                // passes over the ordered groups per substep
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2
+  double damping = 0.0;                  // 1/s, applied to every particle
+  double settle_speed = 1e-3;            // m/s: settled when no particle moves faster
+  Id contact_group;                      // set by the world: the group that holds collider contacts
+};
+
+struct GroupReport {
+  int64_t count = 0;
+  double residual_max = 0.0;
+  double residual_rms = 0.0;
+};
+
+struct StepReport {
+  int64_t frame = 0;            // frames stepped since creation
+  double time = 0.0;            // simulated seconds
+  double kinetic_energy = 0.0;  // J
+  double max_speed = 0.0;       // m/s
+  double residual_max = 0.0;    // over all constraints, in each constraint's own unit
+  double residual_rms = 0.0;
+  int64_t constraint_count = 0;
+  int64_t contact_count = 0;
+  bool settled = false;
+};
+
+struct Warning {
+  int64_t frame = -1;     // frame of the last numerical failure, -1 if none
+  int32_t particle = -1;  // first particle found non-finite
+  std::string message;
+};
+
+struct BodyInfo {
+  int32_t first_particle = 0;
+  int32_t particle_count = 0;
+  Material material;
+  double rest_scale = 1.0, rest_scale_u = 1.0, rest_scale_v = 1.0;
+  std::vector<int32_t> triangles;  // world particle indices
+  std::vector<int32_t> tets;
+  bool has_uv = false;
+};
+
+/// A plain array of constraints of one kind, in one group: operands, rest and compliance (model)
+/// and accumulated multipliers (state). `rest_u/rest_v` split a distance's rest length into its
+/// material u and v parts so a body's per-direction rest-length scale applies; `body` is the body
+/// whose scale applies (-1: none).
+struct ConstraintArray {
+  std::vector<int32_t> ids;  // arity per constraint
+  std::vector<double> rest;
+  std::vector<double> rest_u, rest_v;
+  std::vector<int32_t> body;
+  std::vector<double> compliance;
+  std::vector<double> rest_now;  // rest after scaling, refreshed when scales change
+  std::vector<double> lambda;    // for welds: 3 per constraint
+  size_t size() const { return rest.size(); }
+};
+
+struct Contact {
+  int32_t particle;
+  int32_t collider;
+  double lambda;
+};
+
+struct Group {
+  GroupDesc desc;
+  uint32_t generation = 0;
+  bool alive = false;
+  int64_t serial = 0;  // creation order, to break ties in `order`
+  ConstraintArray arrays[kKindCount];
+  std::vector<int32_t> soft_pins;  // indices into World::pins_
+  std::vector<Contact> contacts;   // only in the contact group
+  GroupReport report;
+};
+
+struct Pin {
+  int32_t particle = 0;
+  Vec3 target = Vec3::Zero();
+  Vec3 target_prev = Vec3::Zero();  // target at the start of the current frame
+  double compliance = 0.0;
+  Id group;
+  Vec3 lambda = Vec3::Zero();
+  uint32_t generation = 0;
+  bool alive = false;
+};
+
+/// A collider's pose moves along a straight path from where it was at the start of the frame to
+/// `desc` (the pose the host set) over the frame's substeps.
+struct Collider {
+  ColliderDesc desc;                   // desc.position/rotation: the pose at the end of the frame
+  Vec3 frame_position = Vec3::Zero();  // pose at the start of the frame
+  Eigen::Quaterniond frame_rotation = Eigen::Quaterniond::Identity();
+  Vec3 position = Vec3::Zero();  // pose at the end of the current substep
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Vec3 position_prev = Vec3::Zero();  // pose at the start of the current substep
+  Eigen::Quaterniond rotation_prev = Eigen::Quaterniond::Identity();
+  uint32_t generation = 0;
+  bool alive = false;
+};
+
+/// The world. Not thread-safe: one thread at a time per world; different worlds are independent.
+class World {
+ public:
+  explicit World(const Settings& settings = Settings());
+
+  // --- settings --------------------------------------------------------------------------------
+  const Settings& settings() const { return settings_; }
+  void set_settings(const Settings& settings);
+  void set_gravity(const Vec3& g);
+
+  // --- bodies ----------------------------------------------------------------------------------
+  Id create_body(const BodyDesc& desc);
+  const BodyInfo& body(Id id) const;
+  void set_rest_scale(Id body, double scale, double scale_u, double scale_v);
+  size_t body_count() const { return bodies_.size(); }
+
+  // --- groups ----------------------------------------------------------------------------------
+  Id create_group(const GroupDesc& desc);
+  void destroy_group(Id id);
+  void set_group_order(Id id, int32_t order);
+  void set_group_weight(Id id, int32_t weight);
+  const Group& group(Id id) const;
+  Id default_group() const { return default_group_; }
+  Id contact_group() const { return settings_.contact_group; }
+  size_t group_count() const;
+
+  // --- constraints -----------------------------------------------------------------------------
+  /// Adds `particles.size() / arity(kind)` constraints to a group; returns how many were added.
+  int64_t add_constraints(const ConstraintDesc& desc);
+  int64_t constraint_count() const;
+
+  // --- pins ------------------------------------------------------------------------------------
+  Id create_pin(const PinDesc& desc);
+  void destroy_pin(Id id);
+  void set_pin_target(Id id, const Vec3& target);
+  const Pin& pin(Id id) const;
+  size_t pin_count() const;
+
+  // --- colliders -------------------------------------------------------------------------------
+  Id create_collider(const ColliderDesc& desc);
+  void destroy_collider(Id id);
+  void set_collider_transform(Id id, const Vec3& position, const Eigen::Quaterniond& rotation);
+  const Collider& collider(Id id) const;
+  size_t collider_count() const;
+
+  // --- particles -------------------------------------------------------------------------------
+  int32_t particle_count() const { return static_cast<int32_t>(x_.size()); }
+  const std::vector<Vec3>& positions() const { return x_; }
+  const std::vector<Vec3>& velocities() const { return v_; }
+  const std::vector<double>& inverse_masses() const { return inv_mass_; }
+  void set_positions(int32_t first, std::span<const double> xyz);
+  void set_velocities(int32_t first, std::span<const double> xyz);
+
+  // --- stepping --------------------------------------------------------------------------------
+  /// Advances one frame of settings().dt. On a non-finite state the world returns to the state it
+  /// had before the call, records a Warning and throws Error(numerical).
+  void step();
+  const StepReport& report() const { return report_; }
+  const Warning& warning() const { return warning_; }
+
+ private:
+  Group& group_mut(Id id);
+  const Group* find_group(Id id) const;
+  Id resolve_group(Id id) const;
+  void check_particle(int64_t index, const char* what) const;
+  void refresh_rest();
+  void rebuild_order();
+  void predict(double h, double alpha);
+  void move_colliders(double alpha);
+  void find_contacts();
+  void reset_multipliers();
+  void project_group(Group& g, double h);
+  void project_contacts(Group& g, double h);
+  void update_velocities(double h);
+  void measure();
+  int32_t first_non_finite() const;
+
+  Settings settings_;
+  // particle state and per-particle model
+  std::vector<Vec3> x_, x_prev_, v_;
+  std::vector<double> inv_mass_;  // model: 0 = immovable
+  std::vector<double> w_;         // solver: inverse mass with hard pins as 0
+  std::vector<double> radius_;    // contact offset (half the body's thickness)
+  std::vector<double> damping_;   // per-particle damping rate (1/s)
+  std::vector<double> mu_s_, mu_k_;
+  std::vector<int32_t> body_of_;
+  std::vector<int32_t> hard_pin_of_;  // pin slot or -1
+
+  std::vector<BodyInfo> bodies_;
+  std::vector<Group> groups_;
+  std::vector<int32_t> order_;  // live group slots in projection order
+  std::vector<Pin> pins_;
+  std::vector<Collider> colliders_;
+  Id default_group_;
+  int64_t serial_ = 0;
+  bool rest_dirty_ = true;
+  StepReport report_;
+  Warning warning_;
+};
+
+}  // namespace embra

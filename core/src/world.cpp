@@ -1,0 +1,737 @@
+// World construction and editing: everything but the step (solver.cpp). Each mutating call
+// validates everything first and only then changes the world.
+#include "embra/core/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+namespace embra {
+
+namespace {
+
+[[noreturn]] void fail(ErrorCode code, const std::string& message) {
+  throw Error(code, message);
+}
+
+[[noreturn]] void invalid(const std::string& message) {
+  fail(ErrorCode::invalid_argument, message);
+}
+
+void check_finite(double value, const char* what) {
+  if (!std::isfinite(value)) invalid(std::string(what) + " is not a finite number");
+}
+
+void check_non_negative(double value, const char* what) {
+  check_finite(value, what);
+  if (value < 0.0) invalid(std::string(what) + " must be >= 0");
+}
+
+void check_material(const Material& m) {
+  check_non_negative(m.mass, "material.mass");
+  check_non_negative(m.density, "material.density");
+  check_non_negative(m.stretch_compliance, "material.stretch_compliance");
+  check_non_negative(m.shear_compliance, "material.shear_compliance");
+  check_non_negative(m.bend_compliance, "material.bend_compliance");
+  check_non_negative(m.volume_compliance, "material.volume_compliance");
+  check_non_negative(m.damping, "material.damping");
+  check_non_negative(m.thickness, "material.thickness");
+  check_non_negative(m.friction_static, "material.friction_static");
+  check_non_negative(m.friction_dynamic, "material.friction_dynamic");
+  if (m.mass == 0.0 && m.density == 0.0) invalid("material needs a mass or a density greater than 0");
+}
+
+Vec3 at(std::span<const double> xyz, int64_t i) {
+  return Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+}
+
+std::string element_name(const char* kind, int64_t i) {
+  std::ostringstream s;
+  s << kind << " " << i;
+  return s.str();
+}
+
+/// Validates an element list (edges, triangles, tets) against the vertex count: indices in range
+/// and distinct within an element.
+void check_elements(std::span<const int32_t> ids, int n, int64_t vertex_count, const char* kind) {
+  if (ids.size() % n != 0) invalid(std::string(kind) + " index array length is not a multiple of " + std::to_string(n));
+  for (size_t e = 0; e < ids.size() / n; ++e) {
+    for (int k = 0; k < n; ++k) {
+      const int32_t v = ids[e * n + k];
+      if (v < 0 || v >= vertex_count)
+        invalid(element_name(kind, static_cast<int64_t>(e)) + " refers to vertex " + std::to_string(v) +
+                ", outside [0, " + std::to_string(vertex_count) + ")");
+      for (int j = 0; j < k; ++j)
+        if (ids[e * n + j] == v)
+          invalid(element_name(kind, static_cast<int64_t>(e)) + " is degenerate: vertex " + std::to_string(v) +
+                  " appears twice");
+    }
+  }
+}
+
+}  // namespace
+
+int arity(Kind kind) {
+  switch (kind) {
+    case Kind::distance:
+      return 2;
+    case Kind::edge_angle:
+      return 3;
+    case Kind::dihedral:
+      return 4;
+    case Kind::tet_volume:
+      return 4;
+    case Kind::weld:
+      return 2;
+    case Kind::tether:
+      return 2;
+  }
+  return 0;
+}
+
+const char* kind_name(Kind kind) {
+  switch (kind) {
+    case Kind::distance:
+      return "distance";
+    case Kind::edge_angle:
+      return "edge_angle";
+    case Kind::dihedral:
+      return "dihedral";
+    case Kind::tet_volume:
+      return "tet_volume";
+    case Kind::weld:
+      return "weld";
+    case Kind::tether:
+      return "tether";
+  }
+  return "unknown";
+}
+
+World::World(const Settings& settings) {
+  Settings s = settings;
+  s.contact_group = Id{};
+  set_settings(s);
+  GroupDesc d;
+  d.name = "default";
+  default_group_ = create_group(d);
+  GroupDesc c;
+  c.name = "contacts";
+  c.order = 1000;  // after everything else: collisions take precedence
+  settings_.contact_group = create_group(c);
+}
+
+void World::set_settings(const Settings& s) {
+  check_finite(s.dt, "settings.dt");
+  if (s.dt <= 0.0) invalid("settings.dt must be > 0");
+  if (s.substeps < 1 || s.substeps > 10000) invalid("settings.substeps must be in [1, 10000]");
+  if (s.iterations < 1 || s.iterations > 10000) invalid("settings.iterations must be in [1, 10000]");
+  for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
+  check_non_negative(s.damping, "settings.damping");
+  check_non_negative(s.settle_speed, "settings.settle_speed");
+  const Id contacts = settings_.contact_group;
+  settings_ = s;
+  settings_.contact_group = contacts;
+}
+
+void World::set_gravity(const Vec3& g) {
+  for (int k = 0; k < 3; ++k) check_finite(g[k], "gravity");
+  settings_.gravity = g;
+}
+
+// --- groups ------------------------------------------------------------------------------------
+
+const Group* World::find_group(Id id) const {
+  if (id.index >= groups_.size()) return nullptr;
+  const Group& g = groups_[id.index];
+  if (!g.alive || g.generation != id.generation) return nullptr;
+  return &g;
+}
+
+const Group& World::group(Id id) const {
+  const Group* g = find_group(id);
+  if (g == nullptr) fail(ErrorCode::stale_id, "group id does not name a live group of this world");
+  return *g;
+}
+
+Group& World::group_mut(Id id) {
+  return const_cast<Group&>(group(id));
+}
+
+Id World::resolve_group(Id id) const {
+  if (id.is_null()) return default_group_;
+  group(id);
+  return id;
+}
+
+size_t World::group_count() const {
+  return static_cast<size_t>(std::count_if(groups_.begin(), groups_.end(), [](const Group& g) { return g.alive; }));
+}
+
+Id World::create_group(const GroupDesc& desc) {
+  if (desc.weight < 1 || desc.weight > 1000) invalid("group weight must be in [1, 1000]");
+  size_t slot = groups_.size();
+  for (size_t i = 0; i < groups_.size(); ++i)
+    if (!groups_[i].alive) {
+      slot = i;
+      break;
+    }
+  if (slot == groups_.size()) groups_.emplace_back();
+  Group& g = groups_[slot];
+  const uint32_t generation = g.generation + 1;
+  g = Group{};
+  g.desc = desc;
+  g.generation = generation;
+  g.alive = true;
+  g.serial = serial_++;
+  rebuild_order();
+  return Id{static_cast<uint32_t>(slot), generation};
+}
+
+void World::destroy_group(Id id) {
+  Group& g = group_mut(id);
+  if (id == default_group_ || id == settings_.contact_group)
+    invalid("the default and contact groups cannot be destroyed");
+  if (!g.soft_pins.empty()) invalid("group still holds soft pins; destroy them first");
+  const uint32_t generation = g.generation;
+  g = Group{};
+  g.generation = generation;
+  rebuild_order();
+}
+
+void World::set_group_order(Id id, int32_t order) {
+  group_mut(id).desc.order = order;
+  rebuild_order();
+}
+
+void World::set_group_weight(Id id, int32_t weight) {
+  Group& g = group_mut(id);
+  if (weight < 1 || weight > 1000) invalid("group weight must be in [1, 1000]");
+  g.desc.weight = weight;
+}
+
+void World::rebuild_order() {
+  order_.clear();
+  for (size_t i = 0; i < groups_.size(); ++i)
+    if (groups_[i].alive) order_.push_back(static_cast<int32_t>(i));
+  std::sort(order_.begin(), order_.end(), [&](int32_t a, int32_t b) {
+    const Group& ga = groups_[a];
+    const Group& gb = groups_[b];
+    if (ga.desc.order != gb.desc.order) return ga.desc.order < gb.desc.order;
+    return ga.serial < gb.serial;
+  });
+}
+
+// --- constraints -------------------------------------------------------------------------------
+
+void World::check_particle(int64_t index, const char* what) const {
+  if (index < 0 || index >= particle_count())
+    invalid(std::string(what) + " " + std::to_string(index) + " is outside [0, " + std::to_string(particle_count()) +
+            ")");
+}
+
+namespace {
+
+/// Measures a constraint's function at the current positions (rest "from current"); throws for a
+/// degenerate element, for which no rest value can be measured.
+double measure_rest(Kind kind, const int32_t* p, const std::vector<Vec3>& x, int64_t i) {
+  const std::string name = element_name(kind_name(kind), i);
+  switch (kind) {
+    case Kind::distance:
+    case Kind::tether: {
+      const double len = (x[p[0]] - x[p[1]]).norm();
+      if (!(len > 0.0)) invalid(name + " is degenerate: its particles coincide (zero length)");
+      return len;
+    }
+    case Kind::edge_angle: {
+      const auto e = eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]);
+      if ((x[p[1]] - x[p[0]]).norm() == 0.0 || (x[p[2]] - x[p[0]]).norm() == 0.0)
+        invalid(name + " is degenerate: an edge has zero length");
+      return e.value;
+    }
+    case Kind::dihedral: {
+      const auto e = eval_dihedral(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+      if (!e.valid) invalid(name + " is degenerate: a triangle has zero area");
+      return e.value;
+    }
+    case Kind::tet_volume: {
+      const auto e = eval_tet_volume(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+      const double scale =
+          std::max({(x[p[1]] - x[p[0]]).norm(), (x[p[2]] - x[p[0]]).norm(), (x[p[3]] - x[p[0]]).norm()});
+      if (!(std::abs(e.value) > 1e-12 * scale * scale * scale)) invalid(name + " is degenerate: zero volume");
+      return e.value;
+    }
+    case Kind::weld:
+      return 0.0;
+  }
+  return 0.0;
+}
+
+void check_rest(Kind kind, double rest, int64_t i) {
+  const std::string name = element_name(kind_name(kind), i);
+  check_finite(rest, (name + " rest value").c_str());
+  switch (kind) {
+    case Kind::distance:
+    case Kind::tether:
+      if (rest < 0.0) invalid(name + " rest length must be >= 0");
+      break;
+    case Kind::edge_angle:
+      if (rest < 0.0 || rest > std::numbers::pi) invalid(name + " rest angle must be in [0, pi]");
+      break;
+    case Kind::dihedral:
+      if (rest <= -std::numbers::pi || rest > std::numbers::pi) invalid(name + " rest angle must be in (-pi, pi]");
+      break;
+    case Kind::weld:
+      if (rest != 0.0) invalid(name + ": a weld has no rest value other than 0");
+      break;
+    case Kind::tet_volume:
+      break;
+  }
+}
+
+}  // namespace
+
+int64_t World::add_constraints(const ConstraintDesc& desc) {
+  const int k = static_cast<int>(desc.kind);
+  if (k < 0 || k >= kKindCount) invalid("unknown constraint kind " + std::to_string(k));
+  const int n = arity(desc.kind);
+  const Id gid = resolve_group(desc.group);
+  if (desc.particles.empty()) invalid("no constraints given (particle array is empty)");
+  if (desc.particles.size() % n != 0)
+    invalid(std::string("particle array length is not a multiple of ") + std::to_string(n) + " (the arity of " +
+            kind_name(desc.kind) + ")");
+  const size_t count = desc.particles.size() / n;
+  if (!desc.rest.empty() && desc.rest.size() != count) invalid("rest array length differs from the constraint count");
+  if (!desc.compliance.empty() && desc.compliance.size() != count)
+    invalid("compliance array length differs from the constraint count");
+  check_non_negative(desc.uniform_compliance, "compliance");
+  std::vector<double> rest(count);
+  for (size_t i = 0; i < count; ++i) {
+    const int32_t* p = &desc.particles[i * n];
+    for (int a = 0; a < n; ++a) {
+      check_particle(p[a], (element_name(kind_name(desc.kind), static_cast<int64_t>(i)) + " particle").c_str());
+      for (int b = 0; b < a; ++b)
+        if (p[a] == p[b])
+          invalid(element_name(kind_name(desc.kind), static_cast<int64_t>(i)) + " is degenerate: particle " +
+                  std::to_string(p[a]) + " appears twice");
+    }
+    if (!desc.compliance.empty()) check_non_negative(desc.compliance[i], "compliance");
+    if (desc.rest.empty()) {
+      rest[i] = measure_rest(desc.kind, p, x_, static_cast<int64_t>(i));
+    } else {
+      check_rest(desc.kind, desc.rest[i], static_cast<int64_t>(i));
+      rest[i] = desc.rest[i];
+    }
+  }
+  // Everything is valid: append.
+  ConstraintArray& a = group_mut(gid).arrays[k];
+  a.ids.insert(a.ids.end(), desc.particles.begin(), desc.particles.end());
+  for (size_t i = 0; i < count; ++i) {
+    a.rest.push_back(rest[i]);
+    a.rest_u.push_back(0.0);
+    a.rest_v.push_back(0.0);
+    a.body.push_back(-1);
+    a.compliance.push_back(desc.compliance.empty() ? desc.uniform_compliance : desc.compliance[i]);
+    a.rest_now.push_back(rest[i]);
+    for (int c = 0; c < (desc.kind == Kind::weld ? 3 : 1); ++c) a.lambda.push_back(0.0);
+  }
+  rest_dirty_ = true;
+  return static_cast<int64_t>(count);
+}
+
+int64_t World::constraint_count() const {
+  int64_t n = 0;
+  for (const Group& g : groups_)
+    if (g.alive)
+      for (const ConstraintArray& a : g.arrays) n += static_cast<int64_t>(a.size());
+  return n;
+}
+
+// --- bodies ------------------------------------------------------------------------------------
+
+Id World::create_body(const BodyDesc& d) {
+  if (d.positions.empty() || d.positions.size() % 3 != 0)
+    invalid("body positions must be a non-empty array of 3 numbers per vertex");
+  const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
+  if (nv + particle_count() > INT32_MAX / 4) invalid("too many particles");
+  for (double c : d.positions) check_finite(c, "body vertex coordinate");
+  if (!d.masses.empty()) {
+    if (static_cast<int64_t>(d.masses.size()) != nv) invalid("body masses must have one value per vertex");
+    for (double m : d.masses) check_non_negative(m, "body vertex mass");
+  }
+  if (!d.uvs.empty()) {
+    if (static_cast<int64_t>(d.uvs.size()) != 2 * nv) invalid("body uvs must have two values per vertex");
+    for (double c : d.uvs) check_finite(c, "body uv coordinate");
+  }
+  check_elements(d.edges, 2, nv, "edge");
+  check_elements(d.triangles, 3, nv, "triangle");
+  check_elements(d.tets, 4, nv, "tetrahedron");
+  if (d.masses.empty())
+    check_material(d.material);
+  else {
+    Material m = d.material;
+    if (m.mass == 0.0 && m.density == 0.0) m.density = 1.0;  // not used: masses are given
+    check_material(m);
+  }
+  const Id groups[4] = {resolve_group(d.stretch_group), resolve_group(d.shear_group), resolve_group(d.bend_group),
+                        resolve_group(d.volume_group)};
+
+  // Degenerate elements, measured against the body's size.
+  Vec3 lo = at(d.positions, 0), hi = lo;
+  for (int64_t i = 1; i < nv; ++i) {
+    lo = lo.cwiseMin(at(d.positions, i));
+    hi = hi.cwiseMax(at(d.positions, i));
+  }
+  const double diag = std::max((hi - lo).norm(), 1e-300);
+  const double eps_len = 1e-12 * diag;
+  auto P = [&](int32_t i) { return at(d.positions, i); };
+  std::vector<double> weight(nv, 0.0);
+  std::vector<double> edge_w(nv, 0.0), tri_w(nv, 0.0), tet_w(nv, 0.0);
+  for (size_t e = 0; e < d.edges.size() / 2; ++e) {
+    const double len = (P(d.edges[2 * e]) - P(d.edges[2 * e + 1])).norm();
+    if (len <= eps_len) invalid(element_name("edge", static_cast<int64_t>(e)) + " is degenerate: zero length");
+    edge_w[d.edges[2 * e]] += len / 2;
+    edge_w[d.edges[2 * e + 1]] += len / 2;
+  }
+  for (size_t t = 0; t < d.triangles.size() / 3; ++t) {
+    const int32_t* v = &d.triangles[3 * t];
+    const double area = 0.5 * (P(v[1]) - P(v[0])).cross(P(v[2]) - P(v[0])).norm();
+    if (area <= eps_len * diag)
+      invalid(element_name("triangle", static_cast<int64_t>(t)) + " is degenerate: zero area");
+    for (int k = 0; k < 3; ++k) tri_w[v[k]] += area / 3;
+  }
+  for (size_t t = 0; t < d.tets.size() / 4; ++t) {
+    const int32_t* v = &d.tets[4 * t];
+    const double vol = std::abs((P(v[1]) - P(v[0])).cross(P(v[2]) - P(v[0])).dot(P(v[3]) - P(v[0]))) / 6;
+    if (vol <= eps_len * diag * diag)
+      invalid(element_name("tetrahedron", static_cast<int64_t>(t)) + " is degenerate: zero volume");
+    for (int k = 0; k < 4; ++k) tet_w[v[k]] += vol / 4;
+  }
+
+  // Lumped masses: by volume when there are tetrahedra, else area, else length, else equal.
+  std::vector<double> mass(nv);
+  if (!d.masses.empty()) {
+    std::copy(d.masses.begin(), d.masses.end(), mass.begin());
+  } else {
+    const std::vector<double>* w = !d.tets.empty()        ? &tet_w
+                                   : !d.triangles.empty() ? &tri_w
+                                   : !d.edges.empty()     ? &edge_w
+                                                          : nullptr;
+    double total = 0.0;
+    int64_t covered = 0;
+    for (int64_t i = 0; i < nv; ++i) {
+      weight[i] = w ? (*w)[i] : 1.0;
+      total += weight[i];
+      covered += weight[i] > 0.0;
+    }
+    const double fill = total / static_cast<double>(covered);  // isolated vertices get the mean
+    for (int64_t i = 0; i < nv; ++i)
+      if (weight[i] == 0.0) weight[i] = fill;
+    total = std::accumulate(weight.begin(), weight.end(), 0.0);
+    for (int64_t i = 0; i < nv; ++i)
+      mass[i] = d.material.mass > 0.0 ? d.material.mass * weight[i] / total : d.material.density * weight[i];
+  }
+
+  // Unique edges from the explicit list, the triangles and the tetrahedra.
+  std::vector<std::pair<int32_t, int32_t>> edges;
+  auto add_edge = [&](int32_t a, int32_t b) { edges.emplace_back(std::min(a, b), std::max(a, b)); };
+  for (size_t e = 0; e < d.edges.size() / 2; ++e) add_edge(d.edges[2 * e], d.edges[2 * e + 1]);
+  for (size_t t = 0; t < d.triangles.size() / 3; ++t)
+    for (int k = 0; k < 3; ++k) add_edge(d.triangles[3 * t + k], d.triangles[3 * t + (k + 1) % 3]);
+  for (size_t t = 0; t < d.tets.size() / 4; ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) add_edge(d.tets[4 * t + a], d.tets[4 * t + b]);
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+  // Hinges: pairs of triangles sharing an edge (consecutive pairs around a non-manifold edge).
+  std::map<std::pair<int32_t, int32_t>, std::vector<std::pair<int32_t, int32_t>>> wings;  // edge -> (triangle, wing)
+  for (size_t t = 0; t < d.triangles.size() / 3; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = d.triangles[3 * t + k], b = d.triangles[3 * t + (k + 1) % 3],
+                    c = d.triangles[3 * t + (k + 2) % 3];
+      wings[{std::min(a, b), std::max(a, b)}].emplace_back(static_cast<int32_t>(t), c);
+    }
+
+  // Everything is valid: commit.
+  const int32_t first = particle_count();
+  const int32_t body_index = static_cast<int32_t>(bodies_.size());
+  for (int64_t i = 0; i < nv; ++i) {
+    x_.push_back(P(static_cast<int32_t>(i)));
+    x_prev_.push_back(x_.back());
+    v_.push_back(Vec3::Zero());
+    inv_mass_.push_back(mass[i] > 0.0 ? 1.0 / mass[i] : 0.0);
+    w_.push_back(inv_mass_.back());
+    radius_.push_back(0.5 * d.material.thickness);
+    damping_.push_back(d.material.damping);
+    mu_s_.push_back(d.material.friction_static);
+    mu_k_.push_back(d.material.friction_dynamic);
+    body_of_.push_back(body_index);
+    hard_pin_of_.push_back(-1);
+  }
+  BodyInfo info;
+  info.first_particle = first;
+  info.particle_count = static_cast<int32_t>(nv);
+  info.material = d.material;
+  info.has_uv = !d.uvs.empty();
+  for (int32_t v : d.triangles) info.triangles.push_back(first + v);
+  for (int32_t v : d.tets) info.tets.push_back(first + v);
+  bodies_.push_back(info);
+
+  auto append = [&](Kind kind, Id gid, std::initializer_list<int32_t> local, double rest, double compliance, double ru,
+                    double rv) {
+    ConstraintArray& a = group_mut(gid).arrays[static_cast<int>(kind)];
+    for (int32_t v : local) a.ids.push_back(first + v);
+    a.rest.push_back(rest);
+    a.rest_u.push_back(ru);
+    a.rest_v.push_back(rv);
+    a.body.push_back(body_index);
+    a.compliance.push_back(compliance);
+    a.rest_now.push_back(rest);
+    a.lambda.push_back(0.0);
+  };
+  const Material& m = d.material;
+  if (d.generate & generate_stretch)
+    for (auto [a, b] : edges) {
+      const double rest = (P(a) - P(b)).norm();
+      double ru = 0.0, rv = 0.0;
+      if (info.has_uv) {
+        const double du = std::abs(d.uvs[2 * a] - d.uvs[2 * b]);
+        const double dv = std::abs(d.uvs[2 * a + 1] - d.uvs[2 * b + 1]);
+        const double duv = std::hypot(du, dv);
+        if (duv > 0.0) {
+          ru = rest * du / duv;
+          rv = rest * dv / duv;
+        }
+      }
+      append(Kind::distance, groups[0], {a, b}, rest, m.stretch_compliance, ru, rv);
+    }
+  if (d.generate & generate_shear)
+    for (size_t t = 0; t < d.triangles.size() / 3; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int32_t c = d.triangles[3 * t + k], a = d.triangles[3 * t + (k + 1) % 3],
+                      b = d.triangles[3 * t + (k + 2) % 3];
+        append(Kind::edge_angle, groups[1], {c, a, b}, eval_edge_angle(P(c), P(a), P(b)).value, m.shear_compliance, 0,
+               0);
+      }
+  if (d.generate & generate_bend)
+    for (const auto& [edge, list] : wings)
+      for (size_t i = 0; i + 1 < list.size(); ++i) {
+        const int32_t* t = &d.triangles[3 * list[i].first];
+        // Orient the hinge edge as it runs in the first triangle.
+        int32_t a = edge.first, b = edge.second;
+        for (int k = 0; k < 3; ++k)
+          if (t[k] == b && t[(k + 1) % 3] == a) std::swap(a, b);
+        const int32_t c = list[i].second, e = list[i + 1].second;
+        if (c == e) continue;  // two triangles on the same three vertices: no hinge
+        append(Kind::dihedral, groups[2], {a, b, c, e}, eval_dihedral(P(a), P(b), P(c), P(e)).value, m.bend_compliance,
+               0, 0);
+      }
+  if (d.generate & generate_volume)
+    for (size_t t = 0; t < d.tets.size() / 4; ++t) {
+      const int32_t* v = &d.tets[4 * t];
+      append(Kind::tet_volume, groups[3], {v[0], v[1], v[2], v[3]},
+             eval_tet_volume(P(v[0]), P(v[1]), P(v[2]), P(v[3])).value, m.volume_compliance, 0, 0);
+    }
+  rest_dirty_ = true;
+  return Id{static_cast<uint32_t>(body_index), 1};
+}
+
+const BodyInfo& World::body(Id id) const {
+  if (id.generation != 1 || id.index >= bodies_.size())
+    fail(ErrorCode::stale_id, "body id does not name a body of this world");
+  return bodies_[id.index];
+}
+
+void World::set_rest_scale(Id id, double scale, double scale_u, double scale_v) {
+  body(id);
+  check_non_negative(scale, "rest scale");
+  check_non_negative(scale_u, "rest scale u");
+  check_non_negative(scale_v, "rest scale v");
+  BodyInfo& b = bodies_[id.index];
+  b.rest_scale = scale;
+  b.rest_scale_u = scale_u;
+  b.rest_scale_v = scale_v;
+  rest_dirty_ = true;
+}
+
+void World::refresh_rest() {
+  for (Group& g : groups_) {
+    if (!g.alive) continue;
+    for (int k = 0; k < kKindCount; ++k) {
+      ConstraintArray& a = g.arrays[k];
+      for (size_t i = 0; i < a.size(); ++i) {
+        if (a.body[i] < 0) {
+          a.rest_now[i] = a.rest[i];
+          continue;
+        }
+        const BodyInfo& b = bodies_[a.body[i]];
+        if (k == static_cast<int>(Kind::distance)) {
+          const double ru = a.rest_u[i] * b.rest_scale_u, rv = a.rest_v[i] * b.rest_scale_v;
+          const double rn2 =
+              std::max(0.0, a.rest[i] * a.rest[i] - a.rest_u[i] * a.rest_u[i] - a.rest_v[i] * a.rest_v[i]);
+          a.rest_now[i] = b.rest_scale * std::sqrt(ru * ru + rv * rv + rn2);
+        } else if (k == static_cast<int>(Kind::tet_volume)) {
+          a.rest_now[i] = a.rest[i] * b.rest_scale * b.rest_scale * b.rest_scale;
+        } else {
+          a.rest_now[i] = a.rest[i];
+        }
+      }
+    }
+  }
+  rest_dirty_ = false;
+}
+
+// --- pins --------------------------------------------------------------------------------------
+
+Id World::create_pin(const PinDesc& desc) {
+  check_particle(desc.particle, "pin particle");
+  for (int k = 0; k < 3; ++k) check_finite(desc.target[k], "pin target");
+  check_non_negative(desc.compliance, "pin compliance");
+  Id gid;
+  if (desc.compliance == 0.0) {
+    if (hard_pin_of_[desc.particle] >= 0)
+      invalid("particle " + std::to_string(desc.particle) + " already has a hard pin");
+  } else {
+    gid = resolve_group(desc.group);
+  }
+  size_t slot = pins_.size();
+  for (size_t i = 0; i < pins_.size(); ++i)
+    if (!pins_[i].alive) {
+      slot = i;
+      break;
+    }
+  if (slot == pins_.size()) pins_.emplace_back();
+  Pin& p = pins_[slot];
+  const uint32_t generation = p.generation + 1;
+  p = Pin{};
+  p.particle = desc.particle;
+  p.target = desc.target;
+  p.target_prev = desc.compliance == 0.0 ? x_[desc.particle] : desc.target;  // a hard pin glides there
+  p.compliance = desc.compliance;
+  p.group = gid;
+  p.generation = generation;
+  p.alive = true;
+  if (desc.compliance == 0.0) {
+    hard_pin_of_[desc.particle] = static_cast<int32_t>(slot);
+    w_[desc.particle] = 0.0;
+  } else {
+    group_mut(gid).soft_pins.push_back(static_cast<int32_t>(slot));
+  }
+  return Id{static_cast<uint32_t>(slot), generation};
+}
+
+const Pin& World::pin(Id id) const {
+  if (id.index >= pins_.size() || !pins_[id.index].alive || pins_[id.index].generation != id.generation)
+    fail(ErrorCode::stale_id, "pin id does not name a live pin of this world");
+  return pins_[id.index];
+}
+
+void World::destroy_pin(Id id) {
+  const Pin& p = pin(id);
+  if (p.compliance == 0.0) {
+    hard_pin_of_[p.particle] = -1;
+    w_[p.particle] = inv_mass_[p.particle];
+  } else {
+    auto& list = group_mut(p.group).soft_pins;
+    list.erase(std::find(list.begin(), list.end(), static_cast<int32_t>(id.index)));
+  }
+  const uint32_t generation = p.generation;
+  pins_[id.index] = Pin{};
+  pins_[id.index].generation = generation;
+}
+
+void World::set_pin_target(Id id, const Vec3& target) {
+  pin(id);
+  for (int k = 0; k < 3; ++k) check_finite(target[k], "pin target");
+  pins_[id.index].target = target;
+}
+
+size_t World::pin_count() const {
+  return static_cast<size_t>(std::count_if(pins_.begin(), pins_.end(), [](const Pin& p) { return p.alive; }));
+}
+
+// --- colliders ---------------------------------------------------------------------------------
+
+namespace {
+void check_transform(const Vec3& position, const Eigen::Quaterniond& rotation) {
+  for (int k = 0; k < 3; ++k) check_finite(position[k], "collider position");
+  for (int k = 0; k < 4; ++k) check_finite(rotation.coeffs()[k], "collider rotation");
+  if (std::abs(rotation.norm() - 1.0) > 1e-6) invalid("collider rotation must be a unit quaternion");
+}
+}  // namespace
+
+Id World::create_collider(const ColliderDesc& desc) {
+  const int shape = static_cast<int>(desc.shape);
+  if (shape < 0 || shape > 1) invalid("unknown collider shape " + std::to_string(shape));
+  check_transform(desc.position, desc.rotation);
+  check_non_negative(desc.thickness, "collider thickness");
+  check_non_negative(desc.friction_static, "collider friction_static");
+  check_non_negative(desc.friction_dynamic, "collider friction_dynamic");
+  if (desc.shape == ColliderShape::sphere) {
+    check_finite(desc.radius, "sphere radius");
+    if (desc.radius <= 0.0) invalid("sphere radius must be > 0");
+  }
+  size_t slot = colliders_.size();
+  for (size_t i = 0; i < colliders_.size(); ++i)
+    if (!colliders_[i].alive) {
+      slot = i;
+      break;
+    }
+  if (slot == colliders_.size()) colliders_.emplace_back();
+  Collider& c = colliders_[slot];
+  const uint32_t generation = c.generation + 1;
+  c = Collider{};
+  c.desc = desc;
+  c.desc.rotation.normalize();
+  c.frame_position = c.position = c.position_prev = desc.position;
+  c.frame_rotation = c.rotation = c.rotation_prev = c.desc.rotation;
+  c.generation = generation;
+  c.alive = true;
+  return Id{static_cast<uint32_t>(slot), generation};
+}
+
+const Collider& World::collider(Id id) const {
+  if (id.index >= colliders_.size() || !colliders_[id.index].alive || colliders_[id.index].generation != id.generation)
+    fail(ErrorCode::stale_id, "collider id does not name a live collider of this world");
+  return colliders_[id.index];
+}
+
+void World::destroy_collider(Id id) {
+  const uint32_t generation = collider(id).generation;
+  colliders_[id.index] = Collider{};
+  colliders_[id.index].generation = generation;
+}
+
+void World::set_collider_transform(Id id, const Vec3& position, const Eigen::Quaterniond& rotation) {
+  collider(id);
+  check_transform(position, rotation);
+  colliders_[id.index].desc.position = position;
+  colliders_[id.index].desc.rotation = rotation.normalized();
+}
+
+size_t World::collider_count() const {
+  return static_cast<size_t>(
+      std::count_if(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; }));
+}
+
+// --- particles ---------------------------------------------------------------------------------
+
+void World::set_positions(int32_t first, std::span<const double> xyz) {
+  if (xyz.size() % 3 != 0) invalid("position array length is not a multiple of 3");
+  const int64_t n = static_cast<int64_t>(xyz.size() / 3);
+  if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
+  for (double c : xyz) check_finite(c, "position coordinate");
+  for (int64_t i = 0; i < n; ++i) x_[first + i] = at(xyz, i);
+}
+
+void World::set_velocities(int32_t first, std::span<const double> xyz) {
+  if (xyz.size() % 3 != 0) invalid("velocity array length is not a multiple of 3");
+  const int64_t n = static_cast<int64_t>(xyz.size() / 3);
+  if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
+  for (double c : xyz) check_finite(c, "velocity coordinate");
+  for (int64_t i = 0; i < n; ++i) v_[first + i] = at(xyz, i);
+}
+
+}  // namespace embra
