@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# The `embra` command's contract: exit codes, and the tent demo's output checked against what it
+# promises (vertex and face counts, finite coordinates, the hard-pinned corners exactly at their
+# targets: 90% of the unit triangle's corners, at z = 0).
+set -u
+embra="$1"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
+
+"$embra" version >/dev/null && ok || bad "embra version exits non-zero"
+"$embra" >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "no arguments must exit 1 (usage)"
+"$embra" demo tent --frames >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "a flag without value must exit 1"
+"$embra" demo tent --n 1 >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "--n 1 must exit 1"
+"$embra" demo tent --out /proc/embra-cannot-write >/dev/null 2>&1; [ $? -eq 2 ] && ok || bad "an unwritable --out must exit 2"
+
+rows=10
+"$embra" demo tent --frames 90 --every 30 --n $rows --out "$tmp/tent" >"$tmp/log" 2>&1 && ok || bad "demo tent failed: $(cat "$tmp/log")"
+for f in frame_00030.obj frame_00060.obj frame_00090.obj final.obj; do
+  [ -s "$tmp/tent/$f" ] && ok || bad "missing $f"
+done
+# (rows+1)(rows+2)/2 vertices, rows^2 faces, all finite; corners 0, rows, last row at 0.9 x start.
+awk -v rows=$rows '
+  /^v / { n++; x[n-1]=$2; y[n-1]=$3; z[n-1]=$4
+          for (k = 2; k <= 4; k++) if ($k != $k + 0 || $k ~ /nan|inf/) bad = 1 }
+  /^f / { f++ }
+  END {
+    nv = (rows + 1) * (rows + 2) / 2
+    if (n != nv || f != rows * rows) { print "counts " n " " f; exit 1 }
+    if (bad) { print "non-finite coordinate"; exit 1 }
+    h = sqrt(3) / 2
+    cx[0] = -0.5; cy[0] = -h / 3; cx[1] = 0.5; cy[1] = -h / 3; cx[2] = 0; cy[2] = 2 * h / 3
+    idx[0] = 0; idx[1] = rows; idx[2] = nv - 1
+    for (k = 0; k < 3; k++) {
+      i = idx[k]; dx = x[i] - 0.9 * cx[k]; dy = y[i] - 0.9 * cy[k]
+      d = sqrt(dx * dx + dy * dy + z[i] * z[i])
+      if (d > 1e-12) { print "corner " k " is " d " m from its pin target"; exit 1 }
+    }
+    top = -1; for (i = 0; i < n; i++) if (z[i] > top) top = z[i]
+    if (top <= 0) { print "reversed gravity must lift the membrane, apex " top; exit 1 }
+  }' "$tmp/tent/final.obj" && ok || bad "final.obj does not match the tent's geometry"
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
