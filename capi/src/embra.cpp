@@ -349,8 +349,8 @@ embra_material embra_default_material(void) {
   r.volume_compliance = m.volume_compliance;
   r.damping = m.damping;
   r.thickness = m.thickness;
-  r.friction_static = 0.5;
-  r.friction_dynamic = 0.3;
+  r.friction_static = m.friction_static;
+  r.friction_dynamic = m.friction_dynamic;
   return r;
 }
 

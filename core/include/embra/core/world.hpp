@@ -65,8 +65,8 @@ struct Material {
   double volume_compliance = 0.0;   // m^3/N
   double damping = 0.0;             // 1/s, velocity decay rate
   double thickness = 0.0;           // m, shell thickness: particles keep half of it off colliders
-  double friction_static = 0.0;
-  double friction_dynamic = 0.0;
+  double friction_static = 0.5;     // against colliders (geometric mean with the collider's)
+  double friction_dynamic = 0.3;
 };
 
 enum GenerateFlags : uint32_t {
