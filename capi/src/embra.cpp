@@ -5,6 +5,7 @@
 #include "embra/core/world.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <string>
@@ -16,6 +17,15 @@ struct embra_world {
 namespace {
 
 thread_local std::string g_last_error;
+
+/// Decimal text of an integer. Not std::to_string: its libstdc++ implementation has function-local
+/// statics of default visibility (std::__detail::__to_chars_10_impl<...>::__digits) that would be
+/// exported from libembra.so beside the embra_ functions.
+std::string num(int64_t value) {
+  char text[24];
+  std::snprintf(text, sizeof text, "%lld", static_cast<long long>(value));
+  return text;
+}
 
 struct Refused {
   embra_status status;
@@ -73,8 +83,8 @@ void need(const T* p, const char* name) {
 
 void need_version(int32_t got, int32_t want, const char* def) {
   if (got != want)
-    refuse(EMBRA_ERROR_VERSION, std::string(def) + ".version is " + std::to_string(got) + ", this library reads " +
-                                    std::to_string(want) + " (start from its embra_default_ function)");
+    refuse(EMBRA_ERROR_VERSION, std::string(def) + ".version is " + num(got) + ", this library reads " + num(want) +
+                                    " (start from its embra_default_ function)");
 }
 
 void need_count(int64_t count, const char* name) {
@@ -130,12 +140,12 @@ embra::Material to_material(const embra_material& m) {
 void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t count, const double* out) {
   need(out, "out_xyz");
   if (first < 0 || count < 0 || static_cast<int64_t>(first) + count > w.particle_count())
-    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particle range [" + std::to_string(first) + ", " +
-                                             std::to_string(static_cast<int64_t>(first) + count) + ") is outside [0, " +
-                                             std::to_string(w.particle_count()) + ")");
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particle range [" + num(first) + ", " +
+                                             num(static_cast<int64_t>(first) + count) + ") is outside [0, " +
+                                             num(w.particle_count()) + ")");
   if (capacity < 3 * static_cast<int64_t>(count))
-    refuse(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer holds " + std::to_string(capacity) + " doubles, " +
-                                             std::to_string(3 * static_cast<int64_t>(count)) + " needed");
+    refuse(EMBRA_ERROR_BUFFER_TOO_SMALL,
+           "buffer holds " + num(capacity) + " doubles, " + num(3 * static_cast<int64_t>(count)) + " needed");
 }
 
 }  // namespace
@@ -184,8 +194,8 @@ int32_t embra_abi_version(void) {
 embra_status embra_check_abi(int32_t header_abi_version) {
   return guard("embra_check_abi", [&] {
     if (header_abi_version != EMBRA_ABI_VERSION)
-      refuse(EMBRA_ERROR_VERSION, "the host was compiled against ABI " + std::to_string(header_abi_version) +
-                                      ", this library is ABI " + std::to_string(EMBRA_ABI_VERSION));
+      refuse(EMBRA_ERROR_VERSION, "the host was compiled against ABI " + num(header_abi_version) +
+                                      ", this library is ABI " + num(EMBRA_ABI_VERSION));
   });
 }
 
@@ -435,7 +445,7 @@ embra_status embra_constraint_add(embra_world* world, const embra_constraint_def
     need(def, "def");
     need_version(def->version, EMBRA_CONSTRAINT_DEF_VERSION, "embra_constraint_def");
     const int32_t n = embra_constraint_arity(def->kind);
-    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + std::to_string(def->kind));
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + num(def->kind));
     if (def->rest_from_current != 0 && def->rest_from_current != 1)
       refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.rest_from_current must be 0 or 1");
     embra::ConstraintDesc d;
@@ -461,7 +471,7 @@ embra_status embra_constraints_add(embra_world* world, const embra_constraint_ba
     need(def, "def");
     need_version(def->version, EMBRA_CONSTRAINT_BATCH_DEF_VERSION, "embra_constraint_batch_def");
     const int32_t n = embra_constraint_arity(def->kind);
-    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + std::to_string(def->kind));
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + num(def->kind));
     if (def->count <= 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.count must be > 0");
     embra::ConstraintDesc d;
     d.kind = static_cast<embra::Kind>(def->kind);
@@ -548,6 +558,8 @@ embra_status embra_collider_create(embra_world* world, const embra_collider_def*
     need(def, "def");
     need(out_collider, "out_collider");
     need_version(def->version, EMBRA_COLLIDER_DEF_VERSION, "embra_collider_def");
+    // Core checks the radius of spheres only; a non-finite number is refused in every field.
+    if (!std::isfinite(def->radius)) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.radius is not a finite number");
     embra::ColliderDesc d;
     d.shape = static_cast<embra::ColliderShape>(def->shape);
     d.position = vec(def->position);
