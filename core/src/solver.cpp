@@ -107,7 +107,8 @@ void World::predict(double h, double alpha) {
     x_[i] += h * v_[i];
   }
   for (const Pin& p : pins_)
-    if (p.alive && p.compliance == 0.0) x_[p.particle] = p.target_prev + alpha * (p.target - p.target_prev);
+    if (p.alive && p.compliance == 0.0)
+      x_[p.particle] = (1.0 - alpha) * p.target_prev + alpha * p.target;  // exact at 1
 }
 
 void World::move_colliders(double alpha) {
@@ -115,8 +116,9 @@ void World::move_colliders(double alpha) {
     if (!c.alive) continue;
     c.position_prev = c.position;
     c.rotation_prev = c.rotation;
-    c.position = c.frame_position + alpha * (c.desc.position - c.frame_position);
-    c.rotation = c.frame_rotation.slerp(alpha, c.desc.rotation);
+    // Exact at alpha = 1: the collider ends the frame precisely where the host put it.
+    c.position = (1.0 - alpha) * c.frame_position + alpha * c.desc.position;
+    c.rotation = alpha == 1.0 ? c.desc.rotation : c.frame_rotation.slerp(alpha, c.desc.rotation);
   }
 }
 
