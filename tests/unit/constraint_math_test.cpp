@@ -1,0 +1,163 @@
+// Constraint functions and gradients (constraint_math.hpp), checked against independent formulas and
+// central finite differences on random, well-conditioned configurations.
+//
+// Weld (x0 - x1) and pin (x - target) are linear: their gradients are +-identity and there is no
+// function for them in constraint_math.hpp; their one-projection answers are checked exactly in
+// projection_test.cpp instead. The tether uses eval_distance.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <array>
+#include <functional>
+#include <numbers>
+
+namespace embra {
+namespace {
+
+using test::Rng;
+
+constexpr int kConfigs = 200;
+
+// Central difference step. With coordinates of order 1 the error of the quotient is about
+// step^2/6 |f'''| + eps |f| / step, i.e. below 1e-9 for the well-conditioned configurations drawn
+// here; a wrong gradient is off by order 1. The tolerance 1e-7 leaves room for |f'''| up to 1e5.
+constexpr double kStep = 1e-6;
+constexpr double kTol = 1e-7;
+
+template <int N>
+using Points = std::array<Vec3, N>;
+
+template <int N>
+void check_gradient(const std::function<ConstraintEval<N>(const Points<N>&)>& f, const Points<N>& x, const char* what,
+                    int config) {
+  const ConstraintEval<N> e = f(x);
+  ASSERT_TRUE(e.valid) << what << " config " << config;
+  for (int k = 0; k < N; ++k)
+    for (int c = 0; c < 3; ++c) {
+      Points<N> xp = x, xm = x;
+      xp[k][c] += kStep;
+      xm[k][c] -= kStep;
+      const double fd = (f(xp).value - f(xm).value) / (2 * kStep);
+      EXPECT_NEAR(e.grad[k][c], fd, kTol * std::max(1.0, std::abs(fd)))
+          << what << " config " << config << " operand " << k << " coordinate " << c;
+    }
+  // A function of the shape alone is invariant under translation and rotation: its gradients sum
+  // to zero and have no net moment. (These two facts are what make a projection conserve linear
+  // and angular momentum.)
+  Vec3 sum = Vec3::Zero(), moment = Vec3::Zero();
+  double scale = 0.0;
+  for (int k = 0; k < N; ++k) {
+    sum += e.grad[k];
+    moment += x[k].cross(e.grad[k]);
+    scale += e.grad[k].norm() * (1.0 + x[k].norm());
+  }
+  EXPECT_LT(sum.norm(), 1e-13 * scale) << what << " config " << config;
+  EXPECT_LT(moment.norm(), 1e-13 * scale) << what << " config " << config;
+}
+
+// Two points: C = |x0 - x1|.
+TEST(ConstraintMath, DistanceValueAndGradient) {
+  Rng rng(1);
+  for (int i = 0; i < kConfigs; ++i) {
+    Points<2> x{rng.vec(-1, 1), rng.vec(-1, 1)};
+    if ((x[0] - x[1]).norm() < 0.2) continue;
+    const auto e = eval_distance(x[0], x[1]);
+    const Vec3 d = x[0] - x[1];
+    EXPECT_NEAR(e.value, std::sqrt(d.x() * d.x() + d.y() * d.y() + d.z() * d.z()), 1e-15);
+    check_gradient<2>([](const Points<2>& p) { return eval_distance(p[0], p[1]); }, x, "distance", i);
+  }
+  EXPECT_FALSE(eval_distance(Vec3(1, 2, 3), Vec3(1, 2, 3)).valid);
+}
+
+// Angle at c between c->a and c->b:   a
+//                                    /
+//                                   c --- b
+TEST(ConstraintMath, EdgeAngleValueAndGradient) {
+  Rng rng(2);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<3> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const Vec3 u = x[1] - x[0], v = x[2] - x[0];
+    if (u.norm() < 0.3 || v.norm() < 0.3) continue;
+    const double expected = std::acos(std::clamp(u.dot(v) / (u.norm() * v.norm()), -1.0, 1.0));
+    if (std::sin(expected) < 0.2) continue;  // the gradient is singular for parallel edges
+    ++checked;
+    EXPECT_NEAR(eval_edge_angle(x[0], x[1], x[2]).value, expected, 1e-13);
+    check_gradient<3>([](const Points<3>& p) { return eval_edge_angle(p[0], p[1], p[2]); }, x, "edge_angle", i);
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // Right angle, and the documented singular case (parallel edges: no gradient).
+  EXPECT_NEAR(eval_edge_angle(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 2, 0)).value, std::numbers::pi / 2, 1e-15);
+  EXPECT_FALSE(eval_edge_angle(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)).valid);
+}
+
+// Hinge across edge x0-x1 between triangles (x0,x1,x2) and (x1,x0,x3):
+//        x2
+//       /  \  .
+//     x0 -- x1      angle 0 when x2 and x3 lie on opposite sides in one plane (unfolded)
+//       \  /
+//        x3
+// Expected value from elementary geometry: with a, b the components of x2 - x0 and x3 - x0
+// perpendicular to the edge, |angle| = pi - angle(a, b); the sign is negative when x3 lies on the
+// side the first triangle's right-hand normal points to.
+TEST(ConstraintMath, DihedralValueAndGradient) {
+  Rng rng(3);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const Vec3 edge = x[1] - x[0];
+    if (edge.norm() < 0.3) continue;
+    const Vec3 eh = edge.normalized();
+    const Vec3 a = (x[2] - x[0]) - (x[2] - x[0]).dot(eh) * eh;
+    const Vec3 b = (x[3] - x[0]) - (x[3] - x[0]).dot(eh) * eh;
+    if (a.norm() < 0.3 || b.norm() < 0.3) continue;  // triangles far from degenerate
+    const double between = std::acos(std::clamp(a.dot(b) / (a.norm() * b.norm()), -1.0, 1.0));
+    if (between < 0.2) continue;  // stay away from the +-pi branch cut
+    const Vec3 n1 = edge.cross(x[2] - x[0]);
+    const double expected = ((x[3] - x[0]).dot(n1) > 0 ? -1.0 : 1.0) * (std::numbers::pi - between);
+    ++checked;
+    EXPECT_NEAR(eval_dihedral(x[0], x[1], x[2], x[3]).value, expected, 1e-12) << "config " << i;
+    check_gradient<4>([](const Points<4>& p) { return eval_dihedral(p[0], p[1], p[2], p[3]); }, x, "dihedral", i);
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // Flat and unfolded: 0. Folded to a right angle with x3 above (+z, the side n1 = e_x cross e_y
+  // points to): -pi/2.
+  EXPECT_NEAR(eval_dihedral(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(0.5, -1, 0)).value, 0.0, 1e-15);
+  EXPECT_NEAR(eval_dihedral(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(0.5, 0, 1)).value,
+              -std::numbers::pi / 2, 1e-15);
+}
+
+// Tetrahedron (x0,x1,x2,x3): V = det[x1-x0, x2-x0, x3-x0] / 6.
+TEST(ConstraintMath, TetVolumeValueAndGradient) {
+  Rng rng(4);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    Eigen::Matrix3d m;
+    m << x[1] - x[0], x[2] - x[0], x[3] - x[0];
+    const double expected = m.determinant() / 6.0;
+    if (std::abs(expected) < 0.02) continue;
+    ++checked;
+    EXPECT_NEAR(eval_tet_volume(x[0], x[1], x[2], x[3]).value, expected, 1e-14);
+    check_gradient<4>([](const Points<4>& p) { return eval_tet_volume(p[0], p[1], p[2], p[3]); }, x, "tet_volume", i);
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // Unit right-corner tetrahedron: 1/6, positive for x3 on the side of (x0,x1,x2)'s normal.
+  EXPECT_NEAR(eval_tet_volume(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)).value, 1.0 / 6.0, 1e-16);
+}
+
+TEST(ConstraintMath, WrapAngle) {
+  constexpr double pi = std::numbers::pi;
+  EXPECT_NEAR(wrap_angle(0.25), 0.25, 1e-16);
+  EXPECT_NEAR(wrap_angle(2 * pi + 0.25), 0.25, 1e-15);
+  EXPECT_NEAR(wrap_angle(-2 * pi - 0.25), -0.25, 1e-15);
+  EXPECT_NEAR(wrap_angle(1.5 * pi), -0.5 * pi, 1e-15);
+  EXPECT_DOUBLE_EQ(wrap_angle(pi), pi);  // (-pi, pi]
+  EXPECT_DOUBLE_EQ(wrap_angle(-pi), pi);
+}
+
+}  // namespace
+}  // namespace embra
