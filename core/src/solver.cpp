@@ -9,24 +9,235 @@
 //   measure            residuals per group, kinetic energy, settled flag
 #include "embra/core/world.hpp"
 
+#include "lanes.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <string>
 
 namespace embra {
 
 namespace {
 
-template <int N>
-void apply(const int32_t* ids, const ConstraintEval<N>& e, double dl, std::vector<Vec3>& x,
-           const std::vector<double>& w) {
-  for (int k = 0; k < N; ++k) x[ids[k]] += (w[ids[k]] * dl) * e.grad[k];
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are packed xyz triples");
+
+template <Kind K>
+constexpr int arity_of() {
+  return K == Kind::distance || K == Kind::tether || K == Kind::weld ? 2 : K == Kind::edge_angle ? 3 : 4;
 }
 
-template <int N>
-double weighted_norm(const int32_t* ids, const ConstraintEval<N>& e, const std::vector<double>& w) {
-  double s = 0.0;
-  for (int k = 0; k < N; ++k) s += w[ids[k]] * e.grad[k].squaredNorm();
-  return s;
+// --- projection kernels ------------------------------------------------------------------------
+//
+// One Gauss-Seidel pass of XPBD over a solver array: for each constraint C with compliance alpha,
+//   dlambda = (-C - alpha~ lambda) / (sum_k w_k |grad_k C|^2 + alpha~),   alpha~ = alpha / h^2,
+//   x_k += w_k dlambda grad_k C.
+// Distance, tether and dihedral have tight hand-written loops over the raw xyz array (the bulk of
+// every cloth); the rarer kinds go through constraint_math.hpp. Constraints are stored colour by
+// colour, so consecutive constraints rarely share a particle and their arithmetic overlaps.
+
+/// Whether every lane lies in (-pi, pi] already.
+template <class T>
+EMBRA_ALWAYS_INLINE bool all_within_pi(T v) {
+  for (int l = 0; l < lanes::Lanes<T>::count; ++l) {
+    const double a = lanes::Lanes<T>::get(v, l);
+    if (!(a > -std::numbers::pi && a <= std::numbers::pi)) return false;
+  }
+  return true;
+}
+
+// Each kernel handles one block of Lanes<T>::count constraints of one colour (they share no
+// particle), reading every operand first and writing every result last.
+
+/// Distance |x0 - x1| = rest; a tether is the unilateral |x0 - x1| <= rest (it only pulls).
+template <class T, bool kTether>
+EMBRA_ALWAYS_INLINE void distance_block(const int32_t* ids, const double* rest, const double* compliance,
+                                        double* lambda, double inv_h2, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  const V3<T> p0 = load_point<T>(x, ids, 2), p1 = load_point<T>(x, ids + 1, 2);
+  const T w0 = load_value<T>(w, ids, 2), w1 = load_value<T>(w, ids + 1, 2);
+  const T r = gather<T>(rest), lam = gather<T>(lambda);
+  const T alpha = gather<T>(compliance) * inv_h2;
+  const V3<T> d = p0 - p1;
+  const T len = lanes::sqrt(dot(d, d));
+  const T c = len - r;
+  const T denom = w0 + w1 + alpha;
+  auto ok = (len > 1e-300) & (denom > 0.0);
+  T dl = (-c - alpha * lam) / denom;
+  if constexpr (kTether) {
+    ok = ok & ((c > 0.0) | (lam != 0.0));  // a slack tether with no pull left does nothing
+    const T sum = lam + dl;
+    dl = select(0.0 < sum, splat<T>(0.0), sum) - lam;  // std::min(lambda + dl, 0) - lambda: pull only
+  }
+  const T s = dl / len;  // grad C = +-(x0 - x1) / len
+  const T s0 = w0 * s, s1 = w1 * s;
+  const T lam_new = lam + dl;
+  for (int l = 0; l < L::count; ++l) {
+    if (!L::on(ok, l)) continue;
+    lambda[l] = L::get(lam_new, l);
+    // An immovable end is not written: no false store-to-load chain through an anchor shared by
+    // many constraints (every tether of a pin), and no write for a parallel pass to race on.
+    if (L::get(w0, l) != 0.0) {
+      double* q = x + 3 * static_cast<int64_t>(ids[2 * l]);
+      const double k = L::get(s0, l);
+      q[0] += k * L::get(d.x, l);
+      q[1] += k * L::get(d.y, l);
+      q[2] += k * L::get(d.z, l);
+    }
+    if (L::get(w1, l) != 0.0) {
+      double* q = x + 3 * static_cast<int64_t>(ids[2 * l + 1]);
+      const double k = L::get(s1, l);
+      q[0] -= k * L::get(d.x, l);
+      q[1] -= k * L::get(d.y, l);
+      q[2] -= k * L::get(d.z, l);
+    }
+  }
+}
+
+/// Dihedral angle across the edge x0-x1 of triangles (x0, x1, x2) and (x1, x0, x3) = rest: the
+/// function and gradients of eval_dihedral (constraint_math.hpp), written out flat:
+///   grad2 = -le / |n1|^2 n1, grad3 = -le / |n2|^2 n2, grad1 = -(s1 grad2 + s2 grad3),
+///   grad0 = -(grad1 + grad2 + grad3), with s_k = (x_k - x0) . edge / le^2.
+template <class T>
+EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, const double* compliance,
+                                        double* lambda, double inv_h2, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  const V3<T> p[4] = {load_point<T>(x, ids, 4), load_point<T>(x, ids + 1, 4), load_point<T>(x, ids + 2, 4),
+                      load_point<T>(x, ids + 3, 4)};
+  const T wk[4] = {load_value<T>(w, ids, 4), load_value<T>(w, ids + 1, 4), load_value<T>(w, ids + 2, 4),
+                   load_value<T>(w, ids + 3, 4)};
+  const T r = gather<T>(rest), lam = gather<T>(lambda);
+  const T alpha = gather<T>(compliance) * inv_h2;
+  const V3<T> edge = p[1] - p[0], a2 = p[2] - p[0], a3 = p[3] - p[0];
+  const V3<T> n1 = cross(edge, a2), n2 = cross(a3, edge);
+  const T le2 = dot(edge, edge), n1sq = dot(n1, n1), n2sq = dot(n2, n2);
+  const T le = lanes::sqrt(le2);
+  const auto valid = (le > 1e-300) & (n1sq > 1e-300) & (n2sq > 1e-300);
+  T c = lanes::atan2(dot(cross(n1, n2), edge), dot(n1, n2) * le) - r;
+  if (!all_within_pi(c)) {  // wrap to (-pi, pi]: rarely needed
+    double v[L::count];
+    for (int l = 0; l < L::count; ++l) v[l] = wrap_angle(L::get(c, l));
+    c = L::make(v);
+  }
+  const T k2 = -le / n1sq, k3 = -le / n2sq;
+  const V3<T> g2 = k2 * n1, g3 = k3 * n2;
+  const T inv_le2 = 1.0 / le2;
+  const T s1 = dot(a2, edge) * inv_le2, s2 = dot(a3, edge) * inv_le2;
+  const V3<T> g1 = -(s1 * g2 + s2 * g3);
+  const V3<T> g0 = -(g1 + g2 + g3);
+  const T denom = wk[0] * dot(g0, g0) + wk[1] * dot(g1, g1) + wk[2] * (le2 / n1sq) + wk[3] * (le2 / n2sq) + alpha;
+  const auto ok = valid & (denom > 0.0);
+  const T dl = (-c - alpha * lam) / denom;
+  const T lam_new = lam + dl;
+  const V3<T> g[4] = {g0, g1, g2, g3};
+  T sk[4];
+  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
+  for (int l = 0; l < L::count; ++l) {
+    if (!L::on(ok, l)) continue;
+    lambda[l] = L::get(lam_new, l);
+    for (int k = 0; k < 4; ++k) {
+      if (L::get(wk[k], l) == 0.0) continue;
+      double* q = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
+      const double f = L::get(sk[k], l);
+      q[0] += f * L::get(g[k].x, l);
+      q[1] += f * L::get(g[k].y, l);
+      q[2] += f * L::get(g[k].z, l);
+    }
+  }
+}
+
+enum class Op { distance, tether, dihedral };
+
+template <class T, Op kOp>
+EMBRA_ALWAYS_INLINE void block(const SolverArray& a, size_t i, double inv_h2, double* x, const double* w,
+                               double* lambda) {
+  if constexpr (kOp == Op::dihedral)
+    dihedral_block<T>(&a.ids[4 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
+  else
+    distance_block<T, kOp == Op::tether>(&a.ids[2 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
+}
+
+/// One pass over a solver array, colour by colour: blocks of T within each colour, single
+/// constraints for a colour's remainder and for the shared tail (whose constraints may overlap).
+template <class T, Op kOp>
+EMBRA_ALWAYS_INLINE void pass(SolverArray& a, double inv_h2, double* x, const double* w) {
+  constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
+  const size_t colours = a.colours();
+  double* lambda = a.lambda.data();
+  for (size_t c = 0; c < colours; ++c) {
+    size_t i = static_cast<size_t>(a.colour_start[c]);
+    const size_t end = static_cast<size_t>(a.colour_start[c + 1]);
+    if (!(a.shared_tail && c + 1 == colours))
+      for (; i + lanes_n <= end; i += lanes_n) block<T, kOp>(a, i, inv_h2, x, w, lambda);
+    for (; i < end; ++i) block<double, kOp>(a, i, inv_h2, x, w, lambda);
+  }
+}
+
+/// The passes for one lane type, compiled for one instruction set (ATTR).
+#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                               \
+  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) { \
+    pass<T, Op::distance>(a, inv_h2, x, w);                                              \
+  }                                                                                      \
+  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {   \
+    pass<T, Op::tether>(a, inv_h2, x, w);                                                \
+  }                                                                                      \
+  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) { \
+    pass<T, Op::dihedral>(a, inv_h2, x, w);                                              \
+  }
+
+struct Kernels {
+  void (*distance)(SolverArray&, double, double*, const double*);
+  void (*tether)(SolverArray&, double, double*, const double*);
+  void (*dihedral)(SolverArray&, double, double*, const double*);
+  const char* name;
+};
+
+EMBRA_DEFINE_PASSES(scalar, double, )
+#if EMBRA_LANES_VECTOR
+EMBRA_DEFINE_PASSES(vec2, lanes::D2, )
+#if defined(__x86_64__) && defined(__GNUC__)
+#define EMBRA_HAVE_AVX2_KERNELS 1
+EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
+#endif
+#endif
+
+/// The kernels for this machine. Every set computes the same bits (lanes.hpp); EMBRA_KERNELS=scalar,
+/// vec2 or avx2 forces one, to check exactly that.
+const Kernels& kernels() {
+  static const Kernels chosen = [] {
+    const Kernels scalar{scalar_distance, scalar_tether, scalar_dihedral, "scalar"};
+    const char* forced = std::getenv("EMBRA_KERNELS");
+    const std::string want = forced ? forced : "";
+    if (want == "scalar") return scalar;
+#if EMBRA_LANES_VECTOR
+    const Kernels vec2{vec2_distance, vec2_tether, vec2_dihedral, "vec2"};
+    if (want == "vec2") return vec2;
+#if defined(EMBRA_HAVE_AVX2_KERNELS)
+    if (__builtin_cpu_supports("avx2")) return Kernels{avx2_distance, avx2_tether, avx2_dihedral, "avx2"};
+#endif
+    return vec2;
+#else
+    return scalar;
+#endif
+  }();
+  return chosen;
+}
+
+/// Welds x0 = x1 (three multipliers each).
+void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
+  for (size_t i = 0; i < a.size(); ++i) {
+    const int32_t p0 = a.ids[2 * i], p1 = a.ids[2 * i + 1];
+    const double alpha = a.compliance[i] * inv_h2;
+    const double denom = w[p0] + w[p1] + alpha;
+    if (denom <= 0.0) continue;
+    const Vec3 l(a.lambda[3 * i], a.lambda[3 * i + 1], a.lambda[3 * i + 2]);
+    const Vec3 dl = (-(x[p0] - x[p1]) - alpha * l) / denom;
+    for (int k = 0; k < 3; ++k) a.lambda[3 * i + k] += dl[k];
+    x[p0] += w[p0] * dl;
+    x[p1] -= w[p1] * dl;
+  }
 }
 
 template <Kind K>
@@ -50,36 +261,49 @@ double deviation(double value, double rest) {
     return value - rest;
 }
 
-/// One Gauss-Seidel pass of XPBD over a plain constraint array of kind K.
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume).
 template <Kind K>
-void project_array(ConstraintArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
-  constexpr int N = K == Kind::distance || K == Kind::tether ? 2 : K == Kind::edge_angle ? 3 : 4;
+void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
+  constexpr int N = arity_of<K>();
   const size_t n = a.size();
   for (size_t i = 0; i < n; ++i) {
     const int32_t* p = &a.ids[i * N];
     const auto e = evaluate<K>(p, x);
     if (!e.valid) continue;
-    const double c = deviation<K>(e.value, a.rest_now[i]);
-    double& lambda = a.lambda[i];
-    if constexpr (K == Kind::tether)
-      if (c <= 0.0 && lambda == 0.0) continue;
+    const double c = deviation<K>(e.value, a.rest[i]);
     const double alpha = a.compliance[i] * inv_h2;
-    const double denom = weighted_norm<N>(p, e, w) + alpha;
+    double denom = alpha;
+    for (int k = 0; k < N; ++k) denom += w[p[k]] * e.grad[k].squaredNorm();
     if (denom <= 0.0) continue;
-    double dl = (-c - alpha * lambda) / denom;
-    if constexpr (K == Kind::tether) dl = std::min(lambda + dl, 0.0) - lambda;  // pull only
-    lambda += dl;
-    apply<N>(p, e, dl, x, w);
+    const double dl = (-c - alpha * a.lambda[i]) / denom;
+    a.lambda[i] += dl;
+    for (int k = 0; k < N; ++k) x[p[k]] += (w[p[k]] * dl) * e.grad[k];
+  }
+}
+
+// --- residuals ---------------------------------------------------------------------------------
+
+/// The constraint function's value alone (no gradient), as the projection kernels compute it.
+template <Kind K>
+double value_of(const int32_t* p, const std::vector<Vec3>& x) {
+  if constexpr (K == Kind::distance || K == Kind::tether) {
+    return (x[p[0]] - x[p[1]]).norm();
+  } else if constexpr (K == Kind::dihedral) {
+    const Vec3 edge = x[p[1]] - x[p[0]];
+    const Vec3 n1 = edge.cross(x[p[2]] - x[p[0]]);
+    const Vec3 n2 = (x[p[3]] - x[p[0]]).cross(edge);
+    return dihedral_angle(n1, n2, edge, std::sqrt(edge.squaredNorm()));
+  } else {
+    return evaluate<K>(p, x).value;
   }
 }
 
 /// XPBD residual |C + alpha~ lambda| (for a tether only while it pulls or is overstretched).
 template <Kind K>
-void residuals(const ConstraintArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq) {
-  constexpr int N = K == Kind::distance || K == Kind::tether ? 2 : K == Kind::edge_angle ? 3 : 4;
+void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq) {
+  constexpr int N = arity_of<K>();
   for (size_t i = 0; i < a.size(); ++i) {
-    const auto e = evaluate<K>(&a.ids[i * N], x);
-    const double c = deviation<K>(e.value, a.rest_now[i]);
+    const double c = deviation<K>(value_of<K>(&a.ids[i * N], x), a.rest[i]);
     double r = c + a.compliance[i] * inv_h2 * a.lambda[i];
     if constexpr (K == Kind::tether)
       if (a.lambda[i] == 0.0) r = std::max(c, 0.0);
@@ -151,7 +375,8 @@ void World::find_contacts() {
 void World::reset_multipliers() {
   for (int32_t slot : order_) {
     Group& g = groups_[slot];
-    for (ConstraintArray& a : g.arrays) std::fill(a.lambda.begin(), a.lambda.end(), 0.0);
+    for (SolverArray& a : g.solve) std::fill(a.lambda.begin(), a.lambda.end(), 0.0);
+    std::fill(g.tethers.lambda.begin(), g.tethers.lambda.end(), 0.0);
     for (int32_t pi : g.soft_pins) pins_[pi].lambda.setZero();
   }
 }
@@ -167,23 +392,16 @@ void World::project_group(Group& g, double h) {
     p.lambda += dl;
     x_[p.particle] += w * dl;
   }
-  ConstraintArray& weld = g.arrays[static_cast<int>(Kind::weld)];
-  for (size_t i = 0; i < weld.size(); ++i) {
-    const int32_t a = weld.ids[2 * i], b = weld.ids[2 * i + 1];
-    const double alpha = weld.compliance[i] * inv_h2;
-    const double denom = w_[a] + w_[b] + alpha;
-    if (denom <= 0.0) continue;
-    const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
-    const Vec3 dl = (-(x_[a] - x_[b]) - alpha * l) / denom;
-    for (int k = 0; k < 3; ++k) weld.lambda[3 * i + k] += dl[k];
-    x_[a] += w_[a] * dl;
-    x_[b] -= w_[b] * dl;
-  }
-  project_array<Kind::distance>(g.arrays[0], inv_h2, x_, w_);
-  project_array<Kind::tether>(g.arrays[5], inv_h2, x_, w_);
-  project_array<Kind::edge_angle>(g.arrays[1], inv_h2, x_, w_);
-  project_array<Kind::dihedral>(g.arrays[2], inv_h2, x_, w_);
-  project_array<Kind::tet_volume>(g.arrays[3], inv_h2, x_, w_);
+  double* x = x_.data()->data();
+  const double* w = w_.data();
+  project_weld(g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
+  const Kernels& k = kernels();
+  k.distance(g.solve[static_cast<int>(Kind::distance)], inv_h2, x, w);
+  k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
+  k.tether(g.tethers, inv_h2, x, w);
+  project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
+  k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
+  project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   if (!g.contacts.empty()) project_contacts(g, h);
 }
 
@@ -263,13 +481,13 @@ void World::measure() {
     Group& g = groups_[slot];
     double max = 0.0, sq = 0.0;
     int64_t n = 0;
-    residuals<Kind::distance>(g.arrays[0], inv_h2, x_, max, sq);
-    residuals<Kind::edge_angle>(g.arrays[1], inv_h2, x_, max, sq);
-    residuals<Kind::dihedral>(g.arrays[2], inv_h2, x_, max, sq);
-    residuals<Kind::tet_volume>(g.arrays[3], inv_h2, x_, max, sq);
-    residuals<Kind::tether>(g.arrays[5], inv_h2, x_, max, sq);
-    for (const ConstraintArray& a : g.arrays) n += static_cast<int64_t>(a.size());
-    const ConstraintArray& weld = g.arrays[static_cast<int>(Kind::weld)];
+    residuals<Kind::distance>(g.solve[0], inv_h2, x_, max, sq);
+    residuals<Kind::edge_angle>(g.solve[1], inv_h2, x_, max, sq);
+    residuals<Kind::dihedral>(g.solve[2], inv_h2, x_, max, sq);
+    residuals<Kind::tet_volume>(g.solve[3], inv_h2, x_, max, sq);
+    residuals<Kind::tether>(g.solve[5], inv_h2, x_, max, sq);
+    for (const SolverArray& a : g.solve) n += static_cast<int64_t>(a.size());
+    const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
       const double r = (x_[weld.ids[2 * i]] - x_[weld.ids[2 * i + 1]] + weld.compliance[i] * inv_h2 * l).norm();
@@ -319,12 +537,14 @@ void World::measure() {
 }
 
 void World::step() {
-  if (rest_dirty_) refresh_rest();
-  // Kept to restore on a numerical failure: the call must leave the world as it found it.
+  if (solver_dirty_)
+    rebuild_solver();
+  else if (rest_dirty_)
+    refresh_rest();
+  // Kept to restore on a numerical failure: the call must leave the world as it found it. (The
+  // constraints' multipliers live in the solver arrays during the step and are only copied back to
+  // the constraint arrays once the frame has succeeded.)
   const std::vector<Vec3> x0 = x_, v0 = v_;
-  std::vector<std::vector<double>> lambdas0;
-  for (const Group& g : groups_)
-    for (const ConstraintArray& a : g.arrays) lambdas0.push_back(a.lambda);
   std::vector<Vec3> pin_lambda0;
   for (const Pin& p : pins_) pin_lambda0.push_back(p.lambda);
 
@@ -347,9 +567,6 @@ void World::step() {
       x_ = x0;
       v_ = v0;
       x_prev_ = x0;
-      size_t k = 0;
-      for (Group& g : groups_)
-        for (ConstraintArray& a : g.arrays) a.lambda = lambdas0[k++];
       for (size_t i = 0; i < pins_.size(); ++i) pins_[i].lambda = pin_lambda0[i];
       for (Collider& c : colliders_) {
         c.position = c.position_prev = c.frame_position;
@@ -362,6 +579,13 @@ void World::step() {
       throw Error(ErrorCode::numerical, warning_.message);
     }
   }
+  for (Group& g : groups_)
+    for (int k = 0; k < kKindCount; ++k) {
+      const SolverArray& a = g.solve[k];
+      const int per = k == static_cast<int>(Kind::weld) ? 3 : 1;
+      for (size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < per; ++c) g.arrays[k].lambda[per * a.source[i] + c] = a.lambda[per * i + c];
+    }
   for (Pin& p : pins_)
     if (p.alive) p.target_prev = p.target;
   for (Collider& c : colliders_)

@@ -3,7 +3,9 @@
 #include "embra/core/world.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -127,10 +129,12 @@ void World::set_settings(const Settings& s) {
   if (s.dt <= 0.0) invalid("settings.dt must be > 0");
   if (s.substeps < 1 || s.substeps > 10000) invalid("settings.substeps must be in [1, 10000]");
   if (s.iterations < 1 || s.iterations > 10000) invalid("settings.iterations must be in [1, 10000]");
+  if (s.tethers < 0 || s.tethers > 64) invalid("settings.tethers must be in [0, 64]");
   for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
   check_non_negative(s.damping, "settings.damping");
   check_non_negative(s.settle_speed, "settings.settle_speed");
   const Id contacts = settings_.contact_group;
+  if (s.tethers != settings_.tethers) solver_dirty_ = true;
   settings_ = s;
   settings_.contact_group = contacts;
 }
@@ -198,6 +202,7 @@ void World::destroy_group(Id id) {
   g = Group{};
   g.generation = generation;
   rebuild_order();
+  solver_dirty_ = true;
 }
 
 void World::set_group_order(Id id, int32_t order) {
@@ -337,6 +342,7 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     for (int c = 0; c < (desc.kind == Kind::weld ? 3 : 1); ++c) a.lambda.push_back(0.0);
   }
   rest_dirty_ = true;
+  solver_dirty_ = true;
   return static_cast<int64_t>(count);
 }
 
@@ -477,6 +483,10 @@ Id World::create_body(const BodyDesc& d) {
   info.has_uv = !d.uvs.empty();
   for (int32_t v : d.triangles) info.triangles.push_back(first + v);
   for (int32_t v : d.tets) info.tets.push_back(first + v);
+  for (auto [a, b] : edges) info.edges.insert(info.edges.end(), {first + a, first + b});
+  for (int64_t i = 0; i < nv; ++i) info.rest_positions.push_back(P(static_cast<int32_t>(i)));
+  info.stretch_group = groups[0];
+  info.generated_stretch = (d.generate & generate_stretch) != 0 && !edges.empty();
   bodies_.push_back(info);
 
   auto append = [&](Kind kind, Id gid, std::initializer_list<int32_t> local, double rest, double compliance, double ru,
@@ -535,6 +545,7 @@ Id World::create_body(const BodyDesc& d) {
              eval_tet_volume(P(v[0]), P(v[1]), P(v[2]), P(v[3])).value, m.volume_compliance, 0, 0);
     }
   rest_dirty_ = true;
+  solver_dirty_ = true;
   return Id{static_cast<uint32_t>(body_index), 1};
 }
 
@@ -578,9 +589,82 @@ void World::refresh_rest() {
           a.rest_now[i] = a.rest[i];
         }
       }
+      SolverArray& sa = g.solve[k];
+      for (size_t i = 0; i < sa.size(); ++i) sa.rest[i] = a.rest_now[sa.source[i]];
+    }
+    // An automatic tether's rest is a path length over the body; no rest scale can lengthen such a
+    // path by more than the largest of the scales, so the tether never holds a legal shape back.
+    SolverArray& t = g.tethers;
+    for (size_t i = 0; i < t.size(); ++i) {
+      const BodyInfo& b = bodies_[t.body[i]];
+      const double directional = b.has_uv ? std::max({b.rest_scale_u, b.rest_scale_v, 1.0}) : 1.0;
+      t.rest[i] = t.base_rest[i] * b.rest_scale * directional;
     }
   }
   rest_dirty_ = false;
+}
+
+namespace {
+
+/// Orders `count` constraints of arity `n` by greedy graph colouring: each constraint takes the
+/// lowest colour none of its particles has yet (particles with ignore[p] set do not count: they
+/// never move). Constraints keep their relative order within a colour. At most 64 colours; what
+/// does not fit goes to one last colour whose constraints may share particles (`shared_tail`).
+void colour_order(const int32_t* ids, size_t count, int n, size_t particle_count, const std::vector<uint8_t>& ignore,
+                  std::vector<int32_t>& order, std::vector<int32_t>& colour_start, bool& shared_tail) {
+  constexpr int kMaxColours = 64;
+  std::vector<uint64_t> used(particle_count, 0);
+  std::vector<int32_t> colour(count);
+  std::vector<int32_t> per_colour(kMaxColours + 1, 0);
+  for (size_t i = 0; i < count; ++i) {
+    uint64_t taken = 0;
+    for (int k = 0; k < n; ++k) {
+      const int32_t p = ids[i * n + k];
+      if (!ignore[p]) taken |= used[p];
+    }
+    const int c = std::countr_one(taken);  // 64 when all are taken
+    colour[i] = c;
+    ++per_colour[c];
+    if (c < kMaxColours)
+      for (int k = 0; k < n; ++k) used[ids[i * n + k]] |= uint64_t{1} << c;
+  }
+  int colours = kMaxColours + 1;
+  while (colours > 0 && per_colour[colours - 1] == 0) --colours;
+  shared_tail = per_colour[kMaxColours] > 0;
+  colour_start.assign(colours + 1, 0);
+  for (int c = 0; c < colours; ++c) colour_start[c + 1] = colour_start[c] + per_colour[c];
+  std::vector<int32_t> next(colour_start.begin(), colour_start.end() - 1);
+  order.resize(count);
+  for (size_t i = 0; i < count; ++i) order[next[colour[i]]++] = static_cast<int32_t>(i);
+}
+
+}  // namespace
+
+void World::rebuild_solver() {
+  std::vector<uint8_t> none(x_.size(), 0);
+  std::vector<int32_t> order;
+  for (Group& g : groups_) {
+    if (!g.alive) continue;
+    for (int k = 0; k < kKindCount; ++k) {
+      const ConstraintArray& a = g.arrays[k];
+      SolverArray& sa = g.solve[k];
+      const int n = arity(static_cast<Kind>(k));
+      const int per = k == static_cast<int>(Kind::weld) ? 3 : 1;
+      sa = SolverArray{};
+      colour_order(a.ids.data(), a.size(), n, x_.size(), none, order, sa.colour_start, sa.shared_tail);
+      for (int32_t i : order) {
+        sa.ids.insert(sa.ids.end(), a.ids.begin() + static_cast<ptrdiff_t>(i) * n,
+                      a.ids.begin() + static_cast<ptrdiff_t>(i + 1) * n);
+        sa.source.push_back(i);
+        sa.compliance.push_back(a.compliance[i]);
+        sa.rest.push_back(a.rest_now[i]);
+      }
+      sa.lambda.assign(per * a.size(), 0.0);
+    }
+    g.tethers = SolverArray{};
+  }
+  solver_dirty_ = false;
+  refresh_rest();
 }
 
 // --- pins --------------------------------------------------------------------------------------
@@ -616,6 +700,7 @@ Id World::create_pin(const PinDesc& desc) {
   if (desc.compliance == 0.0) {
     hard_pin_of_[desc.particle] = static_cast<int32_t>(slot);
     w_[desc.particle] = 0.0;
+    solver_dirty_ = true;  // automatic tethers attach to hard pins
   } else {
     group_mut(gid).soft_pins.push_back(static_cast<int32_t>(slot));
   }
@@ -633,6 +718,7 @@ void World::destroy_pin(Id id) {
   if (p.compliance == 0.0) {
     hard_pin_of_[p.particle] = -1;
     w_[p.particle] = inv_mass_[p.particle];
+    solver_dirty_ = true;
   } else {
     auto& list = group_mut(p.group).soft_pins;
     list.erase(std::find(list.begin(), list.end(), static_cast<int32_t>(id.index)));

@@ -27,9 +27,43 @@ struct ConstraintEval {
   bool valid = false;
 };
 
+/// atan(x) for x >= 0 from +, -, *, / only: Cephes' range reduction and rational approximation.
+inline double atan_nonnegative(double x) {
+  constexpr double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1, p2 = -7.500855792314704667340e1,
+                   p3 = -1.228866684490136173410e2, p4 = -6.485021904942025371773e1;
+  constexpr double q0 = 2.485846490142306297962e1, q1 = 1.650270098316988542046e2, q2 = 4.328810604912902668951e2,
+                   q3 = 4.853903996359136964868e2, q4 = 1.945506571482613964425e2;
+  constexpr double tan_3pi_8 = 2.41421356237309504880, more_bits = 6.123233995736765886130e-17;
+  double base = 0.0, extra = 0.0;
+  if (x > tan_3pi_8) {
+    base = std::numbers::pi / 2;
+    extra = more_bits;
+    x = -1.0 / x;
+  } else if (x > 0.66) {
+    base = std::numbers::pi / 4;
+    extra = 0.5 * more_bits;
+    x = (x - 1.0) / (x + 1.0);
+  }
+  const double z = x * x;
+  const double p = (((p0 * z + p1) * z + p2) * z + p3) * z + p4;
+  const double q = ((((z + q0) * z + q1) * z + q2) * z + q3) * z + q4;
+  return base + ((x * (z * p / q) + x) + extra);
+}
+
+/// atan2(y, x) in [-pi, pi], within about one ulp of std::atan2 but built from +, -, *, / only, so
+/// it gives the same bits on every IEEE-754 machine and C library (and is about 4 times faster).
+inline double atan2_det(double y, double x) {
+  if (x == 0.0) return y > 0.0 ? std::numbers::pi / 2 : y < 0.0 ? -std::numbers::pi / 2 : 0.0;
+  const double t = y / x;
+  const double a = t < 0.0 ? -atan_nonnegative(-t) : atan_nonnegative(t);
+  if (x > 0.0) return a;
+  return y >= 0.0 ? a + std::numbers::pi : a - std::numbers::pi;
+}
+
 /// Wraps an angle difference to (-pi, pi].
 inline double wrap_angle(double a) {
   constexpr double two_pi = 2.0 * std::numbers::pi;
+  if (a > -std::numbers::pi && a <= std::numbers::pi) return a;
   a = std::fmod(a + std::numbers::pi, two_pi);
   if (a <= 0.0) a += two_pi;
   return a - std::numbers::pi;
@@ -60,7 +94,7 @@ inline ConstraintEval<3> eval_edge_angle(const Vec3& c, const Vec3& a, const Vec
   const Vec3 vh = v / lv;
   const double cos_t = uh.dot(vh);
   const double sin_t = uh.cross(vh).norm();
-  e.value = std::atan2(sin_t, cos_t);
+  e.value = atan2_det(sin_t, cos_t);
   // The gradient of the angle is singular when the edges are parallel.
   if (sin_t < 1e-9) return e;
   const Vec3 ga = (cos_t * uh - vh) / (lu * sin_t);
@@ -68,6 +102,13 @@ inline ConstraintEval<3> eval_edge_angle(const Vec3& c, const Vec3& a, const Vec
   e.grad = {-(ga + gb), ga, gb};
   e.valid = true;
   return e;
+}
+
+/// The signed angle from n1 to n2 about `edge` (length le), for normals n1, n2 perpendicular to it:
+/// atan2((n1 x n2) . edge, (n1 . n2) le), the common factor |n1| |n2| le cancelled. Shared by
+/// eval_dihedral and the solver so both measure the same angle to the bit.
+inline double dihedral_angle(const Vec3& n1, const Vec3& n2, const Vec3& edge, double le) {
+  return atan2_det(n1.cross(n2).dot(edge), n1.dot(n2) * le);
 }
 
 /// Signed dihedral angle across the edge x0-x1 between triangle (x0, x1, x2) and triangle
@@ -83,11 +124,7 @@ inline ConstraintEval<4> eval_dihedral(const Vec3& x0, const Vec3& x1, const Vec
   const double n2sq = n2.squaredNorm();
   if (le <= 1e-300 || n1sq <= 1e-300 || n2sq <= 1e-300) return e;
   const Vec3 eh = edge / le;
-  const double inv1 = 1.0 / std::sqrt(n1sq);
-  const double inv2 = 1.0 / std::sqrt(n2sq);
-  const double cos_t = n1.dot(n2) * inv1 * inv2;
-  const double sin_t = n1.cross(n2).dot(eh) * inv1 * inv2;
-  e.value = std::atan2(sin_t, cos_t);
+  e.value = dihedral_angle(n1, n2, edge, le);
   const Vec3 g2 = -le / n1sq * n1;
   const Vec3 g3 = -le / n2sq * n2;
   const double s1 = (x2 - x0).dot(eh);

@@ -129,6 +129,7 @@ struct Settings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2
   double damping = 0.0;                  // 1/s, applied to every particle
   double settle_speed = 1e-3;            // m/s: settled when no particle moves faster
+  int32_t tethers = 0;                   // automatic long-range attachments per particle (0 = none)
   Id contact_group;                      // set by the world: the group that holds collider contacts
 };
 
@@ -164,6 +165,10 @@ struct BodyInfo {
   std::vector<int32_t> triangles;  // world particle indices
   std::vector<int32_t> tets;
   bool has_uv = false;
+  std::vector<int32_t> edges;        // unique edges (2 per edge, world particle indices, lower first)
+  std::vector<Vec3> rest_positions;  // the vertices as given at creation (the body's rest shape)
+  Id stretch_group;                  // the group holding the generated stretch constraints
+  bool generated_stretch = false;    // whether stretch constraints were generated
 };
 
 /// A plain array of constraints of one kind, in one group: operands, rest and compliance (model)
@@ -181,6 +186,24 @@ struct ConstraintArray {
   size_t size() const { return rest.size(); }
 };
 
+/// The solver's working copy of a constraint array, ordered by colour: constraints of one colour
+/// share no particle, so a colour can be projected in any order, or in parallel, with the same
+/// result. Built from a group's ConstraintArray (and from the automatic tethers) when constraints
+/// or pins change; `source` maps each entry back to its ConstraintArray slot.
+struct SolverArray {
+  std::vector<int32_t> ids;     // arity per constraint
+  std::vector<int32_t> source;  // slot in the group's ConstraintArray; -1 for an automatic tether
+  std::vector<double> rest;     // current rest value (rest scales applied)
+  std::vector<double> compliance;
+  std::vector<double> lambda;         // accumulated multiplier (3 per weld)
+  std::vector<double> base_rest;      // automatic tethers: rest before the body's rest scale
+  std::vector<int32_t> body;          // automatic tethers: the body whose rest scale applies
+  std::vector<int32_t> colour_start;  // colour c is [colour_start[c], colour_start[c + 1])
+  bool shared_tail = false;           // the last colour's constraints may share particles (project in order)
+  size_t size() const { return rest.size(); }
+  size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
+};
+
 struct Contact {
   int32_t particle;
   int32_t collider;
@@ -193,6 +216,8 @@ struct Group {
   bool alive = false;
   int64_t serial = 0;  // creation order, to break ties in `order`
   ConstraintArray arrays[kKindCount];
+  SolverArray solve[kKindCount];   // the arrays in colour order, as the solver projects them
+  SolverArray tethers;             // automatic long-range attachments (Settings::tethers)
   std::vector<int32_t> soft_pins;  // indices into World::pins_
   std::vector<Contact> contacts;   // only in the contact group
   GroupReport report;
@@ -289,6 +314,7 @@ class World {
   Id resolve_group(Id id) const;
   void check_particle(int64_t index, const char* what) const;
   void refresh_rest();
+  void rebuild_solver();
   void rebuild_order();
   void predict(double h, double alpha);
   void move_colliders(double alpha);
@@ -319,6 +345,7 @@ class World {
   Id default_group_;
   int64_t serial_ = 0;
   bool rest_dirty_ = true;
+  bool solver_dirty_ = true;  // constraints, pins or bodies changed: rebuild the solver arrays
   StepReport report_;
   Warning warning_;
 };

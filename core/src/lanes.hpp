@@ -1,0 +1,171 @@
+// Lane-generic arithmetic for the projection kernels (private to core/src).
+//
+// A kernel is written once as a template over T: `double` (one constraint) or a vector of doubles
+// (2 or 4 independent constraints of one colour at a time, GCC/Clang vector extensions). Every lane
+// performs exactly the operations the scalar instance performs, in the same order, with IEEE +, -,
+// *, / and sqrt only, so the vector kernels give the same bits as the scalar one on every machine:
+// the instruction set chosen at run time never changes a result.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numbers>
+
+#if defined(__GNUC__) || defined(__clang__)
+// The vector types only ever live inside always-inlined code of one function; no ABI is involved.
+#pragma GCC diagnostic ignored "-Wpsabi"
+#define EMBRA_LANES_VECTOR 1
+#define EMBRA_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define EMBRA_LANES_VECTOR 0
+#define EMBRA_ALWAYS_INLINE inline
+#endif
+
+namespace embra::lanes {
+
+template <class T>
+struct Lanes;
+
+template <>
+struct Lanes<double> {
+  static constexpr int count = 1;
+  static EMBRA_ALWAYS_INLINE double get(double v, int) { return v; }
+  static EMBRA_ALWAYS_INLINE double make(const double* a) { return a[0]; }
+  template <class M>
+  static EMBRA_ALWAYS_INLINE bool on(M m, int) {
+    return static_cast<bool>(m);
+  }
+};
+
+#if EMBRA_LANES_VECTOR
+using D2 = double __attribute__((vector_size(16)));
+using D4 = double __attribute__((vector_size(32)));
+
+template <class V, int N>
+struct VectorLanes {
+  static constexpr int count = N;
+  static EMBRA_ALWAYS_INLINE double get(V v, int l) { return v[l]; }
+  static EMBRA_ALWAYS_INLINE V make(const double* a) {
+    V v;
+    std::memcpy(&v, a, sizeof v);
+    return v;
+  }
+  template <class M>
+  static EMBRA_ALWAYS_INLINE bool on(M m, int l) {
+    return m[l] != 0;
+  }
+};
+template <>
+struct Lanes<D2> : VectorLanes<D2, 2> {};
+template <>
+struct Lanes<D4> : VectorLanes<D4, 4> {};
+#endif
+
+template <class T>
+EMBRA_ALWAYS_INLINE T splat(double s) {
+  double a[Lanes<T>::count];
+  for (double& v : a) v = s;
+  return Lanes<T>::make(a);
+}
+
+/// Lane-wise gather: lane l takes src[l * stride].
+template <class T>
+EMBRA_ALWAYS_INLINE T gather(const double* src, int stride = 1) {
+  double a[Lanes<T>::count];
+  for (int l = 0; l < Lanes<T>::count; ++l) a[l] = src[l * stride];
+  return Lanes<T>::make(a);
+}
+
+/// Lane-wise select: m ? a : b (m a comparison result of the same width).
+template <class M, class T>
+EMBRA_ALWAYS_INLINE T select(M m, T a, T b) {
+  return m ? a : b;
+}
+
+template <class T>
+EMBRA_ALWAYS_INLINE T sqrt(T v) {
+  double a[Lanes<T>::count];
+  for (int l = 0; l < Lanes<T>::count; ++l) a[l] = std::sqrt(Lanes<T>::get(v, l));
+  return Lanes<T>::make(a);
+}
+
+template <class T>
+struct V3 {
+  T x, y, z;
+};
+
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> operator-(const V3<T>& a, const V3<T>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> operator+(const V3<T>& a, const V3<T>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> operator-(const V3<T>& a) {
+  return {-a.x, -a.y, -a.z};
+}
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> operator*(T s, const V3<T>& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+/// The same expressions as Eigen's Vector3d cross and dot, so lane results match eval_* to the bit.
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> cross(const V3<T>& a, const V3<T>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+template <class T>
+EMBRA_ALWAYS_INLINE T dot(const V3<T>& a, const V3<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+/// Lane l takes the point x + 3 ids[l * stride] (packed xyz triples).
+template <class T>
+EMBRA_ALWAYS_INLINE V3<T> load_point(const double* x, const int32_t* ids, int stride) {
+  double a[3][Lanes<T>::count];
+  for (int l = 0; l < Lanes<T>::count; ++l) {
+    const double* q = x + 3 * static_cast<int64_t>(ids[l * stride]);
+    a[0][l] = q[0];
+    a[1][l] = q[1];
+    a[2][l] = q[2];
+  }
+  return {Lanes<T>::make(a[0]), Lanes<T>::make(a[1]), Lanes<T>::make(a[2])};
+}
+
+/// Lane l takes w[ids[l * stride]].
+template <class T>
+EMBRA_ALWAYS_INLINE T load_value(const double* w, const int32_t* ids, int stride) {
+  double a[Lanes<T>::count];
+  for (int l = 0; l < Lanes<T>::count; ++l) a[l] = w[ids[l * stride]];
+  return Lanes<T>::make(a);
+}
+
+/// atan2_det (constraint_math.hpp) lane by lane, its branches turned into selects.
+template <class T>
+EMBRA_ALWAYS_INLINE T atan2(T y, T x) {
+  constexpr double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1, p2 = -7.500855792314704667340e1,
+                   p3 = -1.228866684490136173410e2, p4 = -6.485021904942025371773e1;
+  constexpr double q0 = 2.485846490142306297962e1, q1 = 1.650270098316988542046e2, q2 = 4.328810604912902668951e2,
+                   q3 = 4.853903996359136964868e2, q4 = 1.945506571482613964425e2;
+  constexpr double tan_3pi_8 = 2.41421356237309504880, more_bits = 6.123233995736765886130e-17;
+  constexpr double pi = std::numbers::pi;
+  const T t = y / x;
+  const T at = select(t < 0.0, -t, t);
+  const auto big = at > tan_3pi_8;
+  const auto mid = at > 0.66;
+  const T r = select(big, -1.0 / at, select(mid, (at - 1.0) / (at + 1.0), at));
+  const T base = select(big, splat<T>(pi / 2), select(mid, splat<T>(pi / 4), splat<T>(0.0)));
+  const T extra = select(big, splat<T>(more_bits), select(mid, splat<T>(0.5 * more_bits), splat<T>(0.0)));
+  const T z = r * r;
+  const T p = (((p0 * z + p1) * z + p2) * z + p3) * z + p4;
+  const T q = ((((z + q0) * z + q1) * z + q2) * z + q3) * z + q4;
+  const T u = base + ((r * (z * p / q) + r) + extra);
+  const T a = select(t < 0.0, -u, u);
+  const T left = select(y >= 0.0, a + pi, a - pi);
+  const T axis = select(y > 0.0, splat<T>(pi / 2), select(y < 0.0, splat<T>(-pi / 2), splat<T>(0.0)));
+  return select(x == 0.0, axis, select(x > 0.0, a, left));
+}
+
+}  // namespace embra::lanes
