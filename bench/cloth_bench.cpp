@@ -1,21 +1,27 @@
 // The acceptance benchmark: a 1 m square cloth of n x n particles (stretch + dihedral bend), pinned
-// at the two corners of one side, 1 kg, gravity, dt = 1/60 s, single thread. Each benchmark
-// iteration builds the scene (not timed) and steps 200 frames (timed). Counters:
+// at the two corners of one side, 1 kg, gravity, dt = 1/60 s, one thread (cloth_scenario.hpp).
+// Each benchmark iteration builds the scene (not timed) and steps 200 frames (timed). Counters:
 //
-//   ms_per_frame     wall time of one step, averaged over the 200 frames
+//   ms_per_frame     wall time of one World::step, averaged over the 200 frames
 //   max_edge_strain  max over all triangle edges of |len / rest - 1| after frame 200
-//   pin_strain       the same over the edges within 5 cm (material distance) of a pin
-//   rms_strain       root mean square of the edge strain after frame 200
+//   pin_strain       the same over the edges within 5 cm (rest distance) of a pin
+//   rms_strain       root mean square edge strain after frame 200
+//   substeps, iterations, tethers (automatic long-range attachments per particle), constraints
 //
 // A fast frame that leaves the cloth stretched is not a frame: read ms_per_frame together with
-// max_edge_strain. Run: ./build/bench/embra_bench --benchmark_filter=Cloth
+// max_edge_strain. The label names the configuration and the kernel set (avx2 / vec2 / scalar,
+// all bit-identical).
+//
+//   ./build/bench/embra_bench --benchmark_filter='BM_Cloth/'          embra's defaults, n = 128, 64, 32
+//   ./build/bench/embra_bench --benchmark_filter='BM_ClothConfig'     the configurations compared
+//   ./build/bench/embra_bench --benchmark_filter='BM_Kernels'         cost per constraint and substep
 #include "cloth_scenario.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <chrono>
-#include <limits>
 #include <memory>
+#include <string>
 
 namespace {
 
@@ -23,11 +29,19 @@ using embra::bench::ClothCase;
 
 constexpr int kFrames = 200;
 
+std::string describe(const ClothCase& c) {
+  const auto& s = c.settings;
+  std::string d = "n=" + std::to_string(c.n) + " substeps=" + std::to_string(s.substeps) +
+                  " iterations=" + std::to_string(s.iterations) + " tethers=" + std::to_string(s.tethers);
+  if (c.stretch_weight > 0) d += " stretch_weight=" + std::to_string(c.stretch_weight);
+  if (c.bend_weight > 0) d += " bend_weight=" + std::to_string(c.bend_weight);
+  return d + " kernels=" + embra::solver_kernels();
+}
+
 void run_cloth(benchmark::State& state, const ClothCase& c) {
   embra::bench::Strain strain;
   double seconds = 0.0;
-  int64_t runs = 0;
-  int64_t constraints = 0;
+  int64_t runs = 0, constraints = 0;
   for (auto _ : state) {
     auto world = std::make_unique<embra::World>(c.settings);
     const auto scene = embra::bench::build_cloth(*world, c);
@@ -51,10 +65,11 @@ void run_cloth(benchmark::State& state, const ClothCase& c) {
   state.counters["max_edge_strain"] = strain.max;
   state.counters["pin_strain"] = strain.near_pin;
   state.counters["rms_strain"] = strain.rms;
-  state.counters["particles"] = static_cast<double>(c.n * c.n);
-  state.counters["constraints"] = static_cast<double>(constraints);
   state.counters["substeps"] = s.substeps;
   state.counters["iterations"] = s.iterations;
+  state.counters["tethers"] = s.tethers;
+  state.counters["constraints"] = static_cast<double>(constraints);
+  state.SetLabel(describe(c));
 }
 
 /// The acceptance case with embra's default settings, at n = 128 (and 64, 32).
@@ -65,32 +80,82 @@ void BM_Cloth(benchmark::State& state) {
 }
 BENCHMARK(BM_Cloth)->Arg(128)->Arg(64)->Arg(32)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
 
-/// A configuration sweep: {n, substeps, iterations, explicit tethers, stretch weight, bend weight}
-/// (weight 0 = stretch or bend stays in the default group).
+/// Configurations compared: {n, substeps, iterations, tethers per particle, stretch weight, bend
+/// weight} (a weight of 0 leaves stretch or bend in the default group).
 void BM_ClothConfig(benchmark::State& state) {
   ClothCase c;
   c.n = static_cast<int>(state.range(0));
   c.settings.substeps = static_cast<int32_t>(state.range(1));
   c.settings.iterations = static_cast<int32_t>(state.range(2));
-  c.tethers = state.range(3) != 0;
+  c.settings.tethers = static_cast<int32_t>(state.range(3));
   c.stretch_weight = static_cast<int32_t>(state.range(4));
   c.bend_weight = static_cast<int32_t>(state.range(5));
-  state.counters["tethers"] = c.tethers;
-  state.counters["stretch_weight"] = c.stretch_weight;
-  state.counters["bend_weight"] = c.bend_weight;
   run_cloth(state, c);
 }
 BENCHMARK(BM_ClothConfig)
     ->ArgNames({"n", "substeps", "iters", "tethers", "sw", "bw"})
-    ->Args({128, 8, 1, 0, 0, 0})
-    ->Args({128, 8, 1, 1, 0, 0})
-    ->Args({128, 16, 1, 1, 0, 0})
-    ->Args({128, 32, 1, 1, 0, 0})
-    ->Args({128, 8, 1, 1, 2, 1})
-    ->Args({128, 16, 1, 1, 2, 1})
+    ->Args({128, 1, 10, 0, 0, 0})  // the reference set-up: one step of 10 iterations, no tethers
+    ->Args({128, 8, 1, 0, 0, 0})   // embra's old defaults
+    ->Args({128, 8, 1, 2, 0, 0})
+    ->Args({128, 16, 1, 2, 0, 0})
+    ->Args({128, 20, 1, 2, 0, 0})
+    ->Args({128, 24, 1, 2, 0, 0})
+    ->Args({128, 32, 1, 2, 0, 0})
+    ->Args({128, 12, 1, 2, 2, 1})
+    ->Args({128, 8, 2, 2, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);
+
+/// Cost of one substep's pass per constraint kind on the 128 x 128 cloth, from runs that generate
+/// only some kinds: arg 0 = no constraints, 1 = stretch, 2 = stretch + bend, 3 = stretch + tethers.
+void BM_Kernels(benchmark::State& state) {
+  const int what = static_cast<int>(state.range(0));
+  ClothCase c;
+  c.settings.substeps = 16;
+  c.settings.tethers = what == 3 ? 2 : 0;
+  c.bend = what == 2;
+  const int frames = 20;
+  double seconds = 0.0;
+  int64_t constraints = 0;
+  for (auto _ : state) {
+    embra::World world(c.settings);
+    auto scene = embra::bench::build_cloth(world, c);
+    if (what == 0) {  // the same particles and pins without constraints: the stages around projection
+      embra::World empty(c.settings);
+      embra::BodyDesc d;
+      std::vector<double> xyz;
+      for (const auto& p : world.positions()) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+      std::vector<double> masses(world.particle_count(), 1.0 / world.particle_count());
+      d.positions = xyz;
+      d.masses = masses;
+      d.generate = 0;
+      empty.create_body(d);
+      world.step();
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int f = 0; f < frames; ++f) empty.step();
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      state.SetIterationTime(seconds);
+      continue;
+    }
+    constraints = world.constraint_count();
+    world.step();  // builds the solver arrays (and the tethers) outside the timing
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int f = 0; f < frames; ++f) world.step();
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    seconds += dt;
+    state.SetIterationTime(dt);
+    (void)scene;
+  }
+  state.counters["ms_per_substep"] = 1e3 * seconds / (frames * c.settings.substeps);
+  state.counters["constraints"] = static_cast<double>(constraints);
+  state.SetLabel(std::string(what == 0   ? "no constraints"
+                             : what == 1 ? "stretch"
+                             : what == 2 ? "stretch + bend"
+                                         : "stretch + 2 tethers per particle") +
+                 " kernels=" + embra::solver_kernels());
+}
+BENCHMARK(BM_Kernels)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
 
 }  // namespace
 

@@ -321,6 +321,10 @@ Vec3 collider_point_before(const Collider& c, const Vec3& x) {
 
 }  // namespace
 
+const char* solver_kernels() {
+  return kernels().name;
+}
+
 void World::predict(double h, double alpha) {
   const Vec3 dv = h * settings_.gravity;
   const size_t n = x_.size();

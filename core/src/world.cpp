@@ -6,8 +6,10 @@
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <queue>
 #include <sstream>
 
 namespace embra {
@@ -346,6 +348,29 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
   return static_cast<int64_t>(count);
 }
 
+int64_t World::add_tethers(Id body_id, Id group, int32_t per_particle) {
+  const BodyInfo& b = body(body_id);
+  resolve_group(group);
+  if (per_particle < 1 || per_particle > 64) invalid("tethers per particle must be in [1, 64]");
+  std::vector<int32_t> anchors;
+  for (int32_t i = b.first_particle; i < b.first_particle + b.particle_count; ++i)
+    if (w_[i] == 0.0) anchors.push_back(i);
+  const std::vector<Attachment> links = long_range_attachments(b, anchors, per_particle);
+  if (links.empty()) return 0;
+  std::vector<int32_t> ids;
+  std::vector<double> rest;
+  for (const Attachment& l : links) {
+    ids.insert(ids.end(), {l.particle, l.anchor});
+    rest.push_back(l.rest);
+  }
+  ConstraintDesc d;
+  d.kind = Kind::tether;
+  d.group = group;
+  d.particles = ids;
+  d.rest = rest;
+  return add_constraints(d);
+}
+
 int64_t World::constraint_count() const {
   int64_t n = 0;
   for (const Group& g : groups_)
@@ -488,6 +513,7 @@ Id World::create_body(const BodyDesc& d) {
   info.stretch_group = groups[0];
   info.generated_stretch = (d.generate & generate_stretch) != 0 && !edges.empty();
   bodies_.push_back(info);
+  tether_cache_.emplace_back();
 
   auto append = [&](Kind kind, Id gid, std::initializer_list<int32_t> local, double rest, double compliance, double ru,
                     double rv) {
@@ -638,7 +664,233 @@ void colour_order(const int32_t* ids, size_t count, int n, size_t particle_count
   for (size_t i = 0; i < count; ++i) order[next[colour[i]]++] = static_cast<int32_t>(i);
 }
 
+/// The body's rest shape as a surface: vertex neighbours (sorted) and triangle adjacency, for
+/// straight walks over it (body-local indices).
+class RestSurface {
+ public:
+  explicit RestSurface(const BodyInfo& body) : p_(body.rest_positions) {
+    const int32_t first = body.first_particle;
+    const size_t nv = p_.size();
+    std::vector<std::vector<int32_t>> nbr(nv);
+    for (size_t e = 0; e + 1 < body.edges.size(); e += 2) {
+      nbr[body.edges[e] - first].push_back(body.edges[e + 1] - first);
+      nbr[body.edges[e + 1] - first].push_back(body.edges[e] - first);
+    }
+    nbr_start_.assign(nv + 1, 0);
+    for (size_t v = 0; v < nv; ++v) {
+      std::sort(nbr[v].begin(), nbr[v].end());
+      nbr[v].erase(std::unique(nbr[v].begin(), nbr[v].end()), nbr[v].end());
+      nbr_start_[v + 1] = nbr_start_[v] + static_cast<int32_t>(nbr[v].size());
+      nbr_.insert(nbr_.end(), nbr[v].begin(), nbr[v].end());
+    }
+    for (int32_t v : body.triangles) tri_.push_back(v - first);
+    const size_t nt = tri_.size() / 3;
+    std::vector<std::vector<int32_t>> vt(nv);
+    for (size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) vt[tri_[3 * t + k]].push_back(static_cast<int32_t>(t));
+    vt_start_.assign(nv + 1, 0);
+    for (size_t v = 0; v < nv; ++v) {
+      vt_start_[v + 1] = vt_start_[v] + static_cast<int32_t>(vt[v].size());
+      vt_.insert(vt_.end(), vt[v].begin(), vt[v].end());
+    }
+    // across_[3 t + k]: the triangle on the other side of edge (tri[k], tri[k + 1]); -1 on the
+    // boundary, -2 where more than two triangles share the edge.
+    across_.assign(tri_.size(), -1);
+    std::map<std::pair<int32_t, int32_t>, int32_t> seen;  // edge -> 3 t + k of its first triangle
+    for (size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int32_t a = tri_[3 * t + k], b = tri_[3 * t + (k + 1) % 3];
+        const auto [it, fresh] =
+            seen.emplace(std::pair{std::min(a, b), std::max(a, b)}, static_cast<int32_t>(3 * t + k));
+        if (fresh) continue;
+        const int32_t other = it->second;
+        if (across_[other] == -1 && other / 3 != static_cast<int32_t>(t)) {
+          across_[other] = static_cast<int32_t>(t);
+          across_[3 * t + k] = other / 3;
+        } else {
+          across_[other] = -2;
+          across_[3 * t + k] = -2;
+        }
+      }
+  }
+
+  size_t size() const { return p_.size(); }
+  const Vec3& at(int32_t v) const { return p_[v]; }
+  std::span<const int32_t> neighbours(int32_t v) const {
+    return {nbr_.data() + nbr_start_[v], nbr_.data() + nbr_start_[v + 1]};
+  }
+  bool adjacent(int32_t a, int32_t b) const {
+    const auto n = neighbours(a);
+    return std::binary_search(n.begin(), n.end(), b);
+  }
+
+  /// Whether the straight segment from vertex a to vertex b lies on the surface: it runs through a
+  /// chain of coplanar triangles (crossing their edges or passing through their vertices). Then
+  /// its length is a path length over the surface, never shorter than the geodesic distance.
+  bool straight(int32_t a, int32_t b) const {
+    if (a == b || adjacent(a, b)) return true;
+    if (tri_.empty()) return false;
+    const Vec3 A = p_[a], d = p_[b] - A;
+    const double len = d.norm();
+    if (!(len > 0.0)) return false;
+    const Vec3 dir = d / len;
+    const double tol = 1e-9 * len;
+    Vec3 normal = Vec3::Zero(), side = Vec3::Zero();  // the walk's plane, fixed by its first triangle
+    bool plane = false;
+    auto on_plane = [&](int32_t v) { return std::abs(normal.dot(p_[v] - A)) <= tol; };
+    auto s_of = [&](int32_t v) { return side.dot(p_[v] - A); };
+    auto t_of = [&](int32_t v) { return dir.dot(p_[v] - A); };
+    int32_t vertex = a;  // walking from a vertex on the segment, or
+    int32_t tri = -1;    // across edge (e0, e1) out of triangle tri
+    int32_t e0 = -1, e1 = -1;
+    const size_t max_steps = 4 * (tri_.size() / 3) + 16;
+    for (size_t step = 0; step < max_steps; ++step) {
+      if (vertex >= 0) {
+        if (vertex == b) return true;
+        const double tv = t_of(vertex);
+        bool moved = false;
+        for (int32_t k = vt_start_[vertex]; k < vt_start_[vertex + 1] && !moved; ++k) {
+          const int32_t t = vt_[k];
+          int32_t c = -1, e = -1;
+          for (int j = 0; j < 3; ++j) {
+            const int32_t u = tri_[3 * t + j];
+            if (u == vertex) continue;
+            (c < 0 ? c : e) = u;
+          }
+          if (!plane) {
+            const Vec3 n = (p_[c] - p_[vertex]).cross(p_[e] - p_[vertex]);
+            const double nn = n.norm();
+            if (!(nn > 0.0) || std::abs(n.dot(dir)) > 1e-9 * nn) continue;
+            normal = n / nn;
+            side = normal.cross(dir);
+            if (!on_plane(c) || !on_plane(e)) continue;
+            plane = true;
+          } else if (!on_plane(c) || !on_plane(e)) {
+            continue;
+          }
+          const double sc = s_of(c), se = s_of(e);
+          for (const int32_t u : {c, e})
+            if (std::abs(s_of(u)) <= tol && t_of(u) > tv + tol) {  // along the edge vertex-u
+              if (t_of(u) > len + tol) return false;
+              vertex = u;
+              moved = true;
+              break;
+            }
+          if (moved) break;
+          if ((sc > tol && se < -tol) || (sc < -tol && se > tol)) {
+            const double tx = t_of(c) + (t_of(e) - t_of(c)) * sc / (sc - se);
+            if (tx > tv + tol) {  // through the triangle's interior to its far edge
+              tri = t;
+              e0 = c;
+              e1 = e;
+              vertex = -1;
+              moved = true;
+            }
+          }
+        }
+        if (!moved) return false;
+      } else {
+        // Cross edge (e0, e1) into the neighbouring triangle.
+        int32_t next = -1;
+        for (int k = 0; k < 3; ++k) {
+          const int32_t a0 = tri_[3 * tri + k], a1 = tri_[3 * tri + (k + 1) % 3];
+          if ((a0 == e0 && a1 == e1) || (a0 == e1 && a1 == e0)) next = across_[3 * tri + k];
+        }
+        if (next < 0) return false;  // off the boundary, or a non-manifold edge
+        const int32_t* v = &tri_[3 * next];
+        const int32_t r = v[0] != e0 && v[0] != e1 ? v[0] : v[1] != e0 && v[1] != e1 ? v[1] : v[2];
+        if (!on_plane(r)) return false;  // over a fold
+        if (r == b) return true;
+        const double sr = s_of(r);
+        if (std::abs(sr) <= tol) {
+          if (t_of(r) > len + tol) return false;
+          vertex = r;
+          continue;
+        }
+        if ((sr > 0.0) == (s_of(e0) > 0.0))
+          e0 = r;  // leaves through (r, e1)
+        else
+          e1 = r;  // leaves through (e0, r)
+        tri = next;
+      }
+    }
+    return false;
+  }
+
+ private:
+  const std::vector<Vec3>& p_;
+  std::vector<int32_t> nbr_start_, nbr_, tri_, vt_start_, vt_, across_;
+};
+
 }  // namespace
+
+std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors, int32_t k) {
+  std::vector<Attachment> out;
+  if (k <= 0 || anchors.empty()) return out;
+  const RestSurface surface(body);
+  const int32_t first = body.first_particle;
+  const size_t nv = surface.size();
+  // Up to k labels per vertex (source, distance, parent), settled in increasing distance: a
+  // multi-source Dijkstra over the edges that, as in Theta*, tries to reach each vertex straight
+  // from its predecessor's parent. A straight link is taken only if it lies on the surface, so every
+  // distance is the length of a path over the surface: never shorter than the geodesic (safe for a
+  // tether), and exact on a flat, convex piece of it.
+  struct Label {
+    int32_t source;
+    int32_t parent;
+    double dist;
+  };
+  std::vector<Label> labels(nv * static_cast<size_t>(k));
+  std::vector<int32_t> count(nv, 0);
+  auto find = [&](int32_t v, int32_t s) -> const Label* {
+    for (int32_t i = 0; i < count[v]; ++i)
+      if (labels[v * static_cast<size_t>(k) + i].source == s) return &labels[v * static_cast<size_t>(k) + i];
+    return nullptr;
+  };
+  struct Entry {
+    double dist;
+    int32_t vertex, source, parent;
+    bool operator>(const Entry& o) const {
+      if (dist != o.dist) return dist > o.dist;
+      if (vertex != o.vertex) return vertex > o.vertex;
+      if (source != o.source) return source > o.source;
+      return parent > o.parent;
+    }
+  };
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int32_t a : anchors) queue.push(Entry{0.0, a - first, a - first, a - first});
+  while (!queue.empty()) {
+    const Entry e = queue.top();
+    queue.pop();
+    const int32_t v = e.vertex, s = e.source;
+    if (count[v] >= k || find(v, s)) continue;
+    if (e.parent != v && !surface.straight(e.parent, v)) {
+      // The straight link leaves the surface: come from the best settled neighbour instead.
+      double best = std::numeric_limits<double>::infinity();
+      int32_t from = -1;
+      for (int32_t u : surface.neighbours(v))
+        if (const Label* l = find(u, s)) {
+          const double d = l->dist + (surface.at(u) - surface.at(v)).norm();
+          if (d < best) best = d, from = u;
+        }
+      if (from >= 0) queue.push(Entry{best, v, s, from});
+      continue;
+    }
+    labels[v * static_cast<size_t>(k) + count[v]++] = Label{s, e.parent, e.dist};
+    const int32_t via = v == s ? v : e.parent;
+    const double via_dist = v == s ? 0.0 : find(via, s)->dist;
+    for (int32_t u : surface.neighbours(v))
+      if (count[u] < k && !find(u, s))
+        queue.push(Entry{via_dist + (surface.at(via) - surface.at(u)).norm(), u, s, via});
+  }
+  for (size_t v = 0; v < nv; ++v)
+    for (int32_t i = 0; i < count[v]; ++i) {
+      const Label& l = labels[v * static_cast<size_t>(k) + i];
+      if (l.source != static_cast<int32_t>(v) && l.dist > 0.0)
+        out.push_back(Attachment{first + static_cast<int32_t>(v), first + l.source, l.dist});
+    }
+  return out;
+}
 
 void World::rebuild_solver() {
   std::vector<uint8_t> none(x_.size(), 0);
@@ -662,6 +914,51 @@ void World::rebuild_solver() {
       sa.lambda.assign(per * a.size(), 0.0);
     }
     g.tethers = SolverArray{};
+  }
+  // Automatic long-range attachments: every particle of an inextensible body to its nearest
+  // anchors (hard-pinned or immovable particles of the body), in the body's stretch group.
+  if (settings_.tethers > 0) {
+    std::vector<uint8_t> anchor(x_.size(), 0);
+    for (size_t i = 0; i < x_.size(); ++i) anchor[i] = w_[i] == 0.0;
+    for (size_t bi = 0; bi < bodies_.size(); ++bi) {
+      const BodyInfo& b = bodies_[bi];
+      if (!b.generated_stretch || b.material.stretch_compliance != 0.0 || !find_group(b.stretch_group)) continue;
+      std::vector<int32_t> anchors;
+      for (int32_t i = b.first_particle; i < b.first_particle + b.particle_count; ++i)
+        if (anchor[i]) anchors.push_back(i);
+      if (anchors.empty() || anchors.size() == static_cast<size_t>(b.particle_count)) continue;
+      TetherCache& cache = tether_cache_[bi];
+      if (cache.anchors != anchors || cache.per_particle != settings_.tethers) {
+        cache.anchors = anchors;
+        cache.per_particle = settings_.tethers;
+        cache.links = long_range_attachments(b, anchors, settings_.tethers);
+      }
+      SolverArray& t = groups_[b.stretch_group.index].tethers;
+      for (const Attachment& link : cache.links) {
+        t.ids.insert(t.ids.end(), {link.particle, link.anchor});
+        t.source.push_back(-1);
+        t.base_rest.push_back(link.rest);
+        t.body.push_back(static_cast<int32_t>(bi));
+        t.rest.push_back(link.rest);
+        t.compliance.push_back(0.0);
+      }
+    }
+    for (Group& g : groups_) {
+      SolverArray& t = g.tethers;
+      if (!g.alive || t.size() == 0) continue;
+      colour_order(t.ids.data(), t.size(), 2, x_.size(), anchor, order, t.colour_start, t.shared_tail);
+      SolverArray sorted = t;
+      sorted.ids.clear();
+      for (size_t j = 0; j < order.size(); ++j) {
+        const int32_t i = order[j];
+        sorted.ids.insert(sorted.ids.end(), {t.ids[2 * i], t.ids[2 * i + 1]});
+        sorted.base_rest[j] = t.base_rest[i];
+        sorted.body[j] = t.body[i];
+        sorted.rest[j] = t.rest[i];
+      }
+      t = std::move(sorted);
+      t.lambda.assign(t.size(), 0.0);
+    }
   }
   solver_dirty_ = false;
   refresh_rest();

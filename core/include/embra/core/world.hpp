@@ -129,7 +129,7 @@ struct Settings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2
   double damping = 0.0;                  // 1/s, applied to every particle
   double settle_speed = 1e-3;            // m/s: settled when no particle moves faster
-  int32_t tethers = 0;                   // automatic long-range attachments per particle (0 = none)
+  int32_t tethers = 2;                   // automatic long-range attachments per particle (0 = none)
   Id contact_group;                      // set by the world: the group that holds collider contacts
 };
 
@@ -248,6 +248,26 @@ struct Collider {
   bool alive = false;
 };
 
+/// A long-range attachment: `particle` may be at most `rest` from `anchor` (a tether).
+struct Attachment {
+  int32_t particle = 0;
+  int32_t anchor = 0;
+  double rest = 0.0;
+};
+
+/// The long-range attachments of a body: each of its particles to its `per_particle` nearest
+/// `anchors` (world indices of the body's particles), nearest by path length over the body's rest
+/// shape (edges, and straight lines across coplanar triangles). A rest length is the length of a
+/// path over the surface, so it is never shorter than the geodesic distance: a tether never holds
+/// back a shape the body can take without stretching, and on a flat piece it is the straight-line
+/// distance. Deterministic; cost about that of a Dijkstra search per anchor.
+std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors,
+                                               int32_t per_particle);
+
+/// The projection kernels this machine runs: "avx2" (4 constraints at a time), "vec2" (2) or
+/// "scalar". All give the same bits; the environment variable EMBRA_KERNELS forces one.
+const char* solver_kernels();
+
 /// The world. Not thread-safe: one thread at a time per world; different worlds are independent.
 class World {
  public:
@@ -277,6 +297,12 @@ class World {
   // --- constraints -----------------------------------------------------------------------------
   /// Adds `particles.size() / arity(kind)` constraints to a group; returns how many were added.
   int64_t add_constraints(const ConstraintDesc& desc);
+  /// Adds tether constraints (long-range attachments, see long_range_attachments) from every
+  /// particle of `body` to its `per_particle` nearest anchors: the body's particles that are
+  /// hard-pinned or immovable now. They go to `group` (null = the default group) as ordinary
+  /// constraints; Settings::tethers makes the same attachments automatically and keeps them up to
+  /// date as pins come and go. Returns how many were added (0 when the body has no anchor).
+  int64_t add_tethers(Id body, Id group, int32_t per_particle);
   int64_t constraint_count() const;
 
   // --- pins ------------------------------------------------------------------------------------
@@ -344,6 +370,12 @@ class World {
   std::vector<Collider> colliders_;
   Id default_group_;
   int64_t serial_ = 0;
+  struct TetherCache {  // a body's automatic tethers, kept while its anchors stay the same
+    std::vector<int32_t> anchors;
+    int32_t per_particle = 0;
+    std::vector<Attachment> links;
+  };
+  std::vector<TetherCache> tether_cache_;  // one per body
   bool rest_dirty_ = true;
   bool solver_dirty_ = true;  // constraints, pins or bodies changed: rebuild the solver arrays
   StepReport report_;
