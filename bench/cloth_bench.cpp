@@ -15,6 +15,7 @@
 //   ./build/bench/embra_bench --benchmark_filter='BM_Cloth/'          embra's defaults, n = 128, 64, 32
 //   ./build/bench/embra_bench --benchmark_filter='BM_ClothConfig'     the configurations compared
 //   ./build/bench/embra_bench --benchmark_filter='BM_Kernels'         cost per constraint and substep
+//   ./build/bench/embra_bench --benchmark_filter='BM_ClothDamped'     not the acceptance case: damped
 #include "cloth_scenario.hpp"
 
 #include <benchmark/benchmark.h>
@@ -103,6 +104,23 @@ BENCHMARK(BM_ClothConfig)
     ->Args({128, 32, 1, 2, 0, 0})
     ->Args({128, 12, 1, 2, 2, 1})
     ->Args({128, 8, 2, 2, 0, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1);
+
+/// Not the acceptance case: the same cloth with air-like velocity damping (Settings::damping, 1/s),
+/// to show the strain left once the swinging has died down. Args: {substeps, damping in 1/s}.
+void BM_ClothDamped(benchmark::State& state) {
+  ClothCase c;
+  c.settings.substeps = static_cast<int32_t>(state.range(0));
+  c.settings.damping = static_cast<double>(state.range(1));
+  state.counters["damping"] = c.settings.damping;
+  run_cloth(state, c);
+}
+BENCHMARK(BM_ClothDamped)
+    ->ArgNames({"substeps", "damping"})
+    ->Args({8, 3})
+    ->Args({16, 3})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);

@@ -127,7 +127,7 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   const T s1 = dot(a2, edge) * inv_le2, s2 = dot(a3, edge) * inv_le2;
   const V3<T> g1 = -(s1 * g2 + s2 * g3);
   const V3<T> g0 = -(g1 + g2 + g3);
-  const T denom = wk[0] * dot(g0, g0) + wk[1] * dot(g1, g1) + wk[2] * (le2 / n1sq) + wk[3] * (le2 / n2sq) + alpha;
+  const T denom = wk[0] * dot(g0, g0) + wk[1] * dot(g1, g1) + wk[2] * dot(g2, g2) + wk[3] * dot(g3, g3) + alpha;
   const auto ok = valid & (denom > 0.0);
   const T dl = (-c - alpha * lam) / denom;
   const T lam_new = lam + dl;
