@@ -3,15 +3,19 @@
 #include "embra/embra.h"
 
 #include "embra/core/world.hpp"
+#include "embra/io/scene.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <string>
 
 struct embra_world {
   embra::World world;
+  embra::io::SceneMeta meta;  // names, actions and tolerances of a scene; empty for an API-built world
 };
 
 namespace {
@@ -61,6 +65,9 @@ embra_status guard(const char* function, F&& body) noexcept {
   } catch (const Refused& r) {
     g_last_error = std::string(function) + ": " + r.message;
     return r.status;
+  } catch (const embra::io::SceneError& e) {
+    g_last_error = std::string(function) + ": " + e.what();
+    return EMBRA_ERROR_SCHEMA;
   } catch (const embra::Error& e) {
     g_last_error = std::string(function) + ": " + e.what();
     return map(e.code());
@@ -220,7 +227,7 @@ embra_status embra_world_create(embra_world** out_world, const embra_solver_def*
     need(out_world, "out_world");
     const embra_solver_def d = def ? *def : embra_default_solver_def();
     need_version(d.version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
-    *out_world = new embra_world{embra::World(to_settings(d))};
+    *out_world = new embra_world{embra::World(to_settings(d)), {}};
   });
 }
 
@@ -594,6 +601,8 @@ embra_status embra_collider_set_transform(embra_world* world, embra_collider_id 
 embra_status embra_world_step(embra_world* world) {
   return guard("embra_world_step", [&] {
     need(world, "world");
+    if (!world->meta.actions.empty())
+      embra::io::apply_actions(world->world, world->meta, world->world.report().frame + 1);
     world->world.step();
   });
 }
@@ -661,6 +670,125 @@ embra_status embra_world_set_velocities(embra_world* world, const double* xyz, i
     need(world, "world");
     need_count(count, "count");
     world->world.set_velocities(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+// --- geometry queries ---------------------------------------------------------------------------
+
+embra_status embra_body_get_triangles(const embra_world* world, embra_body_id body, int32_t* out, int64_t capacity,
+                                      int64_t* out_count) {
+  return guard("embra_body_get_triangles", [&] {
+    need(world, "world");
+    need(out_count, "out_count");
+    const std::vector<int32_t>& t = world->world.body(to_id(body)).triangles;
+    const int64_t n = static_cast<int64_t>(t.size());
+    if (out == nullptr && capacity == 0) {
+      *out_count = n;
+      return;
+    }
+    need(out, "out");
+    if (capacity < n)
+      refuse(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer holds " + num(capacity) + " values, " + num(n) + " needed");
+    std::copy(t.begin(), t.end(), out);
+    *out_count = n;
+  });
+}
+
+// --- JSON scenes -------------------------------------------------------------------------------
+
+namespace {
+embra_world* load(std::string_view text, const std::string& base_dir) {
+  embra::io::SceneMeta meta;
+  std::unique_ptr<embra::World> w = embra::io::load_scene(text, base_dir, meta);
+  return new embra_world{std::move(*w), std::move(meta)};
+}
+
+std::string folder_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+}
+}  // namespace
+
+embra_status embra_world_load_json(embra_world** out_world, const char* json, int64_t length, const char* base_dir) {
+  if (out_world != nullptr) *out_world = nullptr;
+  return guard("embra_world_load_json", [&] {
+    need(out_world, "out_world");
+    need(json, "json");
+    need_count(length, "length");
+    *out_world = load(std::string_view(json, static_cast<size_t>(length)), base_dir ? base_dir : ".");
+  });
+}
+
+embra_status embra_world_load_file(embra_world** out_world, const char* path) {
+  if (out_world != nullptr) *out_world = nullptr;
+  return guard("embra_world_load_file", [&] {
+    need(out_world, "out_world");
+    need(path, "path");
+    std::FILE* f = std::fopen(path, "rb");
+    if (f == nullptr)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot open ") + path + ": " + std::strerror(errno));
+    std::string text;
+    char buffer[65536];
+    size_t got;
+    while ((got = std::fread(buffer, 1, sizeof buffer, f)) > 0) {
+      text.append(buffer, got);
+      if (text.size() > (size_t{1} << 31)) {
+        std::fclose(f);
+        refuse(EMBRA_ERROR_SCHEMA, std::string(path) + " is larger than 2 GiB");
+      }
+    }
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot read ") + path);
+    *out_world = load(text, folder_of(path));
+  });
+}
+
+embra_status embra_world_save_json(const embra_world* world, char* out, int64_t capacity, int64_t* out_length) {
+  return guard("embra_world_save_json", [&] {
+    need(world, "world");
+    need(out_length, "out_length");
+    const std::string text = embra::io::save_scene(world->world, world->meta);
+    const int64_t n = static_cast<int64_t>(text.size()) + 1;
+    if (out == nullptr && capacity == 0) {
+      *out_length = n;
+      return;
+    }
+    need(out, "out");
+    if (capacity < n) {
+      *out_length = n;
+      refuse(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer holds " + num(capacity) + " bytes, " + num(n) + " needed");
+    }
+    std::memcpy(out, text.c_str(), static_cast<size_t>(n));
+    *out_length = n;
+  });
+}
+
+embra_status embra_world_save_file(const embra_world* world, const char* path) {
+  return guard("embra_world_save_file", [&] {
+    need(world, "world");
+    need(path, "path");
+    const std::string text = embra::io::save_scene(world->world, world->meta);
+    const std::string tmp = std::string(path) + ".tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (f == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp + ": " + std::strerror(errno));
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok) {
+      std::remove(tmp.c_str());
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp);
+    }
+    if (std::rename(tmp.c_str(), path) != 0) {
+      std::remove(tmp.c_str());
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot replace ") + path + ": " + std::strerror(errno));
+    }
+  });
+}
+
+embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out_frames) {
+  return guard("embra_world_get_scene_frames", [&] {
+    need(world, "world");
+    need(out_frames, "out_frames");
+    *out_frames = world->meta.frames;
   });
 }
 

@@ -512,9 +512,29 @@ Id World::create_body(const BodyDesc& d) {
   for (int64_t i = 0; i < nv; ++i) info.rest_positions.push_back(P(static_cast<int32_t>(i)));
   info.stretch_group = groups[0];
   info.generated_stretch = (d.generate & generate_stretch) != 0 && !edges.empty();
+  info.masses = mass;
+  info.uvs.assign(d.uvs.begin(), d.uvs.end());
+  info.generate = d.generate;
+  info.shear_group = groups[1];
+  info.bend_group = groups[2];
+  info.volume_group = groups[3];
   bodies_.push_back(info);
   tether_cache_.emplace_back();
 
+  // Generated constraints go after earlier bodies' and before added ones (ConstraintArray::generated).
+  struct Touched {
+    ConstraintArray* array;
+    int kind;
+    size_t before;  // size before this body
+    bool operator<(const Touched& o) const { return array < o.array; }
+    bool operator==(const Touched& o) const { return array == o.array; }
+  };
+  std::vector<Touched> touched;
+  for (const Id gid : groups)
+    for (int k = 0; k < kKindCount; ++k)
+      touched.push_back({&group_mut(gid).arrays[k], k, group_mut(gid).arrays[k].size()});
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   auto append = [&](Kind kind, Id gid, std::initializer_list<int32_t> local, double rest, double compliance, double ru,
                     double rv) {
     ConstraintArray& a = group_mut(gid).arrays[static_cast<int>(kind)];
@@ -570,6 +590,26 @@ Id World::create_body(const BodyDesc& d) {
       append(Kind::tet_volume, groups[3], {v[0], v[1], v[2], v[3]},
              eval_tet_volume(P(v[0]), P(v[1]), P(v[2]), P(v[3])).value, m.volume_compliance, 0, 0);
     }
+  for (const Touched& t : touched) {
+    ConstraintArray& a = *t.array;
+    const size_t added = a.size() - t.before;
+    if (added == 0) continue;
+    if (a.generated < t.before) {  // added constraints exist: move this body's block in front of them
+      const auto move_block = [&](auto& v, size_t per) {
+        std::rotate(v.begin() + static_cast<std::ptrdiff_t>(a.generated * per),
+                    v.begin() + static_cast<std::ptrdiff_t>(t.before * per), v.end());
+      };
+      move_block(a.ids, static_cast<size_t>(arity(static_cast<Kind>(t.kind))));
+      move_block(a.rest, 1);
+      move_block(a.rest_u, 1);
+      move_block(a.rest_v, 1);
+      move_block(a.body, 1);
+      move_block(a.compliance, 1);
+      move_block(a.rest_now, 1);
+      move_block(a.lambda, 1);
+    }
+    a.generated += added;
+  }
   rest_dirty_ = true;
   solver_dirty_ = true;
   return Id{static_cast<uint32_t>(body_index), 1};
@@ -579,6 +619,13 @@ const BodyInfo& World::body(Id id) const {
   if (id.generation != 1 || id.index >= bodies_.size())
     fail(ErrorCode::stale_id, "body id does not name a body of this world");
   return bodies_[id.index];
+}
+
+void World::set_clock(int64_t frame, double time) {
+  if (frame < 0) invalid("frame must be >= 0");
+  check_non_negative(time, "time");
+  report_.frame = frame;
+  report_.time = time;
 }
 
 void World::set_rest_scale(Id id, double scale, double scale_u, double scale_v) {

@@ -1,7 +1,13 @@
 /* The `embra` command. Uses only the C ABI (embra.h), as any CAD host would.
  *
  *   embra version
+ *   embra validate SCENE.json
+ *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T]
  *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]
+ *
+ * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
+ * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
+ * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames.
  *
  * `demo tent` is the paper's Gaudi paradigm (section 3.2, figure 6): a triangular cloth pinned at
  * its three corners under reversed gravity. The membrane is elastic, so reversed gravity stretches
@@ -10,12 +16,15 @@
  * It prints convergence as it goes and writes OBJ files of the shell.
  *
  * Exit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state). */
+#define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "embra/embra.h"
 
@@ -24,8 +33,33 @@ enum { EXIT_USAGE = 1, EXIT_INVALID = 2, EXIT_SIM = 3 };
 static int usage(void) {
   fprintf(stderr,
           "usage: embra version\n"
+          "       embra validate SCENE.json\n"
+          "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T]\n"
           "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]\n");
   return EXIT_USAGE;
+}
+
+/* Parses a whole decimal integer in [lo, hi]; 0 on success. */
+static int parse_int(const char* text, long lo, long hi, long* out) {
+  char* end = NULL;
+  errno = 0;
+  const long v = strtol(text, &end, 10);
+  if (errno != 0 || end == text || *end != 0 || v < lo || v > hi) return -1;
+  *out = v;
+  return 0;
+}
+
+static int make_dir(const char* path) {
+  char buf[4096];
+  if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
+  for (char* p = buf + 1; *p; ++p)
+    if (*p == '/') {
+      *p = 0;
+      if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
+      *p = '/';
+    }
+  if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
+  return 0;
 }
 
 static int check(embra_status s, const char* what) {
@@ -95,19 +129,9 @@ static int demo_tent(int argc, char** argv) {
       return usage();
   }
   if (frames < 0 || every < 1 || rows < 2 || rows > 1000) return usage();
-  if (mkdir(out, 0755) != 0 && errno != EEXIST) {
-    /* create the parent once, for the default out/tent */
-    char parent[4096];
-    snprintf(parent, sizeof parent, "%s", out);
-    char* slash = strrchr(parent, '/');
-    if (slash) {
-      *slash = 0;
-      mkdir(parent, 0755);
-    }
-    if (mkdir(out, 0755) != 0 && errno != EEXIST) {
-      fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
-      return EXIT_INVALID;
-    }
+  if (make_dir(out) != 0) {
+    fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
+    return EXIT_INVALID;
   }
 
   const int32_t n = (rows + 1) * (rows + 2) / 2, t = rows * rows;
@@ -209,6 +233,175 @@ done:
   return rc;
 }
 
+static double now_ms(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
+
+/* Writes every body's triangles as one OBJ, a group per body. */
+static int write_world_obj(const char* path, embra_world* world) {
+  embra_world_counts counts;
+  if (embra_world_get_counts(world, &counts) != EMBRA_OK) return -1;
+  double* xyz = malloc(sizeof(double) * 3 * (size_t)(counts.particles > 0 ? counts.particles : 1));
+  if (!xyz) return -1;
+  if (embra_world_get_positions(world, xyz, 3 * (int64_t)counts.particles, 0, counts.particles) != EMBRA_OK) {
+    free(xyz);
+    return -1;
+  }
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    free(xyz);
+    return -1;
+  }
+  fprintf(f, "# embra %s\n", embra_version_string());
+  for (int32_t i = 0; i < counts.particles; ++i)
+    fprintf(f, "v %.17g %.17g %.17g\n", xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  for (int32_t b = 0; b < counts.bodies; ++b) {
+    const embra_body_id body = {(uint32_t)b, 1};
+    int64_t n = 0;
+    if (embra_body_get_triangles(world, body, NULL, 0, &n) != EMBRA_OK || n == 0) continue;
+    int32_t* tri = malloc(sizeof(int32_t) * (size_t)n);
+    if (!tri) break;
+    if (embra_body_get_triangles(world, body, tri, n, &n) == EMBRA_OK) {
+      fprintf(f, "g body_%d\n", b);
+      for (int64_t k = 0; k < n; k += 3) fprintf(f, "f %d %d %d\n", tri[k] + 1, tri[k + 1] + 1, tri[k + 2] + 1);
+    }
+    free(tri);
+  }
+  free(xyz);
+  return fclose(f) == 0 ? 0 : -1;
+}
+
+static int cmd_validate(int argc, char** argv) {
+  if (argc != 1) return usage();
+  embra_world* world = NULL;
+  const embra_status s = embra_world_load_file(&world, argv[0]);
+  if (s != EMBRA_OK) {
+    fprintf(stderr, "embra: %s: %s\n", argv[0], embra_last_error_message());
+    return EXIT_INVALID;
+  }
+  embra_world_counts c;
+  embra_world_get_counts(world, &c);
+  printf("%s: valid (%d particles, %lld constraints, %d pins, %d colliders)\n", argv[0], c.particles,
+         (long long)c.constraints, c.pins, c.colliders);
+  embra_world_destroy(world);
+  return 0;
+}
+
+static void progress(long done, long total, double ms) {
+  const int width = 40;
+  const int filled = total > 0 ? (int)(width * done / total) : width;
+  fprintf(stderr, "\r[%.*s%*s] %ld/%ld frames  %.2f ms/frame", filled, "########################################",
+          width - filled, "", done, total, done > 0 ? ms / (double)done : 0.0);
+  fflush(stderr);
+}
+
+static int cmd_run(int argc, char** argv) {
+  if (argc < 1) return usage();
+  const char* scene = argv[0];
+  const char* out = "out";
+  long frames = -1, every = 0, threads = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (i + 1 >= argc) return usage();
+    if (strcmp(argv[i], "--frames") == 0) {
+      if (parse_int(argv[++i], 0, 100000000, &frames)) return usage();
+    } else if (strcmp(argv[i], "--every") == 0) {
+      if (parse_int(argv[++i], 1, 100000000, &every)) return usage();
+    } else if (strcmp(argv[i], "--threads") == 0) {
+      if (parse_int(argv[++i], 1, 1024, &threads)) return usage();
+    } else if (strcmp(argv[i], "--out") == 0) {
+      out = argv[++i];
+    } else {
+      return usage();
+    }
+  }
+  (void)threads; /* the solver is single-threaded for now; results never depend on this */
+  embra_world* world = NULL;
+  if (embra_world_load_file(&world, scene) != EMBRA_OK) {
+    fprintf(stderr, "embra: %s: %s\n", scene, embra_last_error_message());
+    return EXIT_INVALID;
+  }
+  if (frames < 0) {
+    int64_t f = 0;
+    embra_world_get_scene_frames(world, &f);
+    frames = (long)f;
+  }
+  if (make_dir(out) != 0) {
+    fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
+    embra_world_destroy(world);
+    return EXIT_INVALID;
+  }
+  char path[4200];
+  snprintf(path, sizeof path, "%s/metrics.jsonl", out);
+  FILE* metrics = fopen(path, "w");
+  if (!metrics) {
+    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    embra_world_destroy(world);
+    return EXIT_INVALID;
+  }
+  const int tty = isatty(2);
+  int rc = 0;
+  double total_ms = 0.0;
+  long settled_at = -1;
+  embra_step_report r;
+  memset(&r, 0, sizeof r);
+  for (long f = 1; f <= frames; ++f) {
+    const double t0 = now_ms();
+    const embra_status s = embra_world_step(world);
+    const double ms = now_ms() - t0;
+    total_ms += ms;
+    if (s != EMBRA_OK) {
+      fprintf(stderr, "%sembra: frame %ld: %s\n", tty ? "\n" : "", f, embra_last_error_message());
+      rc = s == EMBRA_ERROR_NUMERICAL ? EXIT_SIM : EXIT_INVALID;
+      break;
+    }
+    embra_world_get_report(world, &r);
+    if (r.settled && settled_at < 0) settled_at = (long)r.frame;
+    if (!r.settled) settled_at = -1;
+    fprintf(metrics,
+            "{\"frame\":%lld,\"time\":%.17g,\"ms\":%.6f,\"residual_max\":%.17g,\"residual_rms\":%.17g,"
+            "\"kinetic_energy\":%.17g,\"max_speed\":%.17g,\"contacts\":%lld,\"settled\":%s}\n",
+            (long long)r.frame, r.time, ms, r.residual_max, r.residual_rms, r.kinetic_energy, r.max_speed,
+            (long long)r.contact_count, r.settled ? "true" : "false");
+    if (every > 0 && f % every == 0) {
+      snprintf(path, sizeof path, "%s/frame_%05ld.obj", out, f);
+      if (write_world_obj(path, world) != 0) {
+        rc = EXIT_INVALID;
+        break;
+      }
+    }
+    if (tty && (f % 10 == 0 || f == frames)) progress(f, frames, total_ms);
+  }
+  if (tty) fputc('\n', stderr);
+  fclose(metrics);
+  /* The state reached so far is kept whatever happened: a failed step restored the last good one. */
+  snprintf(path, sizeof path, "%s/final.json", out);
+  if (embra_world_save_file(world, path) != EMBRA_OK) {
+    fprintf(stderr, "embra: %s\n", embra_last_error_message());
+    if (rc == 0) rc = EXIT_INVALID;
+  }
+  snprintf(path, sizeof path, "%s/final.obj", out);
+  if (write_world_obj(path, world) != 0 && rc == 0) rc = EXIT_INVALID;
+  embra_world_counts c;
+  embra_world_get_counts(world, &c);
+  printf("%-18s %s\n", "scene", scene);
+  printf("%-18s %d particles, %lld constraints, %d pins, %d colliders\n", "world", c.particles,
+         (long long)c.constraints, c.pins, c.colliders);
+  printf("%-18s %lld (%.3f s simulated)\n", "frames", (long long)r.frame, r.time);
+  printf("%-18s %.3f total, %.3f per frame\n", "ms", total_ms, r.frame > 0 ? total_ms / (double)frames : 0.0);
+  printf("%-18s %.3e max, %.3e rms\n", "residual", r.residual_max, r.residual_rms);
+  printf("%-18s %.3e J (max speed %.3e m/s)\n", "kinetic energy", r.kinetic_energy, r.max_speed);
+  if (settled_at >= 0)
+    printf("%-18s since frame %ld\n", "settled", settled_at);
+  else
+    printf("%-18s no\n", "settled");
+  printf("%-18s %s/final.json, %s/metrics.jsonl\n", "wrote", out, out);
+  embra_world_destroy(world);
+  return rc;
+}
+
 int main(int argc, char** argv) {
   if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) {
     fprintf(stderr, "embra: %s\n", embra_last_error_message());
@@ -219,6 +412,8 @@ int main(int argc, char** argv) {
     printf("embra %s (ABI %d)\n", embra_version_string(), embra_abi_version());
     return 0;
   }
+  if (strcmp(argv[1], "validate") == 0) return cmd_validate(argc - 2, argv + 2);
+  if (strcmp(argv[1], "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(argv[1], "demo") == 0 && argc >= 3 && strcmp(argv[2], "tent") == 0) return demo_tent(argc - 3, argv + 3);
   return usage();
 }

@@ -438,6 +438,42 @@ EMBRA_API embra_status embra_world_set_positions(embra_world* world, const doubl
 /* Sets `count` particles' velocities (m/s). */
 EMBRA_API embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count);
 
+/* ---------------------------------------------------------------------------------------------
+ * Geometry queries
+ * ------------------------------------------------------------------------------------------- */
+
+/* Copies a body's triangles as world particle indices (int32_t[3 * triangle count]) into out
+ * (capacity in int32 values). *out_count (required) receives the number of int32 values the
+ * triangles take; with out NULL and capacity 0 only the count is written (EMBRA_OK). */
+EMBRA_API embra_status embra_body_get_triangles(const embra_world* world, embra_body_id body, int32_t* out,
+                                                int64_t capacity, int64_t* out_count);
+
+/* ---------------------------------------------------------------------------------------------
+ * JSON scenes (schemas/scene.schema.json): the same world through a second door
+ *
+ * A scene is validated against the schema before anything is built; an invalid scene returns
+ * EMBRA_ERROR_SCHEMA with a message starting with the JSON pointer of the offending value, and
+ * creates nothing. A saved scene holds the complete world and its state: loading it gives a world
+ * that steps bit-identically to the one saved. Scene actions (rest-scale ramps, pin paths,
+ * collider paths, gravity changes) are applied by embra_world_step before each frame.
+ * ------------------------------------------------------------------------------------------- */
+
+/* Builds a world from scene JSON text of `length` bytes. `base_dir` (nullable: ".") resolves
+ * relative OBJ paths. On failure *out_world is NULL. */
+EMBRA_API embra_status embra_world_load_json(embra_world** out_world, const char* json, int64_t length,
+                                             const char* base_dir);
+/* Same, from a file (relative paths resolve against the file's folder). */
+EMBRA_API embra_status embra_world_load_file(embra_world** out_world, const char* path);
+/* Writes the world as scene JSON (UTF-8, NUL-terminated) into out. *out_length (required)
+ * receives the size in bytes including the terminating NUL; call with out NULL and capacity 0 to
+ * learn it. Too small a buffer: EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. */
+EMBRA_API embra_status embra_world_save_json(const embra_world* world, char* out, int64_t capacity,
+                                             int64_t* out_length);
+/* Writes the world as scene JSON to a file (replaced whole; no partial file on failure). */
+EMBRA_API embra_status embra_world_save_file(const embra_world* world, const char* path);
+/* The scene's own frame count ("frames"; 600 for a world not loaded from a scene). */
+EMBRA_API embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out_frames);
+
 #ifdef __cplusplus
 }
 #endif

@@ -169,6 +169,11 @@ struct BodyInfo {
   std::vector<Vec3> rest_positions;  // the vertices as given at creation (the body's rest shape)
   Id stretch_group;                  // the group holding the generated stretch constraints
   bool generated_stretch = false;    // whether stretch constraints were generated
+  // The rest of the creation description, so the body can be saved and built again exactly.
+  std::vector<double> masses;  // kg per vertex, as computed at creation
+  std::vector<double> uvs;     // 2 per vertex, empty without uvs
+  uint32_t generate = 0;       // GenerateFlags
+  Id shear_group, bend_group, volume_group;
 };
 
 /// A plain array of constraints of one kind, in one group: operands, rest and compliance (model)
@@ -183,6 +188,8 @@ struct ConstraintArray {
   std::vector<double> compliance;
   std::vector<double> rest_now;  // rest after scaling, refreshed when scales change
   std::vector<double> lambda;    // for welds: 3 per constraint
+  size_t generated = 0;          // the first `generated` entries come from bodies, in body order; added
+                                 // constraints follow in the order added (so a saved world loads the same)
   size_t size() const { return rest.size(); }
 };
 
@@ -324,6 +331,12 @@ class World {
   const std::vector<Vec3>& positions() const { return x_; }
   const std::vector<Vec3>& velocities() const { return v_; }
   const std::vector<double>& inverse_masses() const { return inv_mass_; }
+  /// Every group, pin and collider slot, live or not (check `alive`), for saving and inspection.
+  const std::vector<Group>& groups() const { return groups_; }
+  const std::vector<Pin>& pins() const { return pins_; }
+  const std::vector<Collider>& colliders() const { return colliders_; }
+  /// Sets the frame counter and simulated time (a saved scene continuing where it stopped).
+  void set_clock(int64_t frame, double time);
   void set_positions(int32_t first, std::span<const double> xyz);
   void set_velocities(int32_t first, std::span<const double> xyz);
 

@@ -1,0 +1,863 @@
+// Scene documents: parse (nlohmann-json), validate (valijson against the compiled-in schema), build
+// through embra::World, and save back.
+#include "embra/io/scene.hpp"
+
+#include "scene_schema.hpp"
+
+#include <nlohmann/json.hpp>
+#include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/schema.hpp>
+#include <valijson/schema_parser.hpp>
+#include <valijson/validator.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+namespace embra::io {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr int kMaxDepth = 64;  // scenes nest 8 deep; anything far deeper is refused before parsing
+
+[[noreturn]] void fail(const std::string& pointer, const std::string& message) {
+  throw SceneError((pointer.empty() ? std::string("/") : pointer) + ": " + message);
+}
+
+/// Parses JSON text, refusing nesting deeper than kMaxDepth while parsing (so a hostile document
+/// costs neither stack nor memory) and anything that is not JSON (including invalid UTF-8).
+json parse(std::string_view text) {
+  try {
+    return json::parse(text.begin(), text.end(), [](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxDepth)
+        throw SceneError("/: the document nests deeper than " + std::to_string(kMaxDepth) + " levels");
+      return true;
+    });
+  } catch (const json::exception& e) {
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    throw SceneError("/: not valid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)));
+  }
+}
+
+/// valijson's context ("<root>", "[bodies]", "[0]", ...) as a JSON pointer.
+std::string pointer_of(const std::vector<std::string>& context) {
+  std::string p;
+  for (const std::string& c : context) {
+    if (c == "<root>") continue;
+    std::string token = c.size() >= 2 && c.front() == '[' && c.back() == ']' ? c.substr(1, c.size() - 2) : c;
+    if (token.size() >= 2 && token.front() == '"' && token.back() == '"') token = token.substr(1, token.size() - 2);
+    p += "/" + token;
+  }
+  return p.empty() ? "/" : p;
+}
+
+/// The schema, parsed once (thread-safe static initialisation).
+const valijson::Schema& compiled_schema() {
+  static const std::unique_ptr<valijson::Schema> schema = [] {
+    auto s = std::make_unique<valijson::Schema>();
+    const json doc = json::parse(scene_schema());
+    valijson::SchemaParser parser;
+    valijson::adapters::NlohmannJsonAdapter adapter(doc);
+    parser.populateSchema(adapter, *s);
+    return s;
+  }();
+  return *schema;
+}
+
+void validate(const json& doc) {
+  valijson::Validator validator;
+  valijson::ValidationResults results;
+  valijson::adapters::NlohmannJsonAdapter adapter(doc);
+  if (validator.validate(compiled_schema(), adapter, &results)) return;
+  valijson::ValidationResults::Error first, e;
+  results.popError(first);
+  std::string message = first.description;
+  // oneOf failures report every alternative; the deepest first error is the most telling.
+  size_t depth = first.context.size();
+  while (results.popError(e))
+    if (e.context.size() > depth) {
+      depth = e.context.size();
+      first = e;
+    }
+  fail(pointer_of(first.context), "does not match the scene schema: " + first.description);
+}
+
+Vec3 vec3(const json& j) {
+  return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+}
+
+Eigen::Quaterniond quat(const json& j, const std::string& where) {
+  Eigen::Quaterniond q(j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j[3].get<double>());
+  if (std::abs(q.norm() - 1.0) > 1e-6) fail(where, "rotation must be a unit quaternion [w, x, y, z]");
+  return q;
+}
+
+template <class T>
+T value_or(const json& obj, const char* key, T fallback) {
+  const auto it = obj.find(key);
+  return it == obj.end() ? fallback : it->get<T>();
+}
+
+/// A body's vertices, elements and named vertex sets before it becomes part of the world.
+struct Mesh {
+  std::vector<double> positions, uvs, masses;
+  std::vector<int32_t> edges, triangles, tets;
+  std::map<std::string, std::vector<int32_t>> sets;
+};
+
+void place(Mesh& m, const json& spec, const std::string& where) {
+  const Vec3 origin = spec.contains("origin") ? vec3(spec["origin"]) : Vec3::Zero();
+  const Eigen::Quaterniond q =
+      spec.contains("rotation") ? quat(spec["rotation"], where + "/rotation") : Eigen::Quaterniond::Identity();
+  for (size_t i = 0; i < m.positions.size(); i += 3) {
+    const Vec3 p = origin + q * Vec3(m.positions[i], m.positions[i + 1], m.positions[i + 2]);
+    for (int k = 0; k < 3; ++k) m.positions[i + k] = p[k];
+  }
+}
+
+Mesh grid_mesh(const json& s) {
+  Mesh m;
+  const int nx = s["resolution"][0].get<int>(), ny = s["resolution"][1].get<int>();
+  const double sx = s["size"][0].get<double>(), sy = s["size"][1].get<double>();
+  if (static_cast<int64_t>(nx) * ny > 50000000) fail("/resolution", "more than 50 million vertices");
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double x = sx * (static_cast<double>(i) / (nx - 1) - 0.5),
+                   y = sy * (static_cast<double>(j) / (ny - 1) - 0.5);
+      m.positions.insert(m.positions.end(), {x, y, 0.0});
+      m.uvs.insert(m.uvs.end(), {x, y});
+    }
+  auto at = [nx](int i, int j) { return j * nx + i; };
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+      if ((i + j) % 2 == 0)
+        m.triangles.insert(m.triangles.end(), {a, b, c, a, c, d});
+      else
+        m.triangles.insert(m.triangles.end(), {a, b, d, b, c, d});
+    }
+  m.sets["corners"] = {at(0, 0), at(nx - 1, 0), at(nx - 1, ny - 1), at(0, ny - 1)};
+  for (int j = 0; j < ny; ++j) {
+    m.sets["edge_x0"].push_back(at(0, j));
+    m.sets["edge_x1"].push_back(at(nx - 1, j));
+  }
+  for (int i = 0; i < nx; ++i) {
+    m.sets["edge_y0"].push_back(at(i, 0));
+    m.sets["edge_y1"].push_back(at(i, ny - 1));
+  }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) m.sets["boundary"].push_back(at(i, j));
+  return m;
+}
+
+Mesh triangle_mesh(const json& s) {
+  Mesh m;
+  const int rows = s["rows"].get<int>();
+  const double side = s["side"].get<double>();
+  const double h = side * std::sqrt(3.0) / 2.0;
+  auto at = [rows](int r, int c) { return r * (rows + 1) - (r * (r - 1)) / 2 + c; };
+  for (int r = 0; r <= rows; ++r)
+    for (int c = 0; c <= rows - r; ++c) {
+      const double x = side * (c + 0.5 * r) / rows - side / 2, y = h * r / rows - h / 3;
+      m.positions.insert(m.positions.end(), {x, y, 0.0});
+      m.uvs.insert(m.uvs.end(), {x, y});
+      if (r == 0 || c == 0 || c == rows - r) m.sets["boundary"].push_back(at(r, c));
+    }
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < rows - r; ++c) {
+      m.triangles.insert(m.triangles.end(), {at(r, c), at(r, c + 1), at(r + 1, c)});
+      if (c + 1 < rows - r) m.triangles.insert(m.triangles.end(), {at(r, c + 1), at(r + 1, c + 1), at(r + 1, c)});
+    }
+  m.sets["corners"] = {at(0, 0), at(0, rows), at(rows, 0)};
+  return m;
+}
+
+Mesh tube_mesh(const json& s) {
+  Mesh m;
+  const int seg = s["segments"].get<int>(), rings = s["rings"].get<int>();
+  const double radius = s["radius"].get<double>(), length = s["length"].get<double>();
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < seg; ++k) {
+      const double t = 2.0 * std::numbers::pi * k / seg, z = length * (static_cast<double>(r) / (rings - 1) - 0.5);
+      m.positions.insert(m.positions.end(), {radius * std::cos(t), radius * std::sin(t), z});
+      m.uvs.insert(m.uvs.end(), {radius * t, z});
+      if (r == 0) m.sets["ring0"].push_back(r * seg + k);
+      if (r == rings - 1) m.sets["ring1"].push_back(r * seg + k);
+      if (r == 0 || r == rings - 1) m.sets["boundary"].push_back(r * seg + k);
+    }
+  for (int r = 0; r + 1 < rings; ++r)
+    for (int k = 0; k < seg; ++k) {
+      const int a = r * seg + k, b = r * seg + (k + 1) % seg, c = b + seg, d = a + seg;
+      if ((r + k) % 2 == 0)
+        m.triangles.insert(m.triangles.end(), {a, b, c, a, c, d});
+      else
+        m.triangles.insert(m.triangles.end(), {a, b, d, b, c, d});
+    }
+  // A seam-crossing uv jump would misread the edge's direction: u is periodic, so measure it
+  // the short way round by leaving uvs out of the seam's direction split.
+  return m;
+}
+
+Mesh obj_mesh(const json& s, const std::string& base_dir, const std::string& where) {
+  Mesh m;
+  const std::string rel = s["obj"].get<std::string>();
+  const std::string path = !rel.empty() && rel[0] == '/' ? rel : base_dir + "/" + rel;
+  std::ifstream in(path);
+  if (!in) fail(where + "/obj", "cannot open " + path);
+  const double scale = value_or(s, "scale", 1.0);
+  std::string line;
+  int64_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "v") {
+      double x, y, z;
+      if (!(ls >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+        fail(where + "/obj", path + ":" + std::to_string(line_no) + ": a vertex needs three finite numbers");
+      m.positions.insert(m.positions.end(), {scale * x, scale * y, scale * z});
+    } else if (tag == "f") {
+      std::vector<int32_t> face;
+      std::string token;
+      while (ls >> token) {
+        long v = 0;
+        try {
+          v = std::stol(token.substr(0, token.find('/')));
+        } catch (const std::exception&) {
+          fail(where + "/obj", path + ":" + std::to_string(line_no) + ": bad face index '" + token + "'");
+        }
+        const long n = static_cast<long>(m.positions.size() / 3);
+        if (v < 0) v = n + v + 1;  // OBJ's relative indices
+        if (v < 1 || v > n)
+          fail(where + "/obj", path + ":" + std::to_string(line_no) + ": face index " + token + " out of range");
+        face.push_back(static_cast<int32_t>(v - 1));
+      }
+      if (face.size() < 3) fail(where + "/obj", path + ":" + std::to_string(line_no) + ": a face needs 3 vertices");
+      for (size_t k = 1; k + 1 < face.size(); ++k)
+        m.triangles.insert(m.triangles.end(), {face[0], face[k], face[k + 1]});
+    }
+  }
+  if (m.positions.empty()) fail(where + "/obj", path + " has no vertices");
+  return m;
+}
+
+Mesh inline_mesh(const json& s) {
+  Mesh m;
+  for (const json& v : s["vertices"])
+    for (int k = 0; k < 3; ++k) m.positions.push_back(v[k].get<double>());
+  auto ints = [&](const char* key, std::vector<int32_t>& out) {
+    if (!s.contains(key)) return;
+    for (const json& e : s[key])
+      for (const json& i : e) {
+        if (i.get<int64_t>() > INT32_MAX) fail(std::string("/") + key, "index too large");
+        out.push_back(i.get<int32_t>());
+      }
+  };
+  ints("edges", m.edges);
+  ints("triangles", m.triangles);
+  ints("tets", m.tets);
+  if (s.contains("uvs"))
+    for (const json& uv : s["uvs"]) m.uvs.insert(m.uvs.end(), {uv[0].get<double>(), uv[1].get<double>()});
+  if (s.contains("masses"))
+    for (const json& w : s["masses"]) m.masses.push_back(w.get<double>());
+  return m;
+}
+
+Material material(const json& j) {
+  Material m;
+  if (j.is_null()) return m;
+  m.mass = value_or(j, "mass", m.mass);
+  m.density = value_or(j, "density", m.density);
+  m.stretch_compliance = value_or(j, "stretch_compliance", m.stretch_compliance);
+  m.shear_compliance = value_or(j, "shear_compliance", m.shear_compliance);
+  m.bend_compliance = value_or(j, "bend_compliance", m.bend_compliance);
+  m.volume_compliance = value_or(j, "volume_compliance", m.volume_compliance);
+  m.damping = value_or(j, "damping", m.damping);
+  m.thickness = value_or(j, "thickness", m.thickness);
+  m.friction_static = value_or(j, "friction_static", m.friction_static);
+  m.friction_dynamic = value_or(j, "friction_dynamic", m.friction_dynamic);
+  return m;
+}
+
+json material_json(const Material& m) {
+  return json{{"mass", m.mass},
+              {"density", m.density},
+              {"stretch_compliance", m.stretch_compliance},
+              {"shear_compliance", m.shear_compliance},
+              {"bend_compliance", m.bend_compliance},
+              {"volume_compliance", m.volume_compliance},
+              {"damping", m.damping},
+              {"thickness", m.thickness},
+              {"friction_static", m.friction_static},
+              {"friction_dynamic", m.friction_dynamic}};
+}
+
+const char* const kGenerateNames[] = {"stretch", "shear", "bend", "volume"};
+const char* const kKindNames[] = {"distance", "edge_angle", "dihedral", "tet_volume", "weld", "tether"};
+
+/// Builds the world from a validated document, section by section; every error names its place.
+class Builder {
+ public:
+  Builder(const json& doc, const std::string& base_dir, SceneMeta& meta)
+      : doc_(doc), base_dir_(base_dir), meta_(meta) {}
+
+  std::unique_ptr<World> build() {
+    Settings s;
+    if (doc_.contains("solver")) {
+      const json& j = doc_["solver"];
+      s.dt = value_or(j, "dt", s.dt);
+      s.substeps = value_or(j, "substeps", s.substeps);
+      s.iterations = value_or(j, "iterations", s.iterations);
+      if (j.contains("gravity")) s.gravity = vec3(j["gravity"]);
+      s.damping = value_or(j, "damping", s.damping);
+      s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
+    }
+    auto world = std::make_unique<World>(guard("/solver", [&] { return s; }));
+    World& w = *world;
+    meta_.name = value_or(doc_, "name", std::string());
+    meta_.description = value_or(doc_, "description", std::string());
+    meta_.frames = value_or(doc_, "frames", int64_t{600});
+    groups_["default"] = w.default_group();
+    groups_["contacts"] = w.contact_group();
+    meta_.group_names[w.default_group().index] = "default";
+    meta_.group_names[w.contact_group().index] = "contacts";
+    section("groups", [&](const json& g, const std::string& at) {
+      const std::string name = g["name"].get<std::string>();
+      GroupDesc d;
+      d.order = value_or(g, "order", 0);
+      d.weight = value_or(g, "weight", 1);
+      d.name = name;
+      const auto it = groups_.find(name);
+      if (it != groups_.end()) {
+        if (!seen_groups_.insert(name).second) fail(at + "/name", "group '" + name + "' is listed twice");
+        guard(at, [&] {
+          w.set_group_order(it->second, d.order);
+          w.set_group_weight(it->second, d.weight);
+          return 0;
+        });
+        return;
+      }
+      seen_groups_.insert(name);
+      const Id id = guard(at, [&] { return w.create_group(d); });
+      groups_[name] = id;
+      meta_.group_names[id.index] = name;
+    });
+    section("bodies", [&](const json& b, const std::string& at) { body(w, b, at); });
+    section("constraints", [&](const json& c, const std::string& at) { constraints(w, c, at); });
+    if (doc_.contains("state")) state(w, doc_["state"]);
+    section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
+    section("colliders", [&](const json& c, const std::string& at) {
+      ColliderDesc d;
+      d.shape = c["shape"] == "plane" ? ColliderShape::plane : ColliderShape::sphere;
+      if (c.contains("position")) d.position = vec3(c["position"]);
+      if (c.contains("rotation")) d.rotation = quat(c["rotation"], at + "/rotation");
+      d.radius = value_or(c, "radius", d.radius);
+      d.thickness = value_or(c, "thickness", d.thickness);
+      d.friction_static = value_or(c, "friction_static", d.friction_static);
+      d.friction_dynamic = value_or(c, "friction_dynamic", d.friction_dynamic);
+      const Id id = guard(at, [&] { return w.create_collider(d); });
+      if (c.contains("name")) name_once(colliders_, meta_.collider_names, c["name"], id, at, "collider");
+    });
+    section("actions", [&](const json& a, const std::string& at) { action(a, at); });
+    if (doc_.contains("tolerances")) meta_.tolerances = doc_["tolerances"].dump();
+    return world;
+  }
+
+ private:
+  template <class F>
+  auto guard(const std::string& at, F&& f) -> decltype(f()) {
+    try {
+      return f();
+    } catch (const Error& e) {
+      fail(at, e.what());
+    }
+  }
+
+  template <class F>
+  void section(const char* key, F&& per_item) {
+    if (!doc_.contains(key)) return;
+    const json& list = doc_[key];
+    for (size_t i = 0; i < list.size(); ++i) per_item(list[i], std::string("/") + key + "/" + std::to_string(i));
+  }
+
+  static void name_once(std::map<std::string, Id>& names, std::map<uint32_t, std::string>& by_slot, const json& name,
+                        Id id, const std::string& at, const char* what) {
+    const std::string n = name.get<std::string>();
+    if (!names.emplace(n, id).second) fail(at + "/name", std::string(what) + " name '" + n + "' is used twice");
+    by_slot[id.index] = n;
+  }
+
+  Id group(const json& obj, const char* key, const std::string& at) {
+    if (!obj.contains(key)) return Id{};
+    const std::string n = obj[key].get<std::string>();
+    const auto it = groups_.find(n);
+    if (it == groups_.end()) fail(at + "/" + key, "no group named '" + n + "'");
+    return it->second;
+  }
+
+  Id named(const std::map<std::string, Id>& names, const json& obj, const char* key, const std::string& at) {
+    if (!obj.contains(key)) fail(at, std::string("needs \"") + key + "\"");
+    const std::string n = obj[key].get<std::string>();
+    const auto it = names.find(n);
+    if (it == names.end()) fail(at + "/" + key, std::string("no ") + key + " named '" + n + "'");
+    return it->second;
+  }
+
+  void body(World& w, const json& b, const std::string& at) {
+    const json& spec = b["mesh"];
+    Mesh m;
+    if (spec.contains("vertices"))
+      m = inline_mesh(spec);
+    else if (spec.contains("obj"))
+      m = obj_mesh(spec, base_dir_, at + "/mesh");
+    else if (spec["generator"] == "grid")
+      m = grid_mesh(spec);
+    else if (spec["generator"] == "triangle")
+      m = triangle_mesh(spec);
+    else
+      m = tube_mesh(spec);
+    if (!spec.contains("vertices")) place(m, spec, at + "/mesh");
+    const int64_t nv = static_cast<int64_t>(m.positions.size() / 3);
+    if (!m.uvs.empty() && static_cast<int64_t>(m.uvs.size()) != 2 * nv)
+      fail(at + "/mesh/uvs", "needs one [u, v] per vertex");
+    if (!m.masses.empty() && static_cast<int64_t>(m.masses.size()) != nv)
+      fail(at + "/mesh/masses", "needs one mass per vertex");
+    if (b.contains("vertex_sets"))
+      for (const auto& [name, list] : b["vertex_sets"].items()) {
+        std::vector<int32_t> set;
+        for (const json& v : list) {
+          if (v.get<int64_t>() >= nv)
+            fail(at + "/vertex_sets/" + name,
+                 "vertex " + v.dump() + " is outside the body's " + std::to_string(nv) + " vertices");
+          set.push_back(v.get<int32_t>());
+        }
+        m.sets[name] = set;
+      }
+    BodyDesc d;
+    d.positions = m.positions;
+    d.masses = m.masses;
+    d.uvs = m.uvs;
+    d.edges = m.edges;
+    d.triangles = m.triangles;
+    d.tets = m.tets;
+    d.material = material(b.contains("material") ? b["material"] : json());
+    if (b.contains("generate")) {
+      d.generate = 0;
+      for (const json& g : b["generate"])
+        for (uint32_t k = 0; k < 4; ++k)
+          if (g == kGenerateNames[k]) d.generate |= 1u << k;
+    }
+    d.stretch_group = group(b, "stretch_group", at);
+    d.shear_group = group(b, "shear_group", at);
+    d.bend_group = group(b, "bend_group", at);
+    d.volume_group = group(b, "volume_group", at);
+    const Id id = guard(at + "/mesh", [&] { return w.create_body(d); });
+    name_once(bodies_, meta_.body_names, b["name"], id, at, "body");
+    sets_[id.index] = std::move(m.sets);
+    if (b.contains("rest_scale")) {
+      const json& s = b["rest_scale"];
+      guard(at + "/rest_scale", [&] {
+        w.set_rest_scale(id, s[0].get<double>(), s[1].get<double>(), s[2].get<double>());
+        return 0;
+      });
+    }
+  }
+
+  int32_t particle(const World& w, const json& ref, const std::string& at) {
+    if (ref.is_number_integer()) {
+      const int64_t i = ref.get<int64_t>();
+      if (i >= w.particle_count())
+        fail(at, "particle " + std::to_string(i) + " is outside the world's " + std::to_string(w.particle_count()) +
+                     " particles");
+      return static_cast<int32_t>(i);
+    }
+    const Id body = named(bodies_, ref, "body", at);
+    const BodyInfo& info = w.body(body);
+    const int64_t v = ref["vertex"].get<int64_t>();
+    if (v >= info.particle_count)
+      fail(at + "/vertex", "vertex " + std::to_string(v) + " is outside body '" + ref["body"].get<std::string>() +
+                               "' (" + std::to_string(info.particle_count) + " vertices)");
+    return info.first_particle + static_cast<int32_t>(v);
+  }
+
+  void constraints(World& w, const json& c, const std::string& at) {
+    const std::string kind = c["kind"].get<std::string>();
+    int k = 0;
+    while (kind != kKindNames[k]) ++k;
+    const int n = arity(static_cast<Kind>(k));
+    std::vector<int32_t> ids;
+    const json& list = c["particles"];
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string where = at + "/particles/" + std::to_string(i);
+      if (static_cast<int>(list[i].size()) != n)
+        fail(where, "a " + kind + " constraint takes " + std::to_string(n) + " particles, not " +
+                        std::to_string(list[i].size()));
+      for (size_t a = 0; a < list[i].size(); ++a)
+        ids.push_back(particle(w, list[i][a], where + "/" + std::to_string(a)));
+    }
+    std::vector<double> rest, compliance;
+    if (c.contains("rest") && c["rest"].is_array()) {
+      for (const json& r : c["rest"]) rest.push_back(r.get<double>());
+      if (rest.size() != list.size())
+        fail(at + "/rest",
+             "has " + std::to_string(rest.size()) + " values for " + std::to_string(list.size()) + " constraints");
+    }
+    ConstraintDesc d;
+    d.kind = static_cast<Kind>(k);
+    d.group = group(c, "group", at);
+    d.particles = ids;
+    d.rest = rest;
+    if (c.contains("compliance") && c["compliance"].is_array()) {
+      for (const json& v : c["compliance"]) compliance.push_back(v.get<double>());
+      if (compliance.size() != list.size())
+        fail(at + "/compliance", "has " + std::to_string(compliance.size()) + " values for " +
+                                     std::to_string(list.size()) + " constraints");
+      d.compliance = compliance;
+    } else {
+      d.uniform_compliance = value_or(c, "compliance", 0.0);
+    }
+    guard(at, [&] { return w.add_constraints(d); });
+  }
+
+  void state(World& w, const json& s) {
+    const json& x = s["positions"];
+    const json& v = s["velocities"];
+    if (static_cast<int64_t>(x.size()) != w.particle_count())
+      fail("/state/positions",
+           "has " + std::to_string(x.size()) + " positions for " + std::to_string(w.particle_count()) + " particles");
+    if (static_cast<int64_t>(v.size()) != w.particle_count())
+      fail("/state/velocities",
+           "has " + std::to_string(v.size()) + " velocities for " + std::to_string(w.particle_count()) + " particles");
+    std::vector<double> xs, vs;
+    for (const json& p : x)
+      for (int k = 0; k < 3; ++k) xs.push_back(p[k].get<double>());
+    for (const json& p : v)
+      for (int k = 0; k < 3; ++k) vs.push_back(p[k].get<double>());
+    guard("/state", [&] {
+      w.set_positions(0, xs);
+      w.set_velocities(0, vs);
+      w.set_clock(s["frame"].get<int64_t>(), value_or(s, "time", 0.0));
+      return 0;
+    });
+  }
+
+  void pins(World& w, const json& p, const std::string& at) {
+    std::vector<int32_t> particles;
+    if (p.contains("particle")) {
+      if (p.contains("body") || p.contains("set")) fail(at, "give either \"particle\" or \"body\" and \"set\"");
+      particles.push_back(particle(w, p["particle"], at + "/particle"));
+    } else {
+      const Id body = named(bodies_, p, "body", at);
+      const auto& sets = sets_[body.index];
+      const std::string set = p["set"].get<std::string>();
+      const auto it = sets.find(set);
+      if (it == sets.end())
+        fail(at + "/set", "body '" + p["body"].get<std::string>() + "' has no vertex set '" + set + "'");
+      for (int32_t v : it->second) particles.push_back(w.body(body).first_particle + v);
+    }
+    for (size_t i = 0; i < particles.size(); ++i) {
+      PinDesc d;
+      d.particle = particles[i];
+      d.target = p.contains("target") ? vec3(p["target"]) : w.positions()[particles[i]];
+      d.compliance = value_or(p, "compliance", 0.0);
+      d.group = group(p, "group", at);
+      const Id id = guard(at, [&] { return w.create_pin(d); });
+      if (p.contains("name")) {
+        const std::string base = p["name"].get<std::string>();
+        name_once(pins_, meta_.pin_names, particles.size() == 1 ? json(base) : json(base + "." + std::to_string(i)), id,
+                  at, "pin");
+      }
+    }
+  }
+
+  void action(const json& a, const std::string& at) {
+    Action act;
+    const std::string type = a["type"].get<std::string>();
+    size_t width = 3;
+    if (type == "rest_scale") {
+      act.type = Action::Type::rest_scale;
+      act.target = named(bodies_, a, "body", at);
+    } else if (type == "pin_target") {
+      act.type = Action::Type::pin_target;
+      act.target = named(pins_, a, "pin", at);
+    } else if (type == "collider_pose") {
+      act.type = Action::Type::collider_pose;
+      act.target = named(colliders_, a, "collider", at);
+    } else {
+      act.type = Action::Type::gravity;
+    }
+    int64_t last = -1;
+    for (size_t i = 0; i < a["keys"].size(); ++i) {
+      const json& key = a["keys"][i];
+      const std::string where = at + "/keys/" + std::to_string(i);
+      const int64_t frame = key["frame"].get<int64_t>();
+      if (frame <= last) fail(where + "/frame", "key frames must increase");
+      last = frame;
+      if (!key.contains("value")) fail(where, "needs a \"value\"");
+      std::vector<double> value = key["value"].get<std::vector<double>>();
+      const bool pose = act.type == Action::Type::collider_pose && value.size() == 7;
+      if (value.size() != width && !pose)
+        fail(where + "/value", "needs " + std::to_string(width) + " numbers" +
+                                   (act.type == Action::Type::collider_pose ? " (or 7: position and rotation)" : ""));
+      if (pose) quat(json(std::vector<double>(value.begin() + 3, value.end())), where + "/value");
+      if (act.type == Action::Type::rest_scale)
+        for (double s : value)
+          if (s < 0.0) fail(where + "/value", "rest scales must be >= 0");
+      act.frames.push_back(frame);
+      act.values.push_back(std::move(value));
+    }
+    meta_.actions.push_back(std::move(act));
+  }
+
+  const json& doc_;
+  std::string base_dir_;
+  SceneMeta& meta_;
+  std::map<std::string, Id> groups_, bodies_, pins_, colliders_;
+  std::set<std::string> seen_groups_;
+  std::map<uint32_t, std::map<std::string, std::vector<int32_t>>> sets_;
+};
+
+json vec_json(const Vec3& v) {
+  return json::array({v[0], v[1], v[2]});
+}
+
+/// A name for every live object: its own, or "<what>_<slot>" made unique.
+std::string name_for(const std::map<uint32_t, std::string>& names, uint32_t slot, const char* what,
+                     std::set<std::string>& used) {
+  const auto it = names.find(slot);
+  std::string n = it != names.end() ? it->second : std::string(what) + "_" + std::to_string(slot);
+  while (!used.insert(n).second) n += "_";
+  return n;
+}
+
+}  // namespace
+
+std::string_view scene_schema() {
+  return kSceneSchema;
+}
+
+std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta) {
+  const json doc = parse(text);
+  validate(doc);
+  SceneMeta meta;
+  auto world = Builder(doc, base_dir, meta).build();
+  out_meta = std::move(meta);
+  return world;
+}
+
+std::string save_scene(const World& w, const SceneMeta& meta) {
+  json doc = json::object();
+  doc["format"] = "embra-scene";
+  doc["version"] = 1;
+  if (!meta.name.empty()) doc["name"] = meta.name;
+  if (!meta.description.empty()) doc["description"] = meta.description;
+  doc["frames"] = meta.frames;
+  const Settings& s = w.settings();
+  doc["solver"] = {{"dt", s.dt},
+                   {"substeps", s.substeps},
+                   {"iterations", s.iterations},
+                   {"gravity", vec_json(s.gravity)},
+                   {"damping", s.damping},
+                   {"settle_speed", s.settle_speed}};
+
+  // Groups in creation order, so that equal orders resolve the same way when loaded.
+  std::vector<uint32_t> slots;
+  for (uint32_t i = 0; i < w.groups().size(); ++i)
+    if (w.groups()[i].alive) slots.push_back(i);
+  std::sort(slots.begin(), slots.end(),
+            [&](uint32_t a, uint32_t b) { return w.groups()[a].serial < w.groups()[b].serial; });
+  std::map<uint32_t, std::string> gname;
+  std::set<std::string> used{"default", "contacts"};
+  gname[w.default_group().index] = "default";
+  gname[w.contact_group().index] = "contacts";
+  json groups = json::array();
+  for (uint32_t slot : slots) {
+    if (!gname.count(slot)) gname[slot] = name_for(meta.group_names, slot, "group", used);
+    groups.push_back(
+        {{"name", gname[slot]}, {"order", w.groups()[slot].desc.order}, {"weight", w.groups()[slot].desc.weight}});
+  }
+  doc["groups"] = groups;
+  auto group_name = [&](Id id) { return gname.at(id.is_null() ? w.default_group().index : id.index); };
+
+  json bodies = json::array();
+  std::set<std::string> used_bodies;
+  for (uint32_t i = 0; i < w.body_count(); ++i) {
+    const BodyInfo& b = w.body(Id{i, 1});
+    const int32_t f = b.first_particle;
+    json mesh;
+    json vertices = json::array();
+    for (const Vec3& p : b.rest_positions) vertices.push_back(vec_json(p));
+    mesh["vertices"] = vertices;
+    auto local = [&](const std::vector<int32_t>& ids, int n) {
+      json out = json::array();
+      for (size_t e = 0; e < ids.size(); e += n) {
+        json el = json::array();
+        for (int k = 0; k < n; ++k) el.push_back(ids[e + k] - f);
+        out.push_back(el);
+      }
+      return out;
+    };
+    if (!b.edges.empty()) mesh["edges"] = local(b.edges, 2);
+    if (!b.triangles.empty()) mesh["triangles"] = local(b.triangles, 3);
+    if (!b.tets.empty()) mesh["tets"] = local(b.tets, 4);
+    if (!b.uvs.empty()) {
+      json uvs = json::array();
+      for (size_t k = 0; k < b.uvs.size(); k += 2) uvs.push_back({b.uvs[k], b.uvs[k + 1]});
+      mesh["uvs"] = uvs;
+    }
+    mesh["masses"] = b.masses;
+    json generate = json::array();
+    for (uint32_t k = 0; k < 4; ++k)
+      if (b.generate & (1u << k)) generate.push_back(kGenerateNames[k]);
+    bodies.push_back({{"name", name_for(meta.body_names, i, "body", used_bodies)},
+                      {"mesh", mesh},
+                      {"material", material_json(b.material)},
+                      {"generate", generate},
+                      {"stretch_group", group_name(b.stretch_group)},
+                      {"shear_group", group_name(b.shear_group)},
+                      {"bend_group", group_name(b.bend_group)},
+                      {"volume_group", group_name(b.volume_group)},
+                      {"rest_scale", {b.rest_scale, b.rest_scale_u, b.rest_scale_v}}});
+  }
+  doc["bodies"] = bodies;
+
+  // Added constraints, per group and kind, in projection order; generated ones come from bodies.
+  json constraints = json::array();
+  for (uint32_t slot : slots) {
+    const Group& g = w.groups()[slot];
+    for (int k = 0; k < kKindCount; ++k) {
+      const ConstraintArray& a = g.arrays[k];
+      if (a.size() == a.generated) continue;
+      const int n = arity(static_cast<Kind>(k));
+      json particles = json::array(), rest = json::array(), compliance = json::array();
+      for (size_t i = a.generated; i < a.size(); ++i) {
+        json ops = json::array();
+        for (int c = 0; c < n; ++c) ops.push_back(a.ids[i * n + c]);
+        particles.push_back(ops);
+        rest.push_back(a.rest[i]);
+        compliance.push_back(a.compliance[i]);
+      }
+      constraints.push_back({{"kind", kKindNames[k]},
+                             {"group", gname[slot]},
+                             {"particles", particles},
+                             {"rest", rest},
+                             {"compliance", compliance}});
+    }
+  }
+  doc["constraints"] = constraints;
+
+  json pins = json::array();
+  std::set<std::string> used_pins;
+  for (uint32_t i = 0; i < w.pins().size(); ++i) {
+    const Pin& p = w.pins()[i];
+    if (!p.alive) continue;
+    json j = {{"name", name_for(meta.pin_names, i, "pin", used_pins)},
+              {"particle", p.particle},
+              {"target", vec_json(p.target)},
+              {"compliance", p.compliance}};
+    if (p.compliance > 0.0) j["group"] = group_name(p.group);
+    pins.push_back(j);
+  }
+  doc["pins"] = pins;
+
+  json colliders = json::array();
+  std::set<std::string> used_colliders;
+  for (uint32_t i = 0; i < w.colliders().size(); ++i) {
+    const Collider& c = w.colliders()[i];
+    if (!c.alive) continue;
+    const Eigen::Quaterniond& q = c.desc.rotation;
+    colliders.push_back({{"name", name_for(meta.collider_names, i, "collider", used_colliders)},
+                         {"shape", c.desc.shape == ColliderShape::plane ? "plane" : "sphere"},
+                         {"position", vec_json(c.desc.position)},
+                         {"rotation", {q.w(), q.x(), q.y(), q.z()}},
+                         {"radius", c.desc.radius},
+                         {"thickness", c.desc.thickness},
+                         {"friction_static", c.desc.friction_static},
+                         {"friction_dynamic", c.desc.friction_dynamic}});
+  }
+  doc["colliders"] = colliders;
+
+  json actions = json::array();
+  for (const Action& a : meta.actions) {
+    json j;
+    json keys = json::array();
+    for (size_t k = 0; k < a.frames.size(); ++k) keys.push_back({{"frame", a.frames[k]}, {"value", a.values[k]}});
+    switch (a.type) {
+      case Action::Type::rest_scale:
+        j = {{"type", "rest_scale"}, {"body", bodies[a.target.index]["name"]}};
+        break;
+      case Action::Type::pin_target: {
+        std::set<std::string> dummy;
+        j = {{"type", "pin_target"}, {"pin", name_for(meta.pin_names, a.target.index, "pin", dummy)}};
+        break;
+      }
+      case Action::Type::collider_pose: {
+        std::set<std::string> dummy;
+        j = {{"type", "collider_pose"}, {"collider", name_for(meta.collider_names, a.target.index, "collider", dummy)}};
+        break;
+      }
+      case Action::Type::gravity:
+        j = {{"type", "gravity"}};
+        break;
+    }
+    j["keys"] = keys;
+    actions.push_back(j);
+  }
+  doc["actions"] = actions;
+  if (!meta.tolerances.empty()) doc["tolerances"] = json::parse(meta.tolerances);
+
+  json positions = json::array(), velocities = json::array();
+  for (const Vec3& p : w.positions()) positions.push_back(vec_json(p));
+  for (const Vec3& v : w.velocities()) velocities.push_back(vec_json(v));
+  doc["state"] = {
+      {"frame", w.report().frame}, {"time", w.report().time}, {"positions", positions}, {"velocities", velocities}};
+  return doc.dump(1) + "\n";
+}
+
+void apply_actions(World& w, const SceneMeta& meta, int64_t frame) {
+  for (const Action& a : meta.actions) {
+    // Linear between the keys around `frame`, held outside them.
+    size_t hi = 0;
+    while (hi < a.frames.size() && a.frames[hi] < frame) ++hi;
+    std::vector<double> v;
+    if (hi == 0)
+      v = a.values.front();
+    else if (hi == a.frames.size())
+      v = a.values.back();
+    else {
+      const double t =
+          static_cast<double>(frame - a.frames[hi - 1]) / static_cast<double>(a.frames[hi] - a.frames[hi - 1]);
+      v.resize(a.values[hi].size());
+      for (size_t k = 0; k < v.size(); ++k) v[k] = (1.0 - t) * a.values[hi - 1][k] + t * a.values[hi][k];
+    }
+    switch (a.type) {
+      case Action::Type::rest_scale:
+        w.set_rest_scale(a.target, v[0], v[1], v[2]);
+        break;
+      case Action::Type::pin_target:
+        w.set_pin_target(a.target, Vec3(v[0], v[1], v[2]));
+        break;
+      case Action::Type::collider_pose: {
+        const Collider& c = w.collider(a.target);
+        const Eigen::Quaterniond q =
+            v.size() == 7 ? Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized() : c.desc.rotation;
+        w.set_collider_transform(a.target, Vec3(v[0], v[1], v[2]), q);
+        break;
+      }
+      case Action::Type::gravity:
+        w.set_gravity(Vec3(v[0], v[1], v[2]));
+        break;
+    }
+  }
+}
+
+}  // namespace embra::io
