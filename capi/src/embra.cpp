@@ -126,6 +126,7 @@ embra::Settings to_settings(const embra_solver_def& d) {
   s.gravity = vec(d.gravity);
   s.damping = d.damping;
   s.settle_speed = d.settle_speed;
+  s.tethers = d.tethers;
   return s;
 }
 
@@ -218,6 +219,7 @@ embra_solver_def embra_default_solver_def(void) {
   for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
   d.damping = s.damping;
   d.settle_speed = s.settle_speed;
+  d.tethers = s.tethers;
   return d;
 }
 
@@ -247,6 +249,7 @@ embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* 
     for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
     d.damping = s.damping;
     d.settle_speed = s.settle_speed;
+    d.tethers = s.tethers;
     *out_def = d;
   });
 }

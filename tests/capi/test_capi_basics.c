@@ -85,13 +85,14 @@ static void test_struct_layout(void) {
   CHECK_INT(sizeof(embra_collider_id), 8);
   CHECK_INT(offsetof(embra_group_id, generation), 4);
 
-  CHECK_INT(sizeof(embra_solver_def), 4 * 4 + 6 * 8);
+  CHECK_INT(sizeof(embra_solver_def), 6 * 4 + 6 * 8);
   CHECK_INT(offsetof(embra_solver_def, substeps), 4);
   CHECK_INT(offsetof(embra_solver_def, dt), 8);
   CHECK_INT(offsetof(embra_solver_def, iterations), 16);
   CHECK_INT(offsetof(embra_solver_def, gravity), 24);
   CHECK_INT(offsetof(embra_solver_def, damping), 48);
   CHECK_INT(offsetof(embra_solver_def, settle_speed), 56);
+  CHECK_INT(offsetof(embra_solver_def, tethers), 64);
 
   CHECK_INT(sizeof(embra_world_counts), 6 * 4 + 8);
   CHECK_INT(offsetof(embra_world_counts, constraints), 24);
@@ -149,6 +150,7 @@ static void test_defaults(void) {
   CHECK_NEAR(s.gravity[2], -9.81, 0.0);
   CHECK_NEAR(s.damping, 0.0, 0.0);
   CHECK_NEAR(s.settle_speed, 1e-3, 0.0);
+  CHECK_INT(s.tethers, 2);
 
   CHECK_INT(g.version, EMBRA_GROUP_DEF_VERSION);
   CHECK_INT(g.order, 0);

@@ -152,6 +152,13 @@ typedef struct embra_solver_def {
   double gravity[3];   /* m/s^2; default {0, 0, -9.81} (z up). Any direction: negate to hang */
   double damping;      /* 1/s, velocity decay rate applied to every particle; >= 0; default 0 */
   double settle_speed; /* m/s: a frame is "settled" when no particle moves faster; default 1e-3 */
+  int32_t tethers;     /* automatic long-range attachments, [0, 64]; default 2. Each movable
+                          particle of a body with hard-pinned particles is tied to its `tethers`
+                          nearest pinned ones by a one-sided tether whose rest is the length of a
+                          path over the body's rest surface (never shorter than the geodesic, so it
+                          never holds back a shape the cloth can take): a hanging cloth cannot
+                          stretch far from its pins whatever the iteration count. 0 = none */
+  int32_t reserved1;   /* 0 */
 } embra_solver_def;
 
 EMBRA_API embra_solver_def embra_default_solver_def(void);

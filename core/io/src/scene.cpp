@@ -320,8 +320,9 @@ class Builder {
       if (j.contains("gravity")) s.gravity = vec3(j["gravity"]);
       s.damping = value_or(j, "damping", s.damping);
       s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
+      s.tethers = value_or(j, "tethers", s.tethers);
     }
-    auto world = std::make_unique<World>(guard("/solver", [&] { return s; }));
+    auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
     World& w = *world;
     meta_.name = value_or(doc_, "name", std::string());
     meta_.description = value_or(doc_, "description", std::string());
@@ -667,7 +668,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                    {"iterations", s.iterations},
                    {"gravity", vec_json(s.gravity)},
                    {"damping", s.damping},
-                   {"settle_speed", s.settle_speed}};
+                   {"settle_speed", s.settle_speed},
+                   {"tethers", s.tethers}};
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.
   std::vector<uint32_t> slots;
