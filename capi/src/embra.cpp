@@ -127,6 +127,7 @@ embra::Settings to_settings(const embra_solver_def& d) {
   s.damping = d.damping;
   s.settle_speed = d.settle_speed;
   s.tethers = d.tethers;
+  s.realign_passes = d.realign_passes;
   return s;
 }
 
@@ -220,6 +221,7 @@ embra_solver_def embra_default_solver_def(void) {
   d.damping = s.damping;
   d.settle_speed = s.settle_speed;
   d.tethers = s.tethers;
+  d.realign_passes = s.realign_passes;
   return d;
 }
 
@@ -250,6 +252,7 @@ embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* 
     d.damping = s.damping;
     d.settle_speed = s.settle_speed;
     d.tethers = s.tethers;
+    d.realign_passes = s.realign_passes;
     *out_def = d;
   });
 }

@@ -385,6 +385,53 @@ void World::reset_multipliers() {
   }
 }
 
+namespace {
+double collider_gap(const Collider& c, const Vec3& x, const Vec3& from, Vec3& normal);
+
+/// Adds w_k lambda grad_k C(x) of every constraint of a solver array to `out`.
+template <Kind K>
+void add_corrections(const SolverArray& a, const std::vector<Vec3>& x, const std::vector<double>& w,
+                     std::vector<Vec3>& out) {
+  constexpr int N = arity_of<K>();
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a.lambda[i] == 0.0) continue;
+    const int32_t* p = &a.ids[i * N];
+    const auto e = evaluate<K>(p, x);
+    if (!e.valid) continue;
+    for (int k = 0; k < N; ++k) out[p[k]] += (w[p[k]] * a.lambda[i]) * e.grad[k];
+  }
+}
+}  // namespace
+
+void World::realign(const std::vector<Vec3>& predicted) {
+  std::vector<Vec3>& corr = realign_;
+  corr.assign(x_.size(), Vec3::Zero());
+  for (int32_t slot : order_) {
+    const Group& g = groups_[slot];
+    add_corrections<Kind::distance>(g.solve[static_cast<int>(Kind::distance)], x_, w_, corr);
+    add_corrections<Kind::tether>(g.solve[static_cast<int>(Kind::tether)], x_, w_, corr);
+    add_corrections<Kind::tether>(g.tethers, x_, w_, corr);
+    add_corrections<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], x_, w_, corr);
+    add_corrections<Kind::dihedral>(g.solve[static_cast<int>(Kind::dihedral)], x_, w_, corr);
+    add_corrections<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], x_, w_, corr);
+    const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
+    for (size_t i = 0; i < weld.size(); ++i) {
+      const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
+      corr[weld.ids[2 * i]] += w_[weld.ids[2 * i]] * l;
+      corr[weld.ids[2 * i + 1]] -= w_[weld.ids[2 * i + 1]] * l;
+    }
+    for (int32_t pi : g.soft_pins) corr[pins_[pi].particle] += w_[pins_[pi].particle] * pins_[pi].lambda;
+    for (const Contact& ct : g.contacts) {
+      if (ct.lambda == 0.0) continue;
+      Vec3 n;
+      collider_gap(colliders_[ct.collider], x_[ct.particle], x_prev_[ct.particle], n);
+      corr[ct.particle] += ct.lambda * n;
+    }
+  }
+  for (size_t i = 0; i < x_.size(); ++i)
+    if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
+}
+
 void World::project_group(Group& g, double h) {
   const double inv_h2 = 1.0 / (h * h);
   for (int32_t pi : g.soft_pins) {
@@ -560,11 +607,15 @@ void World::step() {
     predict(h, alpha);
     find_contacts();
     reset_multipliers();
-    for (int it = 0; it < settings_.iterations; ++it)
-      for (int32_t slot : order_) {
-        Group& g = groups_[slot];
-        for (int k = 0; k < g.desc.weight; ++k) project_group(g, h);
-      }
+    if (settings_.realign_passes > 0) predicted_ = x_;
+    for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
+      if (pass > 0) realign(predicted_);
+      for (int it = 0; it < settings_.iterations; ++it)
+        for (int32_t slot : order_) {
+          Group& g = groups_[slot];
+          for (int k = 0; k < g.desc.weight; ++k) project_group(g, h);
+        }
+    }
     update_velocities(h);
     const int32_t bad = first_non_finite();
     if (bad >= 0) {

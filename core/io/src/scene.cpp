@@ -321,6 +321,7 @@ class Builder {
       s.damping = value_or(j, "damping", s.damping);
       s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
       s.tethers = value_or(j, "tethers", s.tethers);
+      s.realign_passes = value_or(j, "realign_passes", s.realign_passes);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
     World& w = *world;
@@ -669,7 +670,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                    {"gravity", vec_json(s.gravity)},
                    {"damping", s.damping},
                    {"settle_speed", s.settle_speed},
-                   {"tethers", s.tethers}};
+                   {"tethers", s.tethers},
+                   {"realign_passes", s.realign_passes}};
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.
   std::vector<uint32_t> slots;

@@ -129,8 +129,16 @@ struct Settings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2
   double damping = 0.0;                  // 1/s, applied to every particle
   double settle_speed = 1e-3;            // m/s: settled when no particle moves faster
-  int32_t tethers = 2;                   // automatic long-range attachments per particle (0 = none)
-  Id contact_group;                      // set by the world: the group that holds collider contacts
+  // Realignment passes per substep (0 = textbook XPBD). XPBD projects each constraint along its
+  // gradient where it stands at that moment and drops the term g = M (x - x~) - grad C(x)^T lambda
+  // (Macklin et al. 2016, eq. 11), so a converged substep is the true implicit step only to O(h^2):
+  // a settled structure sits off its static equilibrium by O(h^2 g). A pass resets
+  // x = x~ + M^-1 grad C(x)^T lambda with the current gradients and runs the iterations again,
+  // which drives g to zero: the settled state becomes the equilibrium to rounding. Costs one gradient
+  // sweep and `iterations` more projection passes per substep.
+  int32_t realign_passes = 0;
+  int32_t tethers = 2;  // automatic long-range attachments per particle (0 = none)
+  Id contact_group;     // set by the world: the group that holds collider contacts
 };
 
 struct GroupReport {
@@ -359,6 +367,7 @@ class World {
   void move_colliders(double alpha);
   void find_contacts();
   void reset_multipliers();
+  void realign(const std::vector<Vec3>& predicted);
   void project_group(Group& g, double h);
   void project_contacts(Group& g, double h);
   void update_velocities(double h);
@@ -390,7 +399,9 @@ class World {
   };
   std::vector<TetherCache> tether_cache_;  // one per body
   bool rest_dirty_ = true;
-  bool solver_dirty_ = true;  // constraints, pins or bodies changed: rebuild the solver arrays
+  bool solver_dirty_ = true;
+  std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
+                                           // bodies changed: rebuild the solver arrays
   StepReport report_;
   Warning warning_;
 };
