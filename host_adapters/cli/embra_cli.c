@@ -342,6 +342,10 @@ static int cmd_run(int argc, char** argv) {
     return EXIT_INVALID;
   }
   const int tty = isatty(2);
+  const long stride = frames >= 10 ? frames / 10 : 1;
+  if (frames > 0)
+    printf("%7s %9s %13s %13s %13s %13s %8s\n", "frame", "ms", "residual_max", "residual_rms", "kinetic_J", "max_speed",
+           "settled");
   int rc = 0;
   double total_ms = 0.0;
   long settled_at = -1;
@@ -365,6 +369,12 @@ static int cmd_run(int argc, char** argv) {
             "\"kinetic_energy\":%.17g,\"max_speed\":%.17g,\"contacts\":%lld,\"settled\":%s}\n",
             (long long)r.frame, r.time, ms, r.residual_max, r.residual_rms, r.kinetic_energy, r.max_speed,
             (long long)r.contact_count, r.settled ? "true" : "false");
+    if (f % stride == 0 || f == frames) {
+      if (tty) fputc('\r', stderr);
+      printf("%7lld %9.3f %13.3e %13.3e %13.3e %13.3e %8s\n", (long long)r.frame, ms, r.residual_max, r.residual_rms,
+             r.kinetic_energy, r.max_speed, r.settled ? "yes" : "no");
+      fflush(stdout);
+    }
     if (every > 0 && f % every == 0) {
       snprintf(path, sizeof path, "%s/frame_%05ld.obj", out, f);
       if (write_world_obj(path, world) != 0) {
