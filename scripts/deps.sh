@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libccd-dev nlohmann-json3-dev libvalijson-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format binutils
+  python3-jsonschema
 )
 
 missing=()

@@ -34,15 +34,29 @@ constexpr int kMaxDepth = 64;  // scenes nest 8 deep; anything far deeper is ref
 /// costs neither stack nor memory) and anything that is not JSON (including invalid UTF-8).
 json parse(std::string_view text) {
   try {
-    return json::parse(text.begin(), text.end(), [](int depth, json::parse_event_t, json&) {
-      if (depth > kMaxDepth)
+    return json::parse(text.begin(), text.end(), [](int depth, json::parse_event_t event, json&) {
+      // `depth` counts the containers already open, so the 65th object or array starts at 64.
+      const bool opens = event == json::parse_event_t::object_start || event == json::parse_event_t::array_start;
+      if (opens && depth >= kMaxDepth)
         throw SceneError("/: the document nests deeper than " + std::to_string(kMaxDepth) + " levels");
       return true;
     });
   } catch (const json::exception& e) {
     std::string what = e.what();
     const auto pos = what.find("] ");
-    throw SceneError("/: not valid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)));
+    // nlohmann quotes the bytes it last read, which may be the very invalid UTF-8 it refused: spell
+    // non-ASCII bytes as \xNN so the message itself is always valid UTF-8 (hosts decode it).
+    std::string ascii;
+    for (const char ch : pos == std::string::npos ? what : what.substr(pos + 2)) {
+      const auto byte = static_cast<unsigned char>(ch);
+      if (byte < 0x80) {
+        ascii += ch;
+      } else {
+        const char* hex = "0123456789abcdef";
+        ascii += {'\\', 'x', hex[byte >> 4], hex[byte & 15]};
+      }
+    }
+    throw SceneError("/: not valid JSON: " + ascii);
   }
 }
 
@@ -632,11 +646,22 @@ json vec_json(const Vec3& v) {
   return json::array({v[0], v[1], v[2]});
 }
 
-/// A name for every live object: its own, or "<what>_<slot>" made unique.
+/// The names a scene gave (unique per kind: the loader refuses duplicates), reserved so that the
+/// invented names of unnamed objects never take one of them.
+std::set<std::string> given_names(const std::map<uint32_t, std::string>& names) {
+  std::set<std::string> out;
+  for (const auto& [slot, name] : names) out.insert(name);
+  return out;
+}
+
+/// A name for every live object: its own, or "<what>_<slot>" made unique among all names in `used`
+/// (which holds given_names(names)). Actions refer to objects by these names, so an object keeps its
+/// own name: renaming it could hand its name, and its actions, to another object.
 std::string name_for(const std::map<uint32_t, std::string>& names, uint32_t slot, const char* what,
                      std::set<std::string>& used) {
   const auto it = names.find(slot);
-  std::string n = it != names.end() ? it->second : std::string(what) + "_" + std::to_string(slot);
+  if (it != names.end()) return it->second;
+  std::string n = std::string(what) + "_" + std::to_string(slot);
   while (!used.insert(n).second) n += "_";
   return n;
 }
@@ -649,6 +674,15 @@ std::string_view scene_schema() {
 
 std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta) {
   const json doc = parse(text);
+  // What the document is comes first: the schema alone would only say a `const` did not match.
+  auto shown = [](const json& v) {
+    const std::string s = v.dump(-1, ' ', true);  // ASCII, so cutting it keeps it valid UTF-8
+    return s.size() > 64 ? s.substr(0, 60) + "..." : s;
+  };
+  if (doc.is_object() && doc.contains("format") && doc["format"] != "embra-scene")
+    fail("/format", "is " + shown(doc["format"]) + ", not \"embra-scene\": this is not an embra scene");
+  if (doc.is_object() && doc.contains("version") && doc["version"] != 1)
+    fail("/version", "is " + shown(doc["version"]) + "; this library reads scene version 1");
   validate(doc);
   SceneMeta meta;
   auto world = Builder(doc, base_dir, meta).build();
@@ -680,7 +714,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   std::sort(slots.begin(), slots.end(),
             [&](uint32_t a, uint32_t b) { return w.groups()[a].serial < w.groups()[b].serial; });
   std::map<uint32_t, std::string> gname;
-  std::set<std::string> used{"default", "contacts"};
+  std::set<std::string> used = given_names(meta.group_names);
+  used.insert({"default", "contacts"});
   gname[w.default_group().index] = "default";
   gname[w.contact_group().index] = "contacts";
   json groups = json::array();
@@ -693,7 +728,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   auto group_name = [&](Id id) { return gname.at(id.is_null() ? w.default_group().index : id.index); };
 
   json bodies = json::array();
-  std::set<std::string> used_bodies;
+  std::set<std::string> used_bodies = given_names(meta.body_names);
   for (uint32_t i = 0; i < w.body_count(); ++i) {
     const BodyInfo& b = w.body(Id{i, 1});
     const int32_t f = b.first_particle;
@@ -760,26 +795,34 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   doc["constraints"] = constraints;
 
   json pins = json::array();
-  std::set<std::string> used_pins;
-  for (uint32_t i = 0; i < w.pins().size(); ++i) {
+  std::set<std::string> used_pins = given_names(meta.pin_names);
+  std::map<uint32_t, std::string> pin_name;
+  // Hard pins in slot order, then each group's soft pins in the order the group projects them
+  // (creation order, which a reused slot breaks): a loaded scene lists them in that order again.
+  std::vector<uint32_t> pin_order;
+  for (uint32_t i = 0; i < w.pins().size(); ++i)
+    if (w.pins()[i].alive && w.pins()[i].compliance == 0.0) pin_order.push_back(i);
+  for (uint32_t slot : slots)
+    for (int32_t i : w.groups()[slot].soft_pins) pin_order.push_back(static_cast<uint32_t>(i));
+  for (uint32_t i : pin_order) {
     const Pin& p = w.pins()[i];
-    if (!p.alive) continue;
-    json j = {{"name", name_for(meta.pin_names, i, "pin", used_pins)},
-              {"particle", p.particle},
-              {"target", vec_json(p.target)},
-              {"compliance", p.compliance}};
+    pin_name[i] = name_for(meta.pin_names, i, "pin", used_pins);
+    json j = {
+        {"name", pin_name[i]}, {"particle", p.particle}, {"target", vec_json(p.target)}, {"compliance", p.compliance}};
     if (p.compliance > 0.0) j["group"] = group_name(p.group);
     pins.push_back(j);
   }
   doc["pins"] = pins;
 
   json colliders = json::array();
-  std::set<std::string> used_colliders;
+  std::set<std::string> used_colliders = given_names(meta.collider_names);
+  std::map<uint32_t, std::string> collider_name;
   for (uint32_t i = 0; i < w.colliders().size(); ++i) {
     const Collider& c = w.colliders()[i];
     if (!c.alive) continue;
     const Eigen::Quaterniond& q = c.desc.rotation;
-    colliders.push_back({{"name", name_for(meta.collider_names, i, "collider", used_colliders)},
+    collider_name[i] = name_for(meta.collider_names, i, "collider", used_colliders);
+    colliders.push_back({{"name", collider_name[i]},
                          {"shape", c.desc.shape == ColliderShape::plane ? "plane" : "sphere"},
                          {"position", vec_json(c.desc.position)},
                          {"rotation", {q.w(), q.x(), q.y(), q.z()}},
@@ -799,16 +842,12 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
       case Action::Type::rest_scale:
         j = {{"type", "rest_scale"}, {"body", bodies[a.target.index]["name"]}};
         break;
-      case Action::Type::pin_target: {
-        std::set<std::string> dummy;
-        j = {{"type", "pin_target"}, {"pin", name_for(meta.pin_names, a.target.index, "pin", dummy)}};
+      case Action::Type::pin_target:
+        j = {{"type", "pin_target"}, {"pin", pin_name.at(a.target.index)}};
         break;
-      }
-      case Action::Type::collider_pose: {
-        std::set<std::string> dummy;
-        j = {{"type", "collider_pose"}, {"collider", name_for(meta.collider_names, a.target.index, "collider", dummy)}};
+      case Action::Type::collider_pose:
+        j = {{"type", "collider_pose"}, {"collider", collider_name.at(a.target.index)}};
         break;
-      }
       case Action::Type::gravity:
         j = {{"type", "gravity"}};
         break;
