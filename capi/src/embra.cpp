@@ -12,6 +12,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <vector>
 
 struct embra_world {
   embra::World world;
@@ -112,6 +113,11 @@ embra::Id to_id(T id) {
 template <class T>
 T from_id(embra::Id id) {
   return T{id.index, id.generation};
+}
+
+/// A scene action that drives a destroyed pin or collider goes with it.
+void drop_actions(embra::io::SceneMeta& meta, embra::io::Action::Type type, embra::Id id) {
+  std::erase_if(meta.actions, [&](const embra::io::Action& a) { return a.type == type && a.target == id; });
 }
 
 embra::Vec3 vec(const double* p) {
@@ -524,6 +530,7 @@ embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
   return guard("embra_pin_destroy", [&] {
     need(world, "world");
     world->world.destroy_pin(to_id(pin));
+    drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
   });
 }
 
@@ -589,6 +596,7 @@ embra_status embra_collider_destroy(embra_world* world, embra_collider_id collid
   return guard("embra_collider_destroy", [&] {
     need(world, "world");
     world->world.destroy_collider(to_id(collider));
+    drop_actions(world->meta, embra::io::Action::Type::collider_pose, to_id(collider));
   });
 }
 

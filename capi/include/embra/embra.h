@@ -361,6 +361,7 @@ typedef struct embra_pin_def {
 EMBRA_API embra_pin_def embra_default_pin_def(void);
 /* A particle takes at most one hard pin. */
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
+/* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. */
 EMBRA_API embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]);
@@ -392,6 +393,7 @@ typedef struct embra_collider_def {
 EMBRA_API embra_collider_def embra_default_collider_def(void);
 EMBRA_API embra_status embra_collider_create(embra_world* world, const embra_collider_def* def,
                                              embra_collider_id* out_collider);
+/* Destroys a collider (and a scene action that moves it). */
 EMBRA_API embra_status embra_collider_destroy(embra_world* world, embra_collider_id collider);
 /* Sets where the collider is at the end of the next step; it moves there along a straight path
  * over the substeps, and particles it drags take its velocity through friction. */

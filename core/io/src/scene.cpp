@@ -2,6 +2,7 @@
 // through embra::World, and save back.
 #include "embra/io/scene.hpp"
 
+#include "closed_meshes.hpp"
 #include "scene_schema.hpp"
 
 #include <nlohmann/json.hpp>
@@ -72,24 +73,32 @@ std::string pointer_of(const std::vector<std::string>& context) {
   return p.empty() ? "/" : p;
 }
 
-/// The schema, parsed once (thread-safe static initialisation).
-const valijson::Schema& compiled_schema() {
-  static const std::unique_ptr<valijson::Schema> schema = [] {
-    auto s = std::make_unique<valijson::Schema>();
-    const json doc = json::parse(scene_schema());
-    valijson::SchemaParser parser;
-    valijson::adapters::NlohmannJsonAdapter adapter(doc);
-    parser.populateSchema(adapter, *s);
-    return s;
-  }();
+std::unique_ptr<valijson::Schema> parse_schema(std::string_view text) {
+  auto s = std::make_unique<valijson::Schema>();
+  const json doc = json::parse(text);
+  valijson::SchemaParser parser;
+  valijson::adapters::NlohmannJsonAdapter adapter(doc);
+  parser.populateSchema(adapter, *s);
+  return s;
+}
+
+/// The schemas, parsed once (thread-safe static initialisation).
+const valijson::Schema& scene_schema_compiled() {
+  static const std::unique_ptr<valijson::Schema> schema = parse_schema(scene_schema());
   return *schema;
 }
 
-void validate(const json& doc) {
+const valijson::Schema& tolerances_schema_compiled() {
+  static const std::unique_ptr<valijson::Schema> schema = parse_schema(kTolerancesSchema);
+  return *schema;
+}
+
+/// Validates `doc` against `schema`; errors name their pointer below `prefix`.
+void validate(const json& doc, const valijson::Schema& schema, const std::string& prefix, const char* what) {
   valijson::Validator validator;
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter adapter(doc);
-  if (validator.validate(compiled_schema(), adapter, &results)) return;
+  if (validator.validate(schema, adapter, &results)) return;
   valijson::ValidationResults::Error first, e;
   results.popError(first);
   std::string message = first.description;
@@ -100,7 +109,9 @@ void validate(const json& doc) {
       depth = e.context.size();
       first = e;
     }
-  fail(pointer_of(first.context), "does not match the scene schema: " + first.description);
+  const std::string pointer = pointer_of(first.context);
+  fail(prefix.empty() ? pointer : prefix + (pointer == "/" ? "" : pointer),
+       std::string("does not match the ") + what + " schema: " + first.description);
 }
 
 Vec3 vec3(const json& j) {
@@ -217,6 +228,26 @@ Mesh tube_mesh(const json& s) {
     }
   // A seam-crossing uv jump would misread the edge's direction: u is periodic, so measure it
   // the short way round by leaving uvs out of the seam's direction split.
+  return m;
+}
+
+/// The closed generators (closed_meshes.hpp).
+Mesh closed_mesh(const json& s, const std::string& where) {
+  SurfaceMesh surface;
+  if (s["generator"] == "icosphere") {
+    surface = icosphere(s["radius"].get<double>(), s["subdivisions"].get<int>());
+  } else {
+    const std::array<double, 3> size{s["size"][0].get<double>(), s["size"][1].get<double>(),
+                                     s["size"][2].get<double>()};
+    const double radius = value_or(s, "radius", 0.0);
+    if (2.0 * radius > std::min({size[0], size[1], size[2]}))
+      fail(where + "/radius", "the rounding radius exceeds half the box's smallest extent");
+    surface = rounded_box(size, radius, s["resolution"].get<int>());
+  }
+  Mesh m;
+  m.positions = std::move(surface.positions);
+  m.triangles = std::move(surface.triangles);
+  m.sets = std::move(surface.sets);
   return m;
 }
 
@@ -439,8 +470,10 @@ class Builder {
       m = grid_mesh(spec);
     else if (spec["generator"] == "triangle")
       m = triangle_mesh(spec);
-    else
+    else if (spec["generator"] == "tube")
       m = tube_mesh(spec);
+    else
+      m = closed_mesh(spec, at + "/mesh");
     if (!spec.contains("vertices")) place(m, spec, at + "/mesh");
     const int64_t nv = static_cast<int64_t>(m.positions.size() / 3);
     if (!m.uvs.empty() && static_cast<int64_t>(m.uvs.size()) != 2 * nv)
@@ -683,7 +716,9 @@ std::unique_ptr<World> load_scene(std::string_view text, const std::string& base
     fail("/format", "is " + shown(doc["format"]) + ", not \"embra-scene\": this is not an embra scene");
   if (doc.is_object() && doc.contains("version") && doc["version"] != 1)
     fail("/version", "is " + shown(doc["version"]) + "; this library reads scene version 1");
-  validate(doc);
+  validate(doc, scene_schema_compiled(), "", "scene");
+  if (doc.contains("tolerances"))
+    validate(doc["tolerances"], tolerances_schema_compiled(), "/tolerances", "tolerances");
   SceneMeta meta;
   auto world = Builder(doc, base_dir, meta).build();
   out_meta = std::move(meta);
