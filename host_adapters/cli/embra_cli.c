@@ -370,7 +370,7 @@ static int cmd_run(int argc, char** argv) {
             (long long)r.frame, r.time, ms, r.residual_max, r.residual_rms, r.kinetic_energy, r.max_speed,
             (long long)r.contact_count, r.settled ? "true" : "false");
     if (f % stride == 0 || f == frames) {
-      if (tty) fputc('\r', stderr);
+      if (tty) fputs("\r\033[K", stderr); /* clear the progress bar's line */
       printf("%7lld %9.3f %13.3e %13.3e %13.3e %13.3e %8s\n", (long long)r.frame, ms, r.residual_max, r.residual_rms,
              r.kinetic_energy, r.max_speed, r.settled ? "yes" : "no");
       fflush(stdout);
