@@ -137,6 +137,20 @@ embra::Settings to_settings(const embra_solver_def& d) {
   return s;
 }
 
+embra_solver_def from_settings(const embra::Settings& s) {
+  embra_solver_def d{};
+  d.version = EMBRA_SOLVER_DEF_VERSION;
+  d.substeps = s.substeps;
+  d.dt = s.dt;
+  d.iterations = s.iterations;
+  for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
+  d.damping = s.damping;
+  d.settle_speed = s.settle_speed;
+  d.tethers = s.tethers;
+  d.realign_passes = s.realign_passes;
+  return d;
+}
+
 embra::Material to_material(const embra_material& m) {
   embra::Material r;
   r.mass = m.mass;
@@ -217,18 +231,7 @@ embra_status embra_check_abi(int32_t header_abi_version) {
 // --- world -------------------------------------------------------------------------------------
 
 embra_solver_def embra_default_solver_def(void) {
-  const embra::Settings s;
-  embra_solver_def d{};
-  d.version = EMBRA_SOLVER_DEF_VERSION;
-  d.substeps = s.substeps;
-  d.dt = s.dt;
-  d.iterations = s.iterations;
-  for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
-  d.damping = s.damping;
-  d.settle_speed = s.settle_speed;
-  d.tethers = s.tethers;
-  d.realign_passes = s.realign_passes;
-  return d;
+  return from_settings(embra::Settings());
 }
 
 embra_status embra_world_create(embra_world** out_world, const embra_solver_def* def) {
@@ -249,16 +252,7 @@ embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* 
   return guard("embra_world_get_solver", [&] {
     need(world, "world");
     need(out_def, "out_def");
-    const embra::Settings& s = world->world.settings();
-    embra_solver_def d = embra_default_solver_def();
-    d.substeps = s.substeps;
-    d.dt = s.dt;
-    d.iterations = s.iterations;
-    for (int k = 0; k < 3; ++k) d.gravity[k] = s.gravity[k];
-    d.damping = s.damping;
-    d.settle_speed = s.settle_speed;
-    d.tethers = s.tethers;
-    d.realign_passes = s.realign_passes;
+    const embra_solver_def d = from_settings(world->world.settings());
     *out_def = d;
   });
 }
