@@ -10,6 +10,7 @@
 #include "embra/core/world.hpp"
 
 #include "lanes.hpp"
+#include "self_collision.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -428,6 +429,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
       corr[ct.particle] += ct.lambda * n;
     }
   }
+  self_collision::add_corrections(self_contacts_, w_, corr);
   for (size_t i = 0; i < x_.size(); ++i)
     if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
 }
@@ -454,6 +456,8 @@ void World::project_group(Group& g, double h) {
   k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   if (!g.contacts.empty()) project_contacts(g, h);
+  if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
+    self_collision::project(self_contacts_, x_, w_);
 }
 
 namespace {
@@ -509,6 +513,7 @@ void World::update_velocities(double h) {
     else if (len > 0.0)
       x_[i] -= tangential * std::min(mu_k * ct.lambda / len, 1.0);
   }
+  self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
   const double inv_h = 1.0 / h;
   for (size_t i = 0; i < x_.size(); ++i) {
     v_[i] = (x_[i] - x_prev_[i]) * inv_h;
@@ -583,7 +588,8 @@ void World::measure() {
   report_.residual_max = all_max;
   report_.residual_rms = all_n > 0 ? std::sqrt(all_sq / static_cast<double>(all_n)) : 0.0;
   report_.constraint_count = all_n;
-  report_.contact_count = static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size());
+  report_.contact_count =
+      static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size() + self_contacts_.size());
   report_.settled = report_.max_speed <= settings_.settle_speed;
 }
 
@@ -606,6 +612,7 @@ void World::step() {
     move_colliders(alpha);
     predict(h, alpha);
     find_contacts();
+    find_self_contacts();
     reset_multipliers();
     if (settings_.realign_passes > 0) predicted_ = x_;
     for (int pass = 0; pass <= settings_.realign_passes; ++pass) {

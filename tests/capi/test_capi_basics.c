@@ -85,7 +85,7 @@ static void test_struct_layout(void) {
   CHECK_INT(sizeof(embra_collider_id), 8);
   CHECK_INT(offsetof(embra_group_id, generation), 4);
 
-  CHECK_INT(sizeof(embra_solver_def), 6 * 4 + 6 * 8);
+  CHECK_INT(sizeof(embra_solver_def), 8 * 4 + 6 * 8);
   CHECK_INT(offsetof(embra_solver_def, substeps), 4);
   CHECK_INT(offsetof(embra_solver_def, dt), 8);
   CHECK_INT(offsetof(embra_solver_def, iterations), 16);
@@ -93,6 +93,7 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_solver_def, damping), 48);
   CHECK_INT(offsetof(embra_solver_def, settle_speed), 56);
   CHECK_INT(offsetof(embra_solver_def, tethers), 64);
+  CHECK_INT(offsetof(embra_solver_def, self_collision), 72);
 
   CHECK_INT(sizeof(embra_world_counts), 6 * 4 + 8);
   CHECK_INT(offsetof(embra_world_counts, constraints), 24);

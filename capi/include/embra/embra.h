@@ -166,6 +166,14 @@ typedef struct embra_solver_def {
                              iterates again: with 2-4 passes a settled form is the equilibrium to
                              rounding (the hanging chain matches the discrete catenary to 3e-12).
                              Costs (1 + passes) x the iterations. */
+  int32_t self_collision; /* 0 (default) or 1. 1: cloth and shells (bodies with triangles) collide
+                             with themselves and with each other, point against triangle and edge
+                             against edge, kept the sum of the two sides' half thicknesses apart
+                             (embra_material.thickness), found in space-time over each substep so
+                             fast folds never pass through, resolved as hard contacts in the contact
+                             group with the materials' friction. The broad phase is a spatial hash
+                             rebuilt every substep (cost linear in the particle count). */
+  int32_t reserved1;      /* 0 */
 } embra_solver_def;
 
 EMBRA_API embra_solver_def embra_default_solver_def(void);

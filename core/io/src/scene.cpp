@@ -367,6 +367,7 @@ class Builder {
       s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
       s.tethers = value_or(j, "tethers", s.tethers);
       s.realign_passes = value_or(j, "realign_passes", s.realign_passes);
+      s.self_collision = value_or(j, "self_collision", s.self_collision);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
     World& w = *world;
@@ -740,7 +741,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                    {"damping", s.damping},
                    {"settle_speed", s.settle_speed},
                    {"tethers", s.tethers},
-                   {"realign_passes", s.realign_passes}};
+                   {"realign_passes", s.realign_passes},
+                   {"self_collision", s.self_collision}};
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.
   std::vector<uint32_t> slots;

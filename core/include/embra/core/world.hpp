@@ -139,6 +139,9 @@ struct Settings {
   int32_t realign_passes = 0;
   int32_t tethers = 2;  // automatic long-range attachments per particle (0 = none)
   Id contact_group;     // set by the world: the group that holds collider contacts
+  // 1: cloth and shells (bodies with triangles) collide with themselves and each other, point against
+  // triangle and edge against edge, kept their thickness apart (self_collision.hpp); 0 (default): off.
+  int32_t self_collision = 0;
 };
 
 struct GroupReport {
@@ -217,6 +220,18 @@ struct SolverArray {
   bool shared_tail = false;           // the last colour's constraints may share particles (project in order)
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
+};
+
+/// A self-collision contact (core/src/self_collision.hpp): the hard unilateral constraint
+/// normal . sum_k weight[k] x[ids[k]] - thickness >= 0 between a point and a triangle (ids: the point,
+/// then the corners; weights 1, -barycentric) or two edges (a0, a1, b0, b1; 1 - s, s, -(1 - t), -t).
+struct SelfContact {
+  int32_t ids[4];
+  double weight[4];
+  Vec3 normal;
+  double thickness;
+  double mu_s, mu_k;
+  double lambda;
 };
 
 struct Contact {
@@ -366,6 +381,7 @@ class World {
   void predict(double h, double alpha);
   void move_colliders(double alpha);
   void find_contacts();
+  void find_self_contacts();
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
   void project_group(Group& g, double h);
@@ -400,8 +416,9 @@ class World {
   std::vector<TetherCache> tether_cache_;  // one per body
   bool rest_dirty_ = true;
   bool solver_dirty_ = true;
-  std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
-                                           // bodies changed: rebuild the solver arrays
+  std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
+  std::vector<Vec3> predicted_, realign_;   // realignment scratch (Settings::realign_passes)  // constraints, pins or
+                                            // bodies changed: rebuild the solver arrays
   StepReport report_;
   Warning warning_;
 };

@@ -1,0 +1,704 @@
+// Self-collision: broad phase, narrow phase in space-time, projection and friction (see the header).
+#include "self_collision.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace embra::self_collision {
+
+namespace {
+
+/// The smallest separation kept between two primitives whose bodies have no thickness (m).
+constexpr double kMinGap = 1e-6;
+
+struct Box {
+  Vec3 lo, hi;
+  bool overlaps(const Box& o) const {
+    return lo.x() <= o.hi.x() && o.lo.x() <= hi.x() && lo.y() <= o.hi.y() && o.lo.y() <= hi.y() && lo.z() <= o.hi.z() &&
+           o.lo.z() <= hi.z();
+  }
+  double extent() const { return (hi - lo).maxCoeff(); }
+};
+
+/// A spatial hash of boxes: every box is listed in the buckets of the cells it overlaps, buckets
+/// filled by a counting sort so each lists its boxes in increasing index. A box covering more than
+/// kMaxCells cells (a very fast or very large primitive) goes to a list checked by every query.
+class Grid {
+ public:
+  void build(std::span<const Box> boxes, double cell) {
+    boxes_ = boxes;
+    inv_cell_ = 1.0 / cell;
+    big_.clear();
+    int64_t entries = 0;
+    for (const Box& b : boxes) {
+      const int64_t n = cells(b);
+      if (n <= kMaxCells) entries += n;
+    }
+    size_t size = 16;
+    while (size < 2 * static_cast<size_t>(entries)) size *= 2;
+    mask_ = size - 1;
+    start_.assign(size + 1, 0);
+    for (size_t i = 0; i < boxes.size(); ++i) visit(boxes[i], [&](size_t bucket) { ++start_[bucket + 1]; });
+    for (size_t k = 0; k < size; ++k) start_[k + 1] += start_[k];
+    items_.resize(static_cast<size_t>(entries));
+    fill_.assign(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < boxes.size(); ++i) {
+      if (cells(boxes[i]) > kMaxCells) {
+        big_.push_back(static_cast<int32_t>(i));
+        continue;
+      }
+      visit(boxes[i], [&](size_t bucket) { items_[fill_[bucket]++] = static_cast<int32_t>(i); });
+    }
+  }
+
+  /// The boxes overlapping `q`, in increasing index, each once.
+  void query(const Box& q, std::vector<int32_t>& out) const {
+    out.clear();
+    const int64_t n = cells(q);
+    if (n > kMaxCells) {  // a huge query: every box
+      for (size_t i = 0; i < boxes_.size(); ++i)
+        if (boxes_[i].overlaps(q)) out.push_back(static_cast<int32_t>(i));
+      return;
+    }
+    visit(q, [&](size_t bucket) {
+      for (int32_t k = start_[bucket]; k < start_[bucket + 1]; ++k)
+        if (boxes_[items_[k]].overlaps(q)) out.push_back(items_[k]);
+    });
+    for (int32_t k : big_)
+      if (boxes_[k].overlaps(q)) out.push_back(k);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+ private:
+  static constexpr int64_t kMaxCells = 512;
+
+  int64_t coord(double v) const {
+    const double c = std::floor(v * inv_cell_);
+    return static_cast<int64_t>(std::clamp(c, -1e15, 1e15));
+  }
+  int64_t cells(const Box& b) const {
+    int64_t n = 1;
+    for (int a = 0; a < 3; ++a) {
+      n *= coord(b.hi[a]) - coord(b.lo[a]) + 1;
+      if (n > kMaxCells) return kMaxCells + 1;
+    }
+    return n;
+  }
+  template <class F>
+  void visit(const Box& b, F&& f) const {
+    if (cells(b) > kMaxCells) return;
+    const int64_t i0 = coord(b.lo.x()), i1 = coord(b.hi.x()), j0 = coord(b.lo.y()), j1 = coord(b.hi.y()),
+                  k0 = coord(b.lo.z()), k1 = coord(b.hi.z());
+    for (int64_t k = k0; k <= k1; ++k)
+      for (int64_t j = j0; j <= j1; ++j)
+        for (int64_t i = i0; i <= i1; ++i) {
+          uint64_t h = static_cast<uint64_t>(i) * 73856093u ^ static_cast<uint64_t>(j) * 19349663u ^
+                       static_cast<uint64_t>(k) * 83492791u;
+          h *= 0x9E3779B97F4A7C15ull;
+          f(static_cast<size_t>((h >> 20) & mask_));
+        }
+  }
+
+  std::span<const Box> boxes_;
+  double inv_cell_ = 1.0;
+  size_t mask_ = 0;
+  std::vector<int32_t> start_, items_, fill_, big_;
+};
+
+/// Mean of the boxes' largest extents: the cell size that keeps the cells per box bounded.
+double mean_extent(std::span<const Box> boxes) {
+  double sum = 0.0;
+  for (const Box& b : boxes) sum += b.extent();
+  const double mean = boxes.empty() ? 0.0 : sum / static_cast<double>(boxes.size());
+  return mean > 0.0 ? mean : 1.0;
+}
+
+Box box_of(std::initializer_list<Vec3> points, double grow) {
+  Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
+        Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  for (const Vec3& p : points) {
+    b.lo = b.lo.cwiseMin(p);
+    b.hi = b.hi.cwiseMax(p);
+  }
+  b.lo.array() -= grow;
+  b.hi.array() += grow;
+  return b;
+}
+
+/// Roots of d3 t^3 + d2 t^2 + d1 t + d0 in [0, 1], ascending: the cubic is cut at its critical
+/// points into monotone pieces, each bisected where it changes sign; a piece's end where the cubic
+/// (nearly) vanishes counts too, which catches double roots.
+int cubic_roots(double d0, double d1, double d2, double d3, double roots[3]) {
+  const double scale = std::abs(d0) + std::abs(d1) + std::abs(d2) + std::abs(d3);
+  if (!(scale > 0.0) || !std::isfinite(scale)) return 0;  // identically coplanar: no single time
+  auto f = [&](double t) { return ((d3 * t + d2) * t + d1) * t + d0; };
+  const double tiny = 1e-13 * scale;
+  double cuts[4] = {0.0, 0.0, 0.0, 1.0};
+  int nc = 1;
+  // critical points: 3 d3 t^2 + 2 d2 t + d1 = 0
+  const double qa = 3.0 * d3, qb = 2.0 * d2, qc = d1;
+  double crit[2];
+  int ncrit = 0;
+  if (std::abs(qa) > 1e-300) {
+    const double disc = qb * qb - 4.0 * qa * qc;
+    if (disc >= 0.0) {
+      const double sq = std::sqrt(disc);
+      const double q = -0.5 * (qb + std::copysign(sq, qb));
+      if (q != 0.0) {
+        crit[ncrit++] = q / qa;
+        crit[ncrit++] = qc / q;
+      } else {
+        crit[ncrit++] = 0.0;
+      }
+    }
+  } else if (std::abs(qb) > 1e-300) {
+    crit[ncrit++] = -qc / qb;
+  }
+  std::sort(crit, crit + ncrit);
+  for (int k = 0; k < ncrit; ++k)
+    if (crit[k] > 0.0 && crit[k] < 1.0) cuts[nc++] = crit[k];
+  cuts[nc++] = 1.0;
+  int n = 0;
+  auto add = [&](double t) {
+    if (n == 0 || t > roots[n - 1] + 1e-12) roots[n++] = t;
+  };
+  for (int k = 0; k + 1 < nc && n < 3; ++k) {
+    double lo = cuts[k], hi = cuts[k + 1];
+    double flo = f(lo), fhi = f(hi);
+    if (std::abs(flo) <= tiny) {
+      add(lo);
+      continue;
+    }
+    if ((flo < 0.0) == (fhi < 0.0) && std::abs(fhi) > tiny) continue;
+    if (std::abs(fhi) <= tiny) {
+      add(hi);
+      continue;
+    }
+    for (int it = 0; it < 80 && hi - lo > 1e-15; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      const double fm = f(mid);
+      if ((fm < 0.0) == (flo < 0.0)) {
+        lo = mid;
+        flo = fm;
+      } else {
+        hi = mid;
+      }
+    }
+    add(hi);
+  }
+  return n;
+}
+
+/// Coefficients of det[e1(t), e2(t), e3(t)] with e_k(t) = E_k + t V_k.
+void coplanarity_cubic(const Vec3& E1, const Vec3& E2, const Vec3& E3, const Vec3& V1, const Vec3& V2, const Vec3& V3,
+                       double d[4]) {
+  d[0] = E1.cross(E2).dot(E3);
+  d[1] = V1.cross(E2).dot(E3) + E1.cross(V2).dot(E3) + E1.cross(E2).dot(V3);
+  d[2] = V1.cross(V2).dot(E3) + V1.cross(E2).dot(V3) + E1.cross(V2).dot(V3);
+  d[3] = V1.cross(V2).dot(V3);
+}
+
+Vec3 lerp(const Vec3& a, const Vec3& b, double t) {
+  return a + t * (b - a);
+}
+
+// --- exact arithmetic (Shewchuk's expansions) ---------------------------------------------------
+
+void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double bv = x - a, av = x - bv;
+  y = (a - av) + (b - bv);
+}
+
+void two_product(double a, double b, double& x, double& y) {
+  x = a * b;
+  y = std::fma(a, b, -x);
+}
+
+/// e <- e + b, exactly (e nonoverlapping, increasing magnitude, no zeros).
+void grow(std::vector<double>& e, double b) {
+  if (b == 0.0) return;
+  double q = b;
+  size_t out = 0;
+  for (size_t i = 0; i < e.size(); ++i) {
+    double s, h;
+    two_sum(q, e[i], s, h);
+    q = s;
+    if (h != 0.0) e[out++] = h;
+  }
+  e.resize(out);
+  if (q != 0.0) e.push_back(q);
+}
+
+int exact_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  // Exact differences u = b - a, v = c - a, w = d - a as (hi, lo) pairs, then the determinant as the
+  // sum of every product of three components: 6 signed permutations x 8 products x 4 exact parts.
+  double u[3][2], v[3][2], w[3][2];
+  for (int k = 0; k < 3; ++k) {
+    two_sum(b[k], -a[k], u[k][0], u[k][1]);
+    two_sum(c[k], -a[k], v[k][0], v[k][1]);
+    two_sum(d[k], -a[k], w[k][0], w[k][1]);
+  }
+  static constexpr int perms[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};
+  static constexpr double signs[6] = {1, 1, 1, -1, -1, -1};
+  std::vector<double> e;
+  e.reserve(64);
+  for (int p = 0; p < 6; ++p)
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k) {
+          const double x = u[perms[p][0]][i], y = v[perms[p][1]][j], z = w[perms[p][2]][k];
+          if (x == 0.0 || y == 0.0 || z == 0.0) continue;
+          double p1, e1;
+          two_product(x, y, p1, e1);
+          double p2, e2, p3, e3;
+          two_product(p1, z, p2, e2);
+          two_product(e1, z, p3, e3);
+          grow(e, signs[p] * p2);
+          grow(e, signs[p] * e2);
+          grow(e, signs[p] * p3);
+          grow(e, signs[p] * e3);
+        }
+  if (e.empty()) return 0;
+  return e.back() > 0.0 ? 1 : -1;
+}
+
+}  // namespace
+
+int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 u = b - a, v = c - a, w = d - a;
+  const double det = u.x() * (v.y() * w.z() - v.z() * w.y()) + u.y() * (v.z() * w.x() - v.x() * w.z()) +
+                     u.z() * (v.x() * w.y() - v.y() * w.x());
+  const double perm = std::abs(u.x()) * (std::abs(v.y() * w.z()) + std::abs(v.z() * w.y())) +
+                      std::abs(u.y()) * (std::abs(v.z() * w.x()) + std::abs(v.x() * w.z())) +
+                      std::abs(u.z()) * (std::abs(v.x() * w.y()) + std::abs(v.y() * w.x()));
+  // The differences themselves are rounded, so the bound is taken generously (Shewchuk's
+  // o3derrboundA is about 7 eps of the permanent for exact differences; rounded ones add 3 eps per
+  // product): anything closer to 0 is decided exactly.
+  constexpr double eps = 0x1.0p-53;
+  const double bound = 32.0 * eps * perm;
+  if (det > bound) return 1;
+  if (det < -bound) return -1;
+  return exact_orient3d(a, b, c, d);
+}
+
+bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+  if (op == 0 || oq == 0 || op == oq) return false;
+  const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+  return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+int64_t count_edge_triangle_crossings(std::span<const Vec3> x, std::span<const int32_t> edges,
+                                      std::span<const int32_t> triangles) {
+  const size_t nt = triangles.size() / 3;
+  std::vector<Box> boxes(nt);
+  for (size_t t = 0; t < nt; ++t)
+    boxes[t] = box_of({x[triangles[3 * t]], x[triangles[3 * t + 1]], x[triangles[3 * t + 2]]}, 0.0);
+  Grid grid;
+  grid.build(boxes, mean_extent(boxes));
+  std::vector<int32_t> cand;
+  int64_t count = 0;
+  for (size_t e = 0; e + 1 < edges.size(); e += 2) {
+    const int32_t p = edges[e], q = edges[e + 1];
+    grid.query(box_of({x[p], x[q]}, 0.0), cand);
+    for (int32_t t : cand) {
+      const int32_t* v = &triangles[3 * static_cast<size_t>(t)];
+      if (v[0] == p || v[1] == p || v[2] == p || v[0] == q || v[1] == q || v[2] == q) continue;
+      if (segment_crosses_triangle(x[p], x[q], x[v[0]], x[v[1]], x[v[2]])) ++count;
+    }
+  }
+  return count;
+}
+
+// --- narrow phase ----------------------------------------------------------------------------------
+
+double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, double bary[3]) {
+  // Ericson, Real-Time Collision Detection, 5.1.5: by Voronoi region of the triangle.
+  auto set = [&](double u, double v, double w) {
+    bary[0] = u;
+    bary[1] = v;
+    bary[2] = w;
+    return (p - (u * a + v * b + w * c)).norm();
+  };
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return set(1, 0, 0);
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return set(0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return set(1 - v, v, 0);
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return set(0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    return set(1 - w, 0, w);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return set(0, 1 - w, w);
+  }
+  const double sum = va + vb + vc;
+  if (!(sum > 0.0)) {  // degenerate triangle: the nearest of its edges
+    double best = std::numeric_limits<double>::infinity(), s, t;
+    const Vec3* v[3] = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+      const double d = edge_edge_distance(p, p, *v[k], *v[(k + 1) % 3], s, t);
+      if (d < best) {
+        best = d;
+        double w[3] = {0, 0, 0};
+        w[k] = 1 - t;
+        w[(k + 1) % 3] = t;
+        bary[0] = w[0];
+        bary[1] = w[1];
+        bary[2] = w[2];
+      }
+    }
+    return best;
+  }
+  const double denom = 1.0 / sum;
+  const double v = vb * denom, w = vc * denom;
+  return set(1.0 - v - w, v, w);
+}
+
+double edge_edge_distance(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, double& s, double& t) {
+  // Ericson 5.1.9, with the degenerate cases.
+  const Vec3 d1 = a1 - a0, d2 = b1 - b0, r = a0 - b0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  constexpr double tiny = 1e-300;
+  if (a <= tiny && e <= tiny) {
+    s = t = 0.0;
+  } else if (a <= tiny) {
+    s = 0.0;
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= tiny) {
+      t = 0.0;
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2);
+      const double denom = a * e - b * b;
+      s = denom > 1e-14 * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0.0) {
+        t = 0.0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1.0) {
+        t = 1.0;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return ((a0 + s * d1) - (b0 + t * d2)).norm();
+}
+
+bool point_triangle_toi(const Vec3& p0, const Vec3& p1, const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                        const Vec3& c0, const Vec3& c1, double tolerance, double& t) {
+  double d[4];
+  coplanarity_cubic(b0 - a0, c0 - a0, p0 - a0, (b1 - a1) - (b0 - a0), (c1 - a1) - (c0 - a0), (p1 - a1) - (p0 - a0), d);
+  double roots[3];
+  const int n = cubic_roots(d[0], d[1], d[2], d[3], roots);
+  for (int k = 0; k < n; ++k) {
+    double bary[3];
+    const double tk = roots[k];
+    if (point_triangle_distance(lerp(p0, p1, tk), lerp(a0, a1, tk), lerp(b0, b1, tk), lerp(c0, c1, tk), bary) <=
+        tolerance) {
+      t = tk;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool edge_edge_toi(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, const Vec3& a0e, const Vec3& a1e,
+                   const Vec3& b0e, const Vec3& b1e, double tolerance, double& t) {
+  double d[4];
+  coplanarity_cubic(a1 - a0, b1 - b0, b0 - a0, (a1e - a0e) - (a1 - a0), (b1e - b0e) - (b1 - b0),
+                    (b0e - a0e) - (b0 - a0), d);
+  double roots[3];
+  const int n = cubic_roots(d[0], d[1], d[2], d[3], roots);
+  for (int k = 0; k < n; ++k) {
+    double s, u;
+    const double tk = roots[k];
+    if (edge_edge_distance(lerp(a0, a0e, tk), lerp(a1, a1e, tk), lerp(b0, b0e, tk), lerp(b1, b1e, tk), s, u) <=
+        tolerance) {
+      t = tk;
+      return true;
+    }
+  }
+  return false;
+}
+
+// --- detection -------------------------------------------------------------------------------------
+
+namespace {
+
+struct Scratch {
+  std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
+  std::vector<int32_t> tri_body, edge_body, point_body;
+  std::vector<Box> tri_boxes, edge_boxes;
+  Grid tri_grid, edge_grid;
+  std::vector<int32_t> cand;
+};
+
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
+/// A unit normal: `primary` if it has a length, else `fallback`, turned toward `side` (the vector
+/// from the second primitive to the first at the start of the substep).
+bool orient_normal(Vec3 primary, const Vec3& fallback, const Vec3& side, Vec3& n) {
+  const double len = primary.norm();
+  if (len > 1e-300 && std::abs(primary.dot(side)) > 1e-12 * len * side.norm()) {
+    n = primary / len;
+    if (n.dot(side) < 0.0) n = -n;
+    return true;
+  }
+  const double fl = fallback.norm();
+  if (fl > 1e-300) {
+    n = fallback / fl;
+    return true;
+  }
+  if (len > 1e-300) {
+    n = primary / len;
+    return true;
+  }
+  return false;
+}
+
+double mean_mu(std::span<const double> mu, const int32_t ids[4]) {
+  return std::sqrt(mu[ids[0]] * mu[ids[3]]);
+}
+
+/// Rest-shape position of a world particle of body `b`.
+const Vec3& rest_of(const BodyInfo& b, int32_t i) {
+  return b.rest_positions[static_cast<size_t>(i - b.first_particle)];
+}
+
+}  // namespace
+
+void find_contacts(const Input& in, std::vector<SelfContact>& out) {
+  out.clear();
+  Scratch& s = scratch();
+  s.tris.clear();
+  s.edges.clear();
+  s.points.clear();
+  s.tri_body.clear();
+  s.edge_body.clear();
+  s.point_body.clear();
+  for (size_t bi = 0; bi < in.bodies.size(); ++bi) {
+    const BodyInfo& b = in.bodies[bi];
+    if (b.triangles.empty()) continue;
+    s.tris.insert(s.tris.end(), b.triangles.begin(), b.triangles.end());
+    s.tri_body.insert(s.tri_body.end(), b.triangles.size() / 3, static_cast<int32_t>(bi));
+    s.edges.insert(s.edges.end(), b.edges.begin(), b.edges.end());
+    s.edge_body.insert(s.edge_body.end(), b.edges.size() / 2, static_cast<int32_t>(bi));
+    for (int32_t k = 0; k < b.particle_count; ++k) {
+      s.points.push_back(b.first_particle + k);
+      s.point_body.push_back(static_cast<int32_t>(bi));
+    }
+  }
+  if (s.tris.empty()) return;
+  const auto& x0 = in.x_prev;
+  const auto& x1 = in.x;
+  const auto& r = in.radius;
+  auto grow_of = [&](int32_t i) { return std::max(r[i], 0.5 * kMinGap); };
+
+  const size_t nt = s.tris.size() / 3, ne = s.edges.size() / 2;
+  s.tri_boxes.resize(nt);
+  for (size_t t = 0; t < nt; ++t) {
+    const int32_t a = s.tris[3 * t], b = s.tris[3 * t + 1], c = s.tris[3 * t + 2];
+    s.tri_boxes[t] = box_of({x0[a], x0[b], x0[c], x1[a], x1[b], x1[c]}, std::max({grow_of(a), grow_of(b), grow_of(c)}));
+  }
+  s.edge_boxes.resize(ne);
+  for (size_t e = 0; e < ne; ++e) {
+    const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
+    s.edge_boxes[e] = box_of({x0[a], x0[b], x1[a], x1[b]}, std::max(grow_of(a), grow_of(b)));
+  }
+  const double cell = mean_extent(s.tri_boxes);
+  s.tri_grid.build(s.tri_boxes, cell);
+  s.edge_grid.build(s.edge_boxes, cell);
+
+  // Point against triangle.
+  for (size_t pi = 0; pi < s.points.size(); ++pi) {
+    const int32_t p = s.points[pi];
+    s.tri_grid.query(box_of({x0[p], x1[p]}, grow_of(p)), s.cand);
+    const double motion_p = (x1[p] - x0[p]).norm();
+    for (int32_t t : s.cand) {
+      const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+      if (v[0] == p || v[1] == p || v[2] == p) continue;
+      if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) continue;
+      const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+      double bary[3];
+      const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
+      const double motion = motion_p + std::max({(x1[v[0]] - x0[v[0]]).norm(), (x1[v[1]] - x0[v[1]]).norm(),
+                                                 (x1[v[2]] - x0[v[2]]).norm()});
+      if (d0 >= thk + motion) continue;
+      if (s.point_body[pi] == s.tri_body[t]) {  // neighbours on the surface that rest within reach
+        const BodyInfo& b = in.bodies[s.tri_body[t]];
+        double rb[3];
+        if (point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), rb) < thk)
+          continue;
+      }
+      double toi;
+      const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
+      Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+      Vec3 primary = side;  // closest points at the start
+      if (point_triangle_toi(x0[p], x1[p], x0[v[0]], x1[v[0]], x0[v[1]], x1[v[1]], x0[v[2]], x1[v[2]], thk, toi)) {
+        point_triangle_distance(lerp(x0[p], x1[p], toi), lerp(x0[v[0]], x1[v[0]], toi), lerp(x0[v[1]], x1[v[1]], toi),
+                                lerp(x0[v[2]], x1[v[2]], toi), bary);
+        side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+        primary = tri_n;  // touching within the substep: hold it on the triangle's side it came from
+      }
+      SelfContact c{};
+      c.ids[0] = p;
+      for (int k = 0; k < 3; ++k) c.ids[k + 1] = v[k];
+      c.weight[0] = 1.0;
+      for (int k = 0; k < 3; ++k) c.weight[k + 1] = -bary[k];
+      if (!orient_normal(primary, side, side, c.normal) &&
+          !orient_normal(tri_n, x1[p] - x0[p], x0[p] - x1[p], c.normal))
+        continue;
+      c.thickness = thk;
+      c.mu_s = mean_mu(in.mu_s, c.ids);
+      c.mu_k = mean_mu(in.mu_k, c.ids);
+      out.push_back(c);
+    }
+  }
+
+  // Edge against edge.
+  for (size_t ea = 0; ea < ne; ++ea) {
+    const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1];
+    s.edge_grid.query(s.edge_boxes[ea], s.cand);
+    const double motion_a = std::max((x1[a0] - x0[a0]).norm(), (x1[a1] - x0[a1]).norm());
+    for (int32_t eb : s.cand) {
+      if (static_cast<size_t>(eb) <= ea) continue;
+      const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
+      if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
+      if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) continue;
+      const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+      double sa, tb;
+      const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
+      const double motion = motion_a + std::max((x1[b0] - x0[b0]).norm(), (x1[b1] - x0[b1]).norm());
+      if (d0 >= thk + motion) continue;
+      if (s.edge_body[ea] == s.edge_body[eb]) {
+        const BodyInfo& b = in.bodies[s.edge_body[ea]];
+        double rs, rt;
+        if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), rs, rt) < thk) continue;
+      }
+      const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
+      Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+      Vec3 primary = side;
+      double toi;
+      if (edge_edge_toi(x0[a0], x0[a1], x0[b0], x0[b1], x1[a0], x1[a1], x1[b0], x1[b1], thk, toi)) {
+        edge_edge_distance(lerp(x0[a0], x1[a0], toi), lerp(x0[a1], x1[a1], toi), lerp(x0[b0], x1[b0], toi),
+                           lerp(x0[b1], x1[b1], toi), sa, tb);
+        side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+        primary = cross;
+      }
+      SelfContact c{};
+      c.ids[0] = a0;
+      c.ids[1] = a1;
+      c.ids[2] = b0;
+      c.ids[3] = b1;
+      c.weight[0] = 1.0 - sa;
+      c.weight[1] = sa;
+      c.weight[2] = -(1.0 - tb);
+      c.weight[3] = -tb;
+      if (!orient_normal(primary, side, side, c.normal) && !orient_normal(cross, Vec3::Zero(), side, c.normal))
+        continue;
+      c.thickness = thk;
+      c.mu_s = mean_mu(in.mu_s, c.ids);
+      c.mu_k = mean_mu(in.mu_k, c.ids);
+      out.push_back(c);
+    }
+  }
+}
+
+// --- resolution ------------------------------------------------------------------------------------
+
+namespace {
+double constraint(const SelfContact& c, std::span<const Vec3> x) {
+  Vec3 sum = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) sum += c.weight[k] * x[c.ids[k]];
+  return c.normal.dot(sum) - c.thickness;
+}
+
+double denominator(const SelfContact& c, std::span<const double> w) {
+  double d = 0.0;
+  for (int k = 0; k < 4; ++k) d += w[c.ids[k]] * c.weight[k] * c.weight[k];
+  return d;
+}
+}  // namespace
+
+void project(std::span<SelfContact> contacts, std::span<Vec3> x, std::span<const double> w) {
+  for (SelfContact& c : contacts) {
+    const double denom = denominator(c, w);
+    if (denom <= 0.0) continue;
+    const double C = constraint(c, x);
+    const double dl = std::max(c.lambda - C / denom, 0.0) - c.lambda;
+    if (dl == 0.0) continue;
+    c.lambda += dl;
+    for (int k = 0; k < 4; ++k) x[c.ids[k]] += (w[c.ids[k]] * c.weight[k] * dl) * c.normal;
+  }
+}
+
+void add_corrections(std::span<const SelfContact> contacts, std::span<const double> w, std::span<Vec3> out) {
+  for (const SelfContact& c : contacts) {
+    if (c.lambda == 0.0) continue;
+    for (int k = 0; k < 4; ++k) out[c.ids[k]] += (w[c.ids[k]] * c.weight[k] * c.lambda) * c.normal;
+  }
+}
+
+void apply_friction(std::span<const SelfContact> contacts, std::span<Vec3> x, std::span<const Vec3> x_prev,
+                    std::span<const double> w) {
+  for (const SelfContact& c : contacts) {
+    if (c.lambda <= 0.0) continue;
+    const double denom = denominator(c, w);
+    if (denom <= 0.0) continue;
+    Vec3 slip = Vec3::Zero();  // relative motion of the two sides over the substep
+    for (int k = 0; k < 4; ++k) slip += c.weight[k] * (x[c.ids[k]] - x_prev[c.ids[k]]);
+    const Vec3 tangential = slip - slip.dot(c.normal) * c.normal;
+    const double len = tangential.norm();
+    const double push = denom * c.lambda;  // the normal correction, a length
+    double f;
+    if (len < c.mu_s * push)
+      f = 1.0;
+    else if (len > 0.0)
+      f = std::min(c.mu_k * push / len, 1.0);
+    else
+      continue;
+    // Remove the fraction f of the relative tangential motion, shared by inverse mass.
+    for (int k = 0; k < 4; ++k) x[c.ids[k]] -= (f * w[c.ids[k]] * c.weight[k] / denom) * tangential;
+  }
+}
+
+double penetration(const SelfContact& c, std::span<const Vec3> x) {
+  return std::max(-constraint(c, x), 0.0);
+}
+
+}  // namespace embra::self_collision
+
+namespace embra {
+
+void World::find_self_contacts() {
+  if (settings_.self_collision == 0) {
+    self_contacts_.clear();
+    return;
+  }
+  self_collision::Input in{bodies_, x_prev_, x_, w_, radius_, mu_s_, mu_k_};
+  self_collision::find_contacts(in, self_contacts_);
+}
+
+}  // namespace embra

@@ -1,0 +1,256 @@
+// Self-collision (issue 4): the narrow phase against hand-computed distances and times of contact,
+// the exact crossing count, and a folded cloth dropped on a plane that must never pass through
+// itself (no edge of the cloth crossing one of its triangles after any frame, counted exactly).
+#include "self_collision.hpp"
+
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace embra {
+namespace {
+
+namespace sc = self_collision;
+
+TEST(SelfCollisionNarrow, PointTriangleDistance) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  double bary[3];
+  // Above the face: the foot of the perpendicular, (0.2, 0.2, 0) = 0.6 a + 0.2 b + 0.2 c.
+  EXPECT_DOUBLE_EQ(sc::point_triangle_distance(Vec3(0.2, 0.2, 1.0), a, b, c, bary), 1.0);
+  EXPECT_NEAR(bary[0], 0.6, 1e-15);
+  EXPECT_NEAR(bary[1], 0.2, 1e-15);
+  EXPECT_NEAR(bary[2], 0.2, 1e-15);
+  // Beyond the corner a.
+  EXPECT_DOUBLE_EQ(sc::point_triangle_distance(Vec3(-1, -1, 0), a, b, c, bary), std::sqrt(2.0));
+  EXPECT_EQ(bary[0], 1.0);
+  // Beside the edge ab: closest (0.5, 0, 0), distance sqrt(1 + 4).
+  EXPECT_NEAR(sc::point_triangle_distance(Vec3(0.5, -1, 2), a, b, c, bary), std::sqrt(5.0), 1e-15);
+  EXPECT_NEAR(bary[0], 0.5, 1e-15);
+  EXPECT_NEAR(bary[1], 0.5, 1e-15);
+  EXPECT_EQ(bary[2], 0.0);
+  // Beside the hypotenuse bc: (1, 1, 0) is sqrt(2)/2 from (0.5, 0.5, 0).
+  EXPECT_NEAR(sc::point_triangle_distance(Vec3(1, 1, 0), a, b, c, bary), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(bary[1], 0.5, 1e-15);
+  EXPECT_NEAR(bary[2], 0.5, 1e-15);
+}
+
+TEST(SelfCollisionNarrow, EdgeEdgeDistance) {
+  double s, t;
+  // Crossing at right angles one unit apart, at their midpoints.
+  EXPECT_DOUBLE_EQ(sc::edge_edge_distance(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, -1, 1), Vec3(0.5, 1, 1), s, t), 1.0);
+  EXPECT_DOUBLE_EQ(s, 0.5);
+  EXPECT_DOUBLE_EQ(t, 0.5);
+  // Skew, closest points inside: a along x at z = 0, b along y at z = 2 through x = 0.25.
+  EXPECT_DOUBLE_EQ(sc::edge_edge_distance(Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0.5, -3, 2), Vec3(0.5, 1, 2), s, t), 2.0);
+  EXPECT_DOUBLE_EQ(s, 0.25);
+  EXPECT_DOUBLE_EQ(t, 0.75);
+  // Parallel, offset past the end: nearest are (1, 0, 0) and (2, 1, 0).
+  EXPECT_NEAR(sc::edge_edge_distance(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 1, 0), Vec3(3, 1, 0), s, t), std::sqrt(2.0),
+              1e-15);
+  EXPECT_DOUBLE_EQ(s, 1.0);
+  EXPECT_DOUBLE_EQ(t, 0.0);
+  // Clamped at one end: b's end (1.5, 0, 1) against a's end (1, 0, 0).
+  EXPECT_NEAR(sc::edge_edge_distance(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1.5, 0, 1), Vec3(3, 0, 4), s, t),
+              std::sqrt(1.25), 1e-15);
+  EXPECT_DOUBLE_EQ(s, 1.0);
+  EXPECT_DOUBLE_EQ(t, 0.0);
+}
+
+TEST(SelfCollisionNarrow, PointTriangleTimeOfContact) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  double t = -1;
+  // Straight down through a still triangle: coplanar half way.
+  ASSERT_TRUE(sc::point_triangle_toi(Vec3(0.25, 0.25, 1), Vec3(0.25, 0.25, -1), a, a, b, b, c, c, 1e-12, t));
+  EXPECT_NEAR(t, 0.5, 1e-14);
+  // 1000 times faster: the same crossing time.
+  ASSERT_TRUE(sc::point_triangle_toi(Vec3(0.25, 0.25, 1000), Vec3(0.25, 0.25, -1000), a, a, b, b, c, c, 1e-9, t));
+  EXPECT_NEAR(t, 0.5, 1e-14);
+  // Both moving: point z = 1 - t, triangle z = 0.5 t meet at t = 2/3.
+  const Vec3 up(0, 0, 0.5);
+  ASSERT_TRUE(sc::point_triangle_toi(Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, 0), a, a + up, b, b + up, c, c + up, 1e-12, t));
+  EXPECT_NEAR(t, 2.0 / 3.0, 1e-14);
+  // A rotating triangle: corner c swings from z = -1 to z = +1 while the point rests at
+  // (0.1, 0.1, 0.05): plane height at (0.1, 0.1) is 0.1 c_z, c_z = -1 + 2t, so t = 0.75.
+  ASSERT_TRUE(sc::point_triangle_toi(Vec3(0.1, 0.1, 0.05), Vec3(0.1, 0.1, 0.05), a, a, b, b, Vec3(0, 1, -1),
+                                     Vec3(0, 1, 1), 1e-12, t));
+  EXPECT_NEAR(t, 0.75, 1e-14);
+  // Passing beside the triangle: never touches.
+  EXPECT_FALSE(sc::point_triangle_toi(Vec3(2, 2, 1), Vec3(2, 2, -1), a, a, b, b, c, c, 1e-12, t));
+  // Moving parallel above it: never touches.
+  EXPECT_FALSE(sc::point_triangle_toi(Vec3(0.1, 0.1, 1), Vec3(0.3, 0.3, 1), a, a, b, b, c, c, 1e-12, t));
+}
+
+TEST(SelfCollisionNarrow, EdgeEdgeTimeOfContact) {
+  const Vec3 a0(0, 0, 0), a1(1, 0, 0);
+  double t = -1;
+  // b (along y over x = 0.5) falls from z = 1 to z = -1 through the still edge a.
+  ASSERT_TRUE(sc::edge_edge_toi(a0, a1, Vec3(0.5, -1, 1), Vec3(0.5, 1, 1), a0, a1, Vec3(0.5, -1, -1), Vec3(0.5, 1, -1),
+                                1e-12, t));
+  EXPECT_NEAR(t, 0.5, 1e-14);
+  // b falls from z = 3 to z = -1 while a rises to z = 1: z_b = 3 - 4t meets z_a = t at t = 0.6.
+  const Vec3 up(0, 0, 1);
+  ASSERT_TRUE(sc::edge_edge_toi(a0, a1, Vec3(0.5, -1, 3), Vec3(0.5, 1, 3), a0 + up, a1 + up, Vec3(0.5, -1, -1),
+                                Vec3(0.5, 1, -1), 1e-12, t));
+  EXPECT_NEAR(t, 0.6, 1e-14);
+  // b passes beyond a's end (x = 2): the lines meet, the segments never do.
+  EXPECT_FALSE(
+      sc::edge_edge_toi(a0, a1, Vec3(2, -1, 1), Vec3(2, 1, 1), a0, a1, Vec3(2, -1, -1), Vec3(2, 1, -1), 1e-12, t));
+}
+
+TEST(SelfCollisionExact, Orient3dAndCrossing) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_EQ(sc::orient3d(a, b, c, Vec3(0.3, 0.3, 1)), 1);
+  EXPECT_EQ(sc::orient3d(a, b, c, Vec3(0.3, 0.3, -1)), -1);
+  // Exactly coplanar points whose floating-point determinant is pure rounding: large offsets and
+  // a tiny in-plane triangle. p = a + u + v is coplanar for any u, v in the plane z = 1e8 + 0.1.
+  const Vec3 o(1e8 + 0.1, 3e8 + 0.3, 1e8 + 0.1);
+  const Vec3 p0 = o, p1 = o + Vec3(0.5, 0.25, 0), p2 = o + Vec3(0.125, 0.75, 0), p3 = o + Vec3(0.625, 1.0, 0);
+  EXPECT_EQ(sc::orient3d(p0, p1, p2, p3), 0);
+  EXPECT_EQ(sc::orient3d(p0, p1, p2, p3 + Vec3(0, 0, 0x1.0p-26)), 1);  // one ulp of 1e8 above
+  EXPECT_EQ(sc::orient3d(p0, p1, p2, p3 - Vec3(0, 0, 0x1.0p-26)), -1);
+  // Segments through, beside, touching and in the plane.
+  EXPECT_TRUE(sc::segment_crosses_triangle(Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, -1), a, b, c));
+  EXPECT_TRUE(sc::segment_crosses_triangle(Vec3(0.5, 0.0, 1), Vec3(0.5, 0.0, -1), a, b, c));  // on an edge
+  EXPECT_FALSE(sc::segment_crosses_triangle(Vec3(0.6, 0.6, 1), Vec3(0.6, 0.6, -1), a, b, c));
+  EXPECT_FALSE(sc::segment_crosses_triangle(Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, 0), a, b, c));  // ends on it
+  EXPECT_FALSE(sc::segment_crosses_triangle(Vec3(-1, 0.2, 0), Vec3(1, 0.2, 0), a, b, c));     // in the plane
+  // The count over a mesh: a square of two triangles pierced by one vertical edge.
+  const std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1, 0, 0),     Vec3(1, 1, 0),
+                               Vec3(0, 1, 0), Vec3(0.7, 0.2, 1), Vec3(0.7, 0.2, -1)};
+  const std::vector<int32_t> tris = {0, 1, 2, 0, 2, 3};
+  const std::vector<int32_t> edges = {4, 5, 0, 2, 1, 4};
+  EXPECT_EQ(sc::count_edge_triangle_crossings(x, edges, tris), 1);
+}
+
+/// A cloth of n x n particles, 1 m square, created flat (its rest shape) and then folded along its
+/// diagonal over a half cylinder of radius `radius` (an isometry, so it starts unstretched): the
+/// lower half lies at height z0, the upper half is turned over onto it, 2 radius higher.
+struct FoldedCloth {
+  Id body;
+  std::vector<int32_t> edges, triangles;
+};
+
+FoldedCloth folded_cloth(World& w, int n, double thickness, double z0, double radius) {
+  const double size = 1.0, step = size / (n - 1);
+  std::vector<double> flat;
+  std::vector<Vec3> folded;
+  const Vec3 u = Vec3(1, 1, 0).normalized(), v = Vec3(-1, 1, 0).normalized();  // along, across the fold
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p(-0.5 * size + i * step, -0.5 * size + j * step, 0.0);
+      flat.insert(flat.end(), {p.x(), p.y(), p.z()});
+      // distance across the fold line (the diagonal x + y = 0), offset a little off the grid's
+      // diagonal so the crease does not run along edges
+      const double a = p.dot(u), d = p.dot(v) + 0.013;
+      Vec3 q;
+      if (d <= 0.0) {
+        q = a * u + d * v;
+      } else if (d < std::numbers::pi * radius) {
+        const double th = d / radius;
+        q = a * u + radius * std::sin(th) * v + Vec3(0, 0, radius * (1.0 - std::cos(th)));
+      } else {
+        q = a * u - (d - std::numbers::pi * radius) * v + Vec3(0, 0, 2.0 * radius);
+      }
+      q -= 0.013 * v;
+      folded.push_back(q + Vec3(0, 0, z0));
+    }
+  std::vector<int32_t> tris;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const int32_t a = j * n + i, b = a + 1, c = a + n + 1, e = a + n;
+      tris.insert(tris.end(), {a, b, c, a, c, e});
+    }
+  BodyDesc desc;
+  desc.positions = flat;
+  desc.triangles = tris;
+  desc.material.mass = 1.0;
+  desc.material.thickness = thickness;
+  desc.generate = generate_stretch;  // no bending stiffness: the upper layer falls onto the lower
+  FoldedCloth c;
+  c.body = w.create_body(desc);
+  const BodyInfo& b = w.body(c.body);
+  std::vector<double> xyz;
+  for (const Vec3& q : folded) xyz.insert(xyz.end(), {q.x(), q.y(), q.z()});
+  w.set_positions(b.first_particle, xyz);
+  c.edges = b.edges;
+  c.triangles = b.triangles;
+  return c;
+}
+
+TEST(SelfCollisionWorld, FoldedClothNeverPassesThroughItself) {
+  Settings s;
+  s.self_collision = 1;
+  World w(s);
+  ColliderDesc ground;  // the plane z = 0
+  w.create_collider(ground);
+  const double thickness = 0.01;
+  FoldedCloth c = folded_cloth(w, 32, thickness, 0.15, 0.06);
+  ASSERT_EQ(sc::count_edge_triangle_crossings(w.positions(), c.edges, c.triangles), 0);
+  int64_t max_contacts = 0;
+  double lowest = 1e300;
+  for (int f = 0; f < 90; ++f) {
+    w.step();
+    ASSERT_EQ(sc::count_edge_triangle_crossings(w.positions(), c.edges, c.triangles), 0) << "frame " << f;
+    max_contacts = std::max(max_contacts, w.report().contact_count);
+    for (const Vec3& p : w.positions()) lowest = std::min(lowest, p.z());
+  }
+  // It did land and fold onto itself: the upper layer came down to the lower one.
+  double top = -1e300;
+  for (const Vec3& p : w.positions()) top = std::max(top, p.z());
+  RecordProperty("max_contacts", std::to_string(max_contacts));
+  RecordProperty("top_after_90_frames", test::sci(top));
+  EXPECT_GT(lowest, 0.5 * thickness - 1e-3);
+  EXPECT_LT(top, 0.1);
+  // The contacts outnumber the particles (one collider: at most one each), so the cloth did touch
+  // itself.
+  EXPECT_GT(max_contacts, w.particle_count());
+}
+
+TEST(SelfCollisionWorld, WithoutItTheFoldPassesThrough) {
+  // The same drop with self-collision off: the exact count does see the cloth passing through
+  // itself, so the zero above means something.
+  World w;
+  ColliderDesc ground;
+  w.create_collider(ground);
+  FoldedCloth c = folded_cloth(w, 32, 0.01, 0.15, 0.06);
+  int64_t crossings = 0;
+  for (int f = 0; f < 90 && crossings == 0; ++f) {
+    w.step();
+    crossings = sc::count_edge_triangle_crossings(w.positions(), c.edges, c.triangles);
+    if (crossings > 0) RecordProperty("first_crossing_frame", std::to_string(f));
+  }
+  EXPECT_GT(crossings, 0);
+}
+
+TEST(SelfCollisionWorld, Deterministic) {
+  auto run = [] {
+    Settings s;
+    s.self_collision = 1;
+    World w(s);
+    ColliderDesc ground;
+    w.create_collider(ground);
+    folded_cloth(w, 16, 0.02, 0.1, 0.05);
+    for (int f = 0; f < 30; ++f) w.step();
+    return w.positions();
+  };
+  const std::vector<Vec3> a = run(), b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+}
+
+TEST(SelfCollisionWorld, SettingIsValidated) {
+  World w;
+  Settings s = w.settings();
+  s.self_collision = 2;
+  EXPECT_THROW(w.set_settings(s), Error);
+  s.self_collision = 1;
+  w.set_settings(s);
+  EXPECT_EQ(w.settings().self_collision, 1);
+}
+
+}  // namespace
+}  // namespace embra
