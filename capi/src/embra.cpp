@@ -559,6 +559,8 @@ embra_collider_def embra_default_collider_def(void) {
   d.thickness = c.thickness;
   d.friction_static = c.friction_static;
   d.friction_dynamic = c.friction_dynamic;
+  for (int k = 0; k < 3; ++k) d.half_extents[k] = c.half_extents[k];
+  d.half_length = c.half_length;
   return d;
 }
 
@@ -576,6 +578,20 @@ embra_status embra_collider_create(embra_world* world, const embra_collider_def*
     need_version(def->version, EMBRA_COLLIDER_DEF_VERSION, "embra_collider_def");
     // Core checks the radius of spheres only; a non-finite number is refused in every field.
     if (!std::isfinite(def->radius)) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.radius is not a finite number");
+    if (!std::isfinite(def->half_length))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.half_length is not a finite number");
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(def->half_extents[k]))
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.half_extents is not a finite number");
+    const bool points = def->shape == EMBRA_COLLIDER_CONVEX || def->shape == EMBRA_COLLIDER_MESH;
+    const bool mesh = def->shape == EMBRA_COLLIDER_MESH;
+    if (def->vertex_count < 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.vertex_count is negative");
+    if (def->triangle_count < 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.triangle_count is negative");
+    if (points && def->vertex_count > 0 && !def->vertices)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.vertices is NULL but def.vertex_count is " + num(def->vertex_count));
+    if (mesh && def->triangle_count > 0 && !def->triangles)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+             "def.triangles is NULL but def.triangle_count is " + num(def->triangle_count));
     embra::ColliderDesc d;
     d.shape = static_cast<embra::ColliderShape>(def->shape);
     d.position = vec(def->position);
@@ -584,6 +600,10 @@ embra_status embra_collider_create(embra_world* world, const embra_collider_def*
     d.thickness = def->thickness;
     d.friction_static = def->friction_static;
     d.friction_dynamic = def->friction_dynamic;
+    d.half_extents = vec(def->half_extents);
+    d.half_length = def->half_length;
+    if (points) d.vertices.assign(def->vertices, def->vertices + 3 * static_cast<int64_t>(def->vertex_count));
+    if (mesh) d.triangles.assign(def->triangles, def->triangles + 3 * static_cast<int64_t>(def->triangle_count));
     *out_collider = from_id<embra_collider_id>(world->world.create_collider(d));
   });
 }

@@ -2,6 +2,8 @@
 // validates everything first and only then changes the world.
 #include "embra/core/world.hpp"
 
+#include "collider_shapes.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -1096,7 +1098,7 @@ void check_transform(const Vec3& position, const Eigen::Quaterniond& rotation) {
 
 Id World::create_collider(const ColliderDesc& desc) {
   const int shape = static_cast<int>(desc.shape);
-  if (shape < 0 || shape > 1) invalid("unknown collider shape " + std::to_string(shape));
+  if (shape < 0 || shape >= kColliderShapeCount) invalid("unknown collider shape " + std::to_string(shape));
   check_transform(desc.position, desc.rotation);
   check_non_negative(desc.thickness, "collider thickness");
   check_non_negative(desc.friction_static, "collider friction_static");
@@ -1105,6 +1107,7 @@ Id World::create_collider(const ColliderDesc& desc) {
     check_finite(desc.radius, "sphere radius");
     if (desc.radius <= 0.0) invalid("sphere radius must be > 0");
   }
+  std::shared_ptr<const ColliderGeometry> geometry = build_collider_geometry(desc);  // validates the shape
   size_t slot = colliders_.size();
   for (size_t i = 0; i < colliders_.size(); ++i)
     if (!colliders_[i].alive) {
@@ -1117,6 +1120,7 @@ Id World::create_collider(const ColliderDesc& desc) {
   c = Collider{};
   c.desc = desc;
   c.desc.rotation.normalize();
+  c.geometry = std::move(geometry);
   c.frame_position = c.position = c.position_prev = desc.position;
   c.frame_rotation = c.rotation = c.rotation_prev = c.desc.rotation;
   c.generation = generation;

@@ -121,7 +121,10 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_pin_def, target), 8);
   CHECK_INT(offsetof(embra_pin_def, group), 40);
 
-  CHECK_INT(sizeof(embra_collider_def), 4 + 4 + 24 + 32 + 4 * 8);
+  CHECK_INT(sizeof(embra_collider_def), 4 + 4 + 24 + 32 + 4 * 8 + 24 + 8 + 4 + 4 + 2 * (int)sizeof(void*));
+  CHECK_INT(offsetof(embra_collider_def, half_extents), 96);
+  CHECK_INT(offsetof(embra_collider_def, vertex_count), 128);
+  CHECK_INT(offsetof(embra_collider_def, vertices), 136);
   CHECK_INT(offsetof(embra_collider_def, rotation), 32);
   CHECK_INT(offsetof(embra_collider_def, radius), 64);
 

@@ -1200,9 +1200,9 @@ static void test_colliders(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_collider", embra_collider_create(W, &d, NULL));
   d.version = 0;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_collider_create(W, &d, &out));
-  d.version = 2;
+  d.version = 3;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_collider_create(W, &d, &out));
-  GOOD_COLLIDER(2);
+  GOOD_COLLIDER(6);
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "shape", embra_collider_create(W, &d, &out));
   GOOD_COLLIDER(-1);
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "shape", embra_collider_create(W, &d, &out));

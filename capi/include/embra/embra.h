@@ -381,21 +381,43 @@ EMBRA_API embra_status embra_pin_get_target(const embra_world* world, embra_pin_
 
 typedef int32_t embra_collider_shape;
 enum {
-  EMBRA_COLLIDER_PLANE = 0, /* the half-space below the plane through `position` with normal
-                               rotation * (0, 0, 1); particles stay above */
-  EMBRA_COLLIDER_SPHERE = 1 /* solid sphere of `radius` centred at `position` */
+  EMBRA_COLLIDER_PLANE = 0,   /* the half-space below the plane through `position` with normal
+                                 rotation * (0, 0, 1); particles stay above */
+  EMBRA_COLLIDER_SPHERE = 1,  /* solid sphere of `radius` centred at `position` */
+  EMBRA_COLLIDER_BOX = 2,     /* solid box of `half_extents` along its local x, y, z */
+  EMBRA_COLLIDER_CAPSULE = 3, /* points within `radius` of the segment from local (0, 0, -half_length)
+                                 to (0, 0, half_length) */
+  EMBRA_COLLIDER_CONVEX = 4,  /* solid convex hull of `vertex_count` local points (at least 4, not all
+                                 in one plane) */
+  EMBRA_COLLIDER_MESH = 5     /* triangle mesh of local `vertices` and `triangles`. Closed (every edge
+                                 shared by exactly two triangles, wound consistently): a solid,
+                                 particles stay outside. Open: a two-sided sheet, particles stay on
+                                 the side they come from. */
 };
 
-#define EMBRA_COLLIDER_DEF_VERSION 1
+/* Every shape moves with the pose the host sets (embra_collider_set_transform); contacts are found
+ * along each particle's path over each substep, against the collider's motion over that substep,
+ * so no speed carries a particle through a thin or moving collider. Geometry arrays are copied at
+ * creation; they are not read afterwards. */
+#define EMBRA_COLLIDER_DEF_VERSION 2
 typedef struct embra_collider_def {
   int32_t version; /* EMBRA_COLLIDER_DEF_VERSION */
   embra_collider_shape shape;
   double position[3];      /* m */
   double rotation[4];      /* unit quaternion {w, x, y, z}; default identity {1, 0, 0, 0} */
-  double radius;           /* m, sphere only, > 0; default 1 */
+  double radius;           /* m, sphere and capsule, > 0; default 1 */
   double thickness;        /* m, extra clearance; default 0 */
   double friction_static;  /* default 0.5 */
   double friction_dynamic; /* default 0.3 */
+  /* Fields added in version 2. */
+  double half_extents[3];   /* m, box only, each > 0; default {0.5, 0.5, 0.5} */
+  double half_length;       /* m, capsule only, >= 0 (0 = a sphere); default 0.5 */
+  int32_t vertex_count;     /* convex (>= 4) and mesh (>= 3) only; default 0 */
+  int32_t triangle_count;   /* mesh only, > 0; default 0 */
+  const double* vertices;   /* m, 3 per vertex, local frame; convex and mesh only; default NULL */
+  const int32_t* triangles; /* mesh only: 3 vertex indices (0-based) per triangle, counter-clockwise
+                               seen from outside for a closed mesh (one wound all inward is turned);
+                               none may have zero area; default NULL */
 } embra_collider_def;
 
 EMBRA_API embra_collider_def embra_default_collider_def(void);
