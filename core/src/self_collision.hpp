@@ -37,6 +37,7 @@ struct Input {
   std::span<const double> w;       // inverse masses (0 = immovable or hard-pinned)
   std::span<const double> radius;  // half thickness per particle
   std::span<const double> mu_s, mu_k;
+  SelfCollisionCache* cache;  // the candidate pairs, kept from substep to substep while they hold
 };
 
 /// Finds the contacts of one substep (replaces `out`), in a deterministic order.
