@@ -9,6 +9,7 @@
 //   measure            residuals per group, kinetic energy, settled flag
 #include "embra/core/world.hpp"
 
+#include "collider_shapes.hpp"
 #include "lanes.hpp"
 #include "self_collision.hpp"
 
@@ -357,6 +358,10 @@ void World::find_contacts() {
   for (size_t c = 0; c < colliders_.size(); ++c) {
     const Collider& col = colliders_[c];
     if (!col.alive) continue;
+    if (col.geometry) {
+      find_shape_contacts(static_cast<int32_t>(c), g.contacts);
+      continue;
+    }
     const Vec3 normal = col.rotation * Vec3::UnitZ();
     for (size_t i = 0; i < x_.size(); ++i) {
       if (w_[i] == 0.0) continue;
@@ -377,6 +382,62 @@ void World::find_contacts() {
   }
 }
 
+void World::find_shape_contacts(int32_t index, std::vector<Contact>& out) const {
+  const Collider& col = colliders_[index];
+  const ColliderGeometry& geo = *col.geometry;
+  // Convex solids have a convex distance along any straight path, so a Newton step towards the
+  // surface never passes it; a mesh advances by the distance alone (the distance changes at most
+  // as fast as the point moves).
+  const bool convex = col.desc.shape != ColliderShape::mesh;
+  Vec3 lo, hi;
+  shape_bounds(col.desc, geo, lo, hi);
+  const Eigen::Quaterniond inv_prev = col.rotation_prev.conjugate(), inv = col.rotation.conjugate();
+  for (size_t i = 0; i < x_.size(); ++i) {
+    if (w_[i] == 0.0) continue;
+    // The particle's path in the collider's frame, from where it was against the collider's pose at
+    // the start of the substep to where it is against the pose at the end: the collider's motion is
+    // part of the path.
+    const Vec3 a0 = inv_prev * (x_prev_[i] - col.position_prev);
+    const Vec3 a1 = inv * (x_[i] - col.position);
+    const double r = radius_[i] + col.desc.thickness;
+    const Vec3 seg = a1 - a0;
+    const double len = seg.norm();
+    const double margin = r + (x_[i] - x_prev_[i]).norm();
+    if ((a0.cwiseMin(a1).array() > hi.array() + margin).any() || (a0.cwiseMax(a1).array() < lo.array() - margin).any())
+      continue;
+    const int32_t particle = static_cast<int32_t>(i);
+    Vec3 n;
+    double d = shape_distance(col.desc, geo, a0, n) - r;
+    if (d < 0.0) {  // inside at the start (if only by rounding): out by the way nearest to where it was
+      out.push_back(Contact{particle, index, 0.0, true, n, n.dot(a0) - d});
+      continue;
+    }
+    // Conservative advancement along the path to its first contact with the clearance surface.
+    const double tol = 1e-13 * (1.0 + a0.cwiseAbs().maxCoeff() + len + r);
+    double t = 0.0;
+    bool hit = d <= tol;
+    for (int it = 0; it < 200 && !hit && len > 0.0; ++it) {
+      double rate = len;
+      if (convex) {
+        rate = -n.dot(seg);
+        if (rate <= 0.0) break;  // moving away from a convex solid: no contact on this path
+      }
+      t += d / rate;
+      if (t > 1.0) break;
+      d = shape_distance(col.desc, geo, a0 + t * seg, n) - r;
+      hit = d <= tol || it == 199;
+    }
+    if (hit) {
+      // Held on the tangent plane where the path met the surface: it leaves the way it came.
+      const Vec3 p = a0 + t * seg;
+      out.push_back(Contact{particle, index, 0.0, true, n, n.dot(p) - d});
+      continue;
+    }
+    d = shape_distance(col.desc, geo, a1, n) - r;
+    if (d < (x_[i] - x_prev_[i]).norm()) out.push_back(Contact{particle, index, 0.0, false, Vec3::Zero(), 0.0});
+  }
+}
+
 void World::reset_multipliers() {
   for (int32_t slot : order_) {
     Group& g = groups_[slot];
@@ -388,6 +449,7 @@ void World::reset_multipliers() {
 
 namespace {
 double collider_gap(const Collider& c, const Vec3& x, const Vec3& from, Vec3& normal);
+double contact_gap(const Collider& c, const Contact& ct, const Vec3& x, const Vec3& from, double r, Vec3& normal);
 
 /// Adds w_k lambda grad_k C(x) of every constraint of a solver array to `out`.
 template <Kind K>
@@ -425,7 +487,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
     for (const Contact& ct : g.contacts) {
       if (ct.lambda == 0.0) continue;
       Vec3 n;
-      collider_gap(colliders_[ct.collider], x_[ct.particle], x_prev_[ct.particle], n);
+      contact_gap(colliders_[ct.collider], ct, x_[ct.particle], x_prev_[ct.particle], 0.0, n);
       corr[ct.particle] += ct.lambda * n;
     }
   }
@@ -479,6 +541,21 @@ double collider_gap(const Collider& c, const Vec3& x, const Vec3& from, Vec3& no
   normal = d / len;
   return len - c.desc.radius;
 }
+
+/// Signed gap of a contact's particle at `x` beyond the clearance `r` (the particle's radius plus
+/// the collider's thickness), and the outward normal it is pushed along.
+double contact_gap(const Collider& c, const Contact& ct, const Vec3& x, const Vec3& from, double r, Vec3& normal) {
+  if (!c.geometry) return collider_gap(c, x, from, normal) - r;
+  const Vec3 local = c.rotation.conjugate() * (x - c.position);
+  if (ct.swept) {
+    normal = c.rotation * ct.normal;
+    return ct.normal.dot(local) - ct.offset;
+  }
+  Vec3 n;
+  const double d = shape_distance(c.desc, *c.geometry, local, n);
+  normal = c.rotation * n;
+  return d - r;
+}
 }  // namespace
 
 void World::project_contacts(Group& g, double /*h*/) {
@@ -486,7 +563,7 @@ void World::project_contacts(Group& g, double /*h*/) {
     const Collider& c = colliders_[ct.collider];
     const int32_t i = ct.particle;
     Vec3 n;
-    const double gap = collider_gap(c, x_[i], x_prev_[i], n) - radius_[i] - c.desc.thickness;
+    const double gap = contact_gap(c, ct, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
     // Hard, unilateral: C = gap >= 0; lambda accumulates the push (a length, as w_i cancels).
     const double dl = std::max(ct.lambda - gap, 0.0) - ct.lambda;
     ct.lambda += dl;
@@ -503,7 +580,7 @@ void World::update_velocities(double h) {
     const Collider& c = colliders_[ct.collider];
     const int32_t i = ct.particle;
     Vec3 n;
-    collider_gap(c, x_[i], x_prev_[i], n);
+    contact_gap(c, ct, x_[i], x_prev_[i], 0.0, n);
     const Vec3 slip = (x_[i] - x_prev_[i]) - (x_[i] - collider_point_before(c, x_[i]));
     const Vec3 tangential = slip - slip.dot(n) * n;
     const double len = tangential.norm();
@@ -562,7 +639,7 @@ void World::measure() {
       Vec3 normal;
       const Collider& c = colliders_[ct.collider];
       const double gap =
-          collider_gap(c, x_[ct.particle], x_prev_[ct.particle], normal) - radius_[ct.particle] - c.desc.thickness;
+          contact_gap(c, ct, x_[ct.particle], x_prev_[ct.particle], radius_[ct.particle] + c.desc.thickness, normal);
       const double r = std::max(-gap, 0.0);
       max = std::max(max, r);
       sq += r * r;

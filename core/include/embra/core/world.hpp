@@ -10,12 +10,15 @@
 #include "embra/core/constraint_math.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace embra {
+
+struct ColliderGeometry;  // collider_shapes.hpp
 
 /// Error categories; the C ABI maps them one to one onto its status codes.
 enum class ErrorCode : int32_t {
@@ -110,14 +113,21 @@ struct PinDesc {
   Id group;                 // group of a soft pin; null = the default group
 };
 
-enum class ColliderShape : int32_t { plane = 0, sphere = 1 };
+/// The numbering is part of the C ABI (embra_collider_shape).
+enum class ColliderShape : int32_t { plane = 0, sphere = 1, box = 2, capsule = 3, convex = 4, mesh = 5 };
+constexpr int kColliderShapeCount = 6;
 
 struct ColliderDesc {
   ColliderShape shape = ColliderShape::plane;
   Vec3 position = Vec3::Zero();
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  // plane normal = local +z
-  double radius = 1.0;                                           // sphere radius (m)
-  double thickness = 0.0;                                        // extra clearance kept by particles (m)
+  double radius = 1.0;                                           // sphere and capsule radius (m)
+  Vec3 half_extents = Vec3(0.5, 0.5, 0.5);                       // box: half size along local x, y, z (m)
+  double half_length = 0.5;        // capsule: half the length of its axis segment, along local z (m)
+  std::vector<double> vertices;    // convex: the points (3 each, local, m); mesh: the vertices
+  std::vector<int32_t> triangles;  // mesh: 3 vertex indices per triangle (outward counter-clockwise
+                                   // when closed; a closed mesh wound inward is turned)
+  double thickness = 0.0;          // extra clearance kept by particles (m)
   double friction_static = 0.5;
   double friction_dynamic = 0.3;
 };
@@ -247,6 +257,13 @@ struct Contact {
   int32_t particle;
   int32_t collider;
   double lambda;
+  // Box, capsule, convex and mesh colliders: a contact found where the particle's path entered the
+  // collider within the substep holds the particle on the tangent plane there (local normal n,
+  // n . local >= offset), so it leaves on the side it came from; otherwise (swept = false) the
+  // closest point of the surface is used, found again at every projection.
+  bool swept = false;
+  Vec3 normal = Vec3::Zero();
+  double offset = 0.0;
 };
 
 struct Group {
@@ -283,6 +300,7 @@ struct Collider {
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
   Vec3 position_prev = Vec3::Zero();  // pose at the start of the current substep
   Eigen::Quaterniond rotation_prev = Eigen::Quaterniond::Identity();
+  std::shared_ptr<const ColliderGeometry> geometry;  // box, capsule, convex, mesh: built at creation
   uint32_t generation = 0;
   bool alive = false;
 };
@@ -391,6 +409,7 @@ class World {
   void move_colliders(double alpha);
   void find_contacts();
   void find_self_contacts();
+  void find_shape_contacts(int32_t collider, std::vector<Contact>& out) const;
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
   void project_group(Group& g, double h);
