@@ -114,6 +114,16 @@ void validate(const json& doc, const valijson::Schema& schema, const std::string
        std::string("does not match the ") + what + " schema: " + first.description);
 }
 
+constexpr const char* kColliderShapeNames[kColliderShapeCount] = {"plane",   "sphere", "box",
+                                                                  "capsule", "convex", "mesh"};
+
+/// The shape a scene names (the schema has checked it is one of kColliderShapeNames).
+ColliderShape collider_shape(const std::string& name) {
+  for (int k = 0; k < kColliderShapeCount; ++k)
+    if (name == kColliderShapeNames[k]) return static_cast<ColliderShape>(k);
+  return ColliderShape::plane;
+}
+
 Vec3 vec3(const json& j) {
   return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
 }
@@ -405,13 +415,21 @@ class Builder {
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
-      d.shape = c["shape"] == "plane" ? ColliderShape::plane : ColliderShape::sphere;
+      d.shape = collider_shape(c["shape"].get<std::string>());
       if (c.contains("position")) d.position = vec3(c["position"]);
       if (c.contains("rotation")) d.rotation = quat(c["rotation"], at + "/rotation");
       d.radius = value_or(c, "radius", d.radius);
       d.thickness = value_or(c, "thickness", d.thickness);
       d.friction_static = value_or(c, "friction_static", d.friction_static);
       d.friction_dynamic = value_or(c, "friction_dynamic", d.friction_dynamic);
+      if (c.contains("half_extents")) d.half_extents = vec3(c["half_extents"]);
+      d.half_length = value_or(c, "half_length", d.half_length);
+      if (c.contains("vertices"))
+        for (const json& v : c["vertices"])
+          for (const json& k : v) d.vertices.push_back(k.get<double>());
+      if (c.contains("triangles"))
+        for (const json& t : c["triangles"])
+          for (const json& k : t) d.triangles.push_back(k.get<int32_t>());
       const Id id = guard(at, [&] { return w.create_collider(d); });
       if (c.contains("name")) name_once(colliders_, meta_.collider_names, c["name"], id, at, "collider");
     });
@@ -859,14 +877,28 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     if (!c.alive) continue;
     const Eigen::Quaterniond& q = c.desc.rotation;
     collider_name[i] = name_for(meta.collider_names, i, "collider", used_colliders);
-    colliders.push_back({{"name", collider_name[i]},
-                         {"shape", c.desc.shape == ColliderShape::plane ? "plane" : "sphere"},
-                         {"position", vec_json(c.desc.position)},
-                         {"rotation", {q.w(), q.x(), q.y(), q.z()}},
-                         {"radius", c.desc.radius},
-                         {"thickness", c.desc.thickness},
-                         {"friction_static", c.desc.friction_static},
-                         {"friction_dynamic", c.desc.friction_dynamic}});
+    json& out = colliders.emplace_back(json{{"name", collider_name[i]},
+                                            {"shape", kColliderShapeNames[static_cast<int>(c.desc.shape)]},
+                                            {"position", vec_json(c.desc.position)},
+                                            {"rotation", {q.w(), q.x(), q.y(), q.z()}},
+                                            {"radius", c.desc.radius},
+                                            {"thickness", c.desc.thickness},
+                                            {"friction_static", c.desc.friction_static},
+                                            {"friction_dynamic", c.desc.friction_dynamic}});
+    if (c.desc.shape == ColliderShape::box) out["half_extents"] = vec_json(c.desc.half_extents);
+    if (c.desc.shape == ColliderShape::capsule) out["half_length"] = c.desc.half_length;
+    if (c.desc.shape == ColliderShape::convex || c.desc.shape == ColliderShape::mesh) {
+      json v = json::array();
+      for (size_t k = 0; k + 2 < c.desc.vertices.size(); k += 3)
+        v.push_back({c.desc.vertices[k], c.desc.vertices[k + 1], c.desc.vertices[k + 2]});
+      out["vertices"] = v;
+    }
+    if (c.desc.shape == ColliderShape::mesh) {
+      json t = json::array();
+      for (size_t k = 0; k + 2 < c.desc.triangles.size(); k += 3)
+        t.push_back({c.desc.triangles[k], c.desc.triangles[k + 1], c.desc.triangles[k + 2]});
+      out["triangles"] = t;
+    }
   }
   doc["colliders"] = colliders;
 
