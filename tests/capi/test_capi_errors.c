@@ -1207,6 +1207,47 @@ static void test_colliders(void) {
   GOOD_COLLIDER(-1);
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "shape", embra_collider_create(W, &d, &out));
 
+  {
+    /* Box, capsule, convex and mesh: their own fields, each refused with nothing changed. */
+    static const double tetra[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    static const int32_t tri_out[3] = {0, 1, 4};
+    static const int32_t tri_flat[3] = {0, 1, 1};
+    CAPI_CONTEXT("box, capsule, convex, mesh");
+    for (i = 0; i < 3; ++i) {
+      GOOD_COLLIDER(EMBRA_COLLIDER_BOX);
+      d.half_extents[i] = i == 0 ? 0.0 : bad_value(i);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "half_extents", embra_collider_create(W, &d, &out));
+      GOOD_COLLIDER(EMBRA_COLLIDER_CAPSULE);
+      d.half_length = i == 0 ? -1.0 : bad_value(i);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "half_length", embra_collider_create(W, &d, &out));
+    }
+    GOOD_COLLIDER(EMBRA_COLLIDER_CAPSULE);
+    d.radius = 0.0;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "radius", embra_collider_create(W, &d, &out));
+    GOOD_COLLIDER(EMBRA_COLLIDER_CONVEX);
+    d.vertex_count = 4;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "vertices", embra_collider_create(W, &d, &out));
+    d.vertices = flat;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_collider_create(W, &d, &out));
+    d.vertices = tetra;
+    d.vertex_count = 3;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "at least 4", embra_collider_create(W, &d, &out));
+    d.vertex_count = -1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "vertex_count", embra_collider_create(W, &d, &out));
+    GOOD_COLLIDER(EMBRA_COLLIDER_MESH);
+    d.vertex_count = 4;
+    d.vertices = tetra;
+    d.triangle_count = 1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "triangles", embra_collider_create(W, &d, &out));
+    d.triangles = tri_out;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_collider_create(W, &d, &out));
+    d.triangles = tri_flat;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_collider_create(W, &d, &out));
+    d.triangle_count = 0;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "no triangles", embra_collider_create(W, &d, &out));
+  }
+
   for (shape = 0; shape < 2; ++shape) {
     for (i = 0; i < 3; ++i) {
       CAPI_CONTEXT("shape %d, %s", shape, bad_name(i));
