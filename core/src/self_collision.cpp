@@ -13,6 +13,13 @@ namespace {
 /// The smallest separation kept between two primitives whose bodies have no thickness (m).
 constexpr double kMinGap = 1e-6;
 
+/// A particle's region, in which the self-collision candidate pairs stay valid: its swept bounds
+/// grown by kRegionMotion times its motion in the substep plus kRegionThickness times its half
+/// thickness. Larger regions are rebuilt less often but keep more pairs (tuned on the folded-cloth
+/// benchmark, bench/self_collision_bench.cpp).
+constexpr double kRegionMotion = 3.0;
+constexpr double kRegionThickness = 0.25;
+
 struct Box {
   Vec3 lo, hi;
   bool overlaps(const Box& o) const {
@@ -50,8 +57,9 @@ class Grid {
         big_.push_back(static_cast<int32_t>(i));
         continue;
       }
-      visit(boxes[i],
-            [&](size_t bucket, int64_t, int64_t, int64_t) { items_[fill_[bucket]++] = static_cast<int32_t>(i); });
+      const Entry entry{
+          boxes[i], {coord(boxes[i].lo.x()), coord(boxes[i].lo.y()), coord(boxes[i].lo.z())}, static_cast<int32_t>(i)};
+      visit(boxes[i], [&](size_t bucket, int64_t, int64_t, int64_t) { items_[fill_[bucket]++] = entry; });
     }
   }
 
@@ -66,15 +74,15 @@ class Grid {
         if (boxes_[i].overlaps(q)) out.push_back(static_cast<int32_t>(i));
       return;
     }
+    const std::array<int64_t, 3> ql = {coord(q.lo.x()), coord(q.lo.y()), coord(q.lo.z())};
     visit(q, [&](size_t bucket, int64_t i, int64_t j, int64_t k) {
       for (int32_t e = start_[bucket]; e < start_[bucket + 1]; ++e) {
-        if (e > start_[bucket] && items_[e] == items_[e - 1]) continue;  // two of its cells share the bucket
-        const Box& b = boxes_[items_[e]];
-        if (!b.overlaps(q)) continue;
-        if (coord(std::max(b.lo.x(), q.lo.x())) != i || coord(std::max(b.lo.y(), q.lo.y())) != j ||
-            coord(std::max(b.lo.z(), q.lo.z())) != k)
+        const Entry& b = items_[e];
+        if (!b.box.overlaps(q)) continue;
+        if (std::max(b.low[0], ql[0]) != i || std::max(b.low[1], ql[1]) != j || std::max(b.low[2], ql[2]) != k)
           continue;
-        out.push_back(items_[e]);
+        if (e > start_[bucket] && b.index == items_[e - 1].index) continue;  // two of its cells share the bucket
+        out.push_back(b.index);
       }
     });
     for (int32_t e : big_)
@@ -114,7 +122,13 @@ class Grid {
   std::span<const Box> boxes_;
   double inv_cell_ = 1.0;
   size_t mask_ = 0;
-  std::vector<int32_t> start_, items_, fill_, big_;
+  struct Entry {
+    Box box;
+    std::array<int64_t, 3> low;  // the box's lowest cell
+    int32_t index;
+  };
+  std::vector<int32_t> start_, fill_, big_;
+  std::vector<Entry> items_;  // the boxes of each bucket, copied so a query reads them in sequence
 };
 
 /// Mean of the boxes' largest extents: the cell size that keeps the cells per box bounded.
@@ -459,6 +473,8 @@ struct Scratch {
   std::vector<Box> tri_boxes, edge_boxes;
   Grid tri_grid, edge_grid;
   std::vector<int32_t> cand;
+  std::vector<double> reach;                            // per particle: the diagonal of its region
+  std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
 };
 
 Scratch& scratch() {
@@ -524,23 +540,35 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   SelfCollisionCache& cache = *in.cache;
 
   // The candidate pairs hold while every particle stays inside the region it had when they were
-  // found: its swept bounds grown by a margin (three times its motion in that substep plus half its
-  // thickness). Two primitives whose swept bounds overlap in a later substep then overlapped in
-  // those regions, so no pair is missed.
+  // found (its swept bounds grown by a margin), at the start and at the end of every substep.
+  //  - Two primitives whose swept bounds overlap in a later substep overlapped in those regions.
+  //  - A particle that stays in its region is never more than the region's diagonal D from where it
+  //    was when the pairs were found, and moves at most D in a substep. A pair at distance d then is
+  //    later at least d - D_a - D_b apart at the start of a substep and moves at most D_a + D_b in it
+  //    (D_a, D_b: the largest D of each side's vertices), so it can only come within its thickness
+  //    if d < thickness + 2 (D_a + D_b). Pairs further apart are dropped here, once, instead of
+  //    being measured again in every substep.
+  // So the pairs measured below are a superset of those the swept bounds would give, and the
+  // contacts are the same as with a broad phase rebuilt every substep.
   bool valid = cache.lo.size() == x1.size() && cache.triangles == nt && cache.edges == ne;
+  auto inside = [&](const Vec3& p, int32_t i) {
+    return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
+  };
   for (size_t k = 0; valid && k < s.points.size(); ++k) {
     const int32_t i = s.points[k];
-    valid = (x1[i].array() >= cache.lo[i].array()).all() && (x1[i].array() <= cache.hi[i].array()).all();
+    valid = inside(x0[i], i) && inside(x1[i], i);
   }
   if (!valid) {
     cache.lo.assign(x1.size(), Vec3::Zero());
     cache.hi.assign(x1.size(), Vec3::Zero());
+    s.reach.assign(x1.size(), 0.0);
     cache.triangles = nt;
     cache.edges = ne;
     for (int32_t i : s.points) {
-      const double margin = 3.0 * (x1[i] - x0[i]).norm() + grow_of(i);
+      const double margin = kRegionMotion * (x1[i] - x0[i]).norm() + kRegionThickness * grow_of(i);
       cache.lo[i] = x0[i].cwiseMin(x1[i]).array() - margin;
       cache.hi[i] = x0[i].cwiseMax(x1[i]).array() + margin;
+      s.reach[i] = (cache.hi[i] - cache.lo[i]).norm();
     }
     auto region = [&](std::initializer_list<int32_t> ids) {
       Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
@@ -555,13 +583,18 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       b.hi.array() += g;
       return b;
     };
+    auto reach = [&](std::initializer_list<int32_t> ids) {
+      double d = 0.0;
+      for (int32_t i : ids) d = std::max(d, s.reach[i]);
+      return d;
+    };
     s.tri_boxes.resize(nt);
     for (size_t t = 0; t < nt; ++t) s.tri_boxes[t] = region({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]});
     s.edge_boxes.resize(ne);
     for (size_t e = 0; e < ne; ++e) s.edge_boxes[e] = region({s.edges[2 * e], s.edges[2 * e + 1]});
-    // Twice the mean triangle extent (measured fastest on the folded-cloth benchmark): a triangle
-    // covers 1 to 8 cells and a bucket holds a bounded number of triangles.
-    const double cell = 2.0 * mean_extent(s.tri_boxes);
+    // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
+    // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
+    const double cell = mean_extent(s.tri_boxes);
     s.tri_grid.build(s.tri_boxes, cell);
     s.edge_grid.build(s.edge_boxes, cell);
     cache.point_triangle.clear();
@@ -572,14 +605,16 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
         const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
         if (v[0] == p || v[1] == p || v[2] == p) continue;
         if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) continue;
+        const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+        double bary[3];
+        if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
+            thk + 2.0 * (s.reach[p] + reach({v[0], v[1], v[2]})))
+          continue;
         const BodyInfo& b = in.bodies[s.tri_body[t]];
-        if (p >= b.first_particle && p < b.first_particle + b.particle_count) {
-          // Neighbours on the surface that rest within reach never count.
-          const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
-          double rb[3];
-          if (point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), rb) < thk)
-            continue;
-        }
+        // Neighbours on the surface that rest within reach never count.
+        if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
+            point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
+          continue;
         cache.point_triangle.insert(cache.point_triangle.end(), {p, t});
       }
     }
@@ -591,11 +626,14 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
         const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
         if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
         if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) continue;
+        const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+        double ps, pt;
+        if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >=
+            thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
+          continue;
         if (s.edge_body[ea] == s.edge_body[eb]) {
           const BodyInfo& b = in.bodies[s.edge_body[ea]];
-          const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
-          double rs, rt;
-          if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), rs, rt) < thk)
+          if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
             continue;
         }
         cache.edge_edge.insert(cache.edge_edge.end(), {static_cast<int32_t>(ea), eb});
@@ -603,9 +641,27 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     }
   }
 
+  // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
+  // stays more than its thickness apart throughout the substep.
+  s.swept_point.resize(x1.size());
+  for (int32_t i : s.points) s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+  auto swept = [&](std::initializer_list<int32_t> ids) {
+    Box b = s.swept_point[*ids.begin()];
+    for (int32_t i : ids) {
+      b.lo = b.lo.cwiseMin(s.swept_point[i].lo);
+      b.hi = b.hi.cwiseMax(s.swept_point[i].hi);
+    }
+    return b;
+  };
+  s.swept_tri.resize(nt);
+  for (size_t t = 0; t < nt; ++t) s.swept_tri[t] = swept({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]});
+  s.swept_edge.resize(ne);
+  for (size_t e = 0; e < ne; ++e) s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]});
+
   // Point against triangle.
   for (size_t k = 0; k < cache.point_triangle.size(); k += 2) {
     const int32_t p = cache.point_triangle[k], t = cache.point_triangle[k + 1];
+    if (!s.swept_point[p].overlaps(s.swept_tri[t])) continue;
     const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
     const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
     double bary[3];
@@ -639,6 +695,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // Edge against edge.
   for (size_t k = 0; k < cache.edge_edge.size(); k += 2) {
     const size_t ea = static_cast<size_t>(cache.edge_edge[k]), eb = static_cast<size_t>(cache.edge_edge[k + 1]);
+    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) continue;
     const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
     const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
     double sa, tb;

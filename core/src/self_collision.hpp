@@ -2,13 +2,18 @@
 // triangles and edges of every body that has triangles, same body or different bodies (pairs
 // sharing a vertex excluded), kept `thickness` apart (the two sides' half thicknesses added).
 //
-//   broad phase   a spatial hash of the primitives' bounds swept from x_prev to the predicted x and
-//                 grown by their thickness, rebuilt every substep. The cell is the mean swept
-//                 triangle extent, so a primitive covers a bounded number of cells and the work grows
-//                 linearly with the particle count. The table is a counting sort into buckets (no
-//                 node allocation, iteration in primitive order): deterministic.
-//   narrow phase  a pair becomes a contact when it could come within the thickness during the
+//   broad phase   a spatial hash of regions around the particles (their swept bounds grown by a
+//                 margin), and the candidate pairs it gives, kept from substep to substep while every
+//                 particle stays inside its region. Pairs that cannot come within their thickness
+//                 while that holds (their distance, less what the regions let them move) are dropped
+//                 when the pairs are found. The cell is the mean triangle region's extent, so a
+//                 primitive covers a bounded number of cells and the work grows linearly with the
+//                 particle count. The table is a counting sort into buckets (no node allocation,
+//                 iteration in primitive order): deterministic.
+//   narrow phase  a kept pair becomes a contact when its swept bounds in this substep, grown by the
+//                 half thicknesses, overlap and it could come within the thickness during the
 //                 substep: its distance at the start is below thickness + how far its vertices move.
+//                 The contacts are the same as a broad phase rebuilt every substep would give.
 //                 Space-time: the first time in the substep at which the four points become coplanar
 //                 with the point inside the triangle (or the two edges crossing) is found from the
 //                 roots of the cubic coplanarity condition; the contact then acts at the barycentric
