@@ -365,7 +365,8 @@ void World::find_contacts() {
     const Vec3 normal = col.rotation * Vec3::UnitZ();
     for (size_t i = 0; i < x_.size(); ++i) {
       if (w_[i] == 0.0) continue;
-      const double reach = radius_[i] + col.desc.thickness + (x_[i] - x_prev_[i]).norm();
+      // The clearance, plus the path, plus the clearance again as a margin (see find_shape_contacts).
+      const double reach = 2.0 * (radius_[i] + col.desc.thickness) + (x_[i] - x_prev_[i]).norm();
       double gap;
       if (col.desc.shape == ColliderShape::plane) {
         gap = normal.dot(x_[i] - col.position);
@@ -433,8 +434,12 @@ void World::find_shape_contacts(int32_t index, std::vector<Contact>& out) const 
       out.push_back(Contact{particle, index, 0.0, true, n, n.dot(p) - d});
       continue;
     }
+    // Near the surface at the end of the path: a contact that acts only if the particle gets within
+    // its clearance. The groups projected before the contacts can move a particle further than its
+    // path (cloth pulled over a box's edge by its stretch), so the reach is the path plus the
+    // clearance again as a margin; an inactive contact costs one distance per projection.
     d = shape_distance(col.desc, geo, a1, n) - r;
-    if (d < (x_[i] - x_prev_[i]).norm()) out.push_back(Contact{particle, index, 0.0, false, Vec3::Zero(), 0.0});
+    if (d < (x_[i] - x_prev_[i]).norm() + r) out.push_back(Contact{particle, index, 0.0, false, Vec3::Zero(), 0.0});
   }
 }
 
