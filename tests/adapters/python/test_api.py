@@ -200,3 +200,33 @@ def test_without_numpy_arrays_are_flat_doubles():
         assert w.positions(out=out) is out and list(out) == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
         if not embra.have_numpy():
             assert isinstance(w.positions(), array)
+
+
+def _which_library(env, cwd):
+    import subprocess
+    import sys
+    code = "import embra; print(embra.library_path)"
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, check=True, capture_output=True, text=True)
+    return out.stdout.strip()
+
+
+def test_library_found_from_env_next_to_package_or_system(tmp_path, source_dir):
+    """$EMBRA_LIBRARY first; else a libembra next to the package; else the loader's own search."""
+    import shutil
+    lib = os.path.realpath(_capi.library_path)
+    pkg = os.path.join(source_dir, "host_adapters", "python", "embra")
+    env = {k: v for k, v in os.environ.items() if k not in ("EMBRA_LIBRARY", "LD_LIBRARY_PATH", "PYTHONPATH")}
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    beside = tmp_path / "beside"
+    shutil.copytree(pkg, beside / "embra")
+    shutil.copy(lib, beside / "embra" / f"libembra.so.{embra.ABI_VERSION}")
+    assert _which_library(env, beside) == str(beside / "embra" / f"libembra.so.{embra.ABI_VERSION}")
+    assert _which_library(dict(env, EMBRA_LIBRARY=lib), beside) == lib
+    system = tmp_path / "system"
+    shutil.copytree(pkg, system / "embra")
+    found = _which_library(dict(env, LD_LIBRARY_PATH=os.path.dirname(lib)), system)
+    assert found == f"libembra.so.{embra.ABI_VERSION}"  # by SONAME, through the dynamic loader's search
+    import subprocess
+    import sys
+    failed = subprocess.run([sys.executable, "-c", "import embra"], env=env, cwd=system, capture_output=True, text=True)
+    assert failed.returncode != 0 and "cannot load libembra" in failed.stderr and "EMBRA_LIBRARY" in failed.stderr
