@@ -367,6 +367,43 @@ namespace Embra.Tests
             CollectionAssert.AreEquivalent(declared, bound);
         }
 
+        static string Pascal(string upper)
+        {
+            return string.Concat(upper.ToLowerInvariant().Split('_').Select(w => char.ToUpperInvariant(w[0]) + w.Substring(1)));
+        }
+
+        [Test]
+        public void EveryHeaderConstantIsMirrored()
+        {
+            // EMBRA_ERROR_STALE_ID -> Status.StaleId, EMBRA_CONSTRAINT_EDGE_ANGLE -> ConstraintKind.EdgeAngle, ...
+            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
+            var constants = Regex.Matches(header, @"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)").Cast<Match>()
+                .ToDictionary(m => m.Groups[1].Value, m => int.Parse(m.Groups[2].Value));
+            Assert.GreaterOrEqual(constants.Count, 25);
+            var mirrors = new[] {
+                Tuple.Create("ERROR_", typeof(Status)), Tuple.Create("OK", typeof(Status)),
+                Tuple.Create("CONSTRAINT_", typeof(ConstraintKind)), Tuple.Create("COLLIDER_", typeof(ColliderShape)),
+                Tuple.Create("GENERATE_", typeof(Generate)) };
+            foreach (var c in constants)
+            {
+                var mirror = mirrors.FirstOrDefault(m => c.Key.StartsWith(m.Item1));
+                Assert.IsNotNull(mirror, "EMBRA_" + c.Key + " has no C# mirror");
+                string name = Pascal(mirror.Item1 == "OK" ? "OK" : c.Key.Substring(mirror.Item1.Length));
+                int value;
+                if (mirror.Item2.IsEnum)
+                    value = (int)Enum.Parse(mirror.Item2, name);
+                else
+                    value = (int)mirror.Item2.GetField(name).GetValue(null);
+                Assert.AreEqual(c.Value, value, "EMBRA_" + c.Key);
+            }
+            foreach (Match m in Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_DEF_VERSION\s+(\d+)"))
+            {
+                var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value) + "Def");
+                Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_DEF_VERSION");
+                Assert.AreEqual(int.Parse(m.Groups[2].Value), (int)def.GetField("CurrentVersion").GetValue(null));
+            }
+        }
+
         [Test]
         public void DefaultsAndVersions()
         {

@@ -230,3 +230,21 @@ def test_library_found_from_env_next_to_package_or_system(tmp_path, source_dir):
     import sys
     failed = subprocess.run([sys.executable, "-c", "import embra"], env=env, cwd=system, capture_output=True, text=True)
     assert failed.returncode != 0 and "cannot load libembra" in failed.stderr and "EMBRA_LIBRARY" in failed.stderr
+
+
+def test_every_header_constant_is_mirrored(source_dir):
+    """Status codes, enum values and def versions of embra.h have the same values in embra._capi."""
+    with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
+        header = f.read()
+    constants = dict(re.findall(r"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)", header))
+    constants.update(re.findall(r"#define\s+EMBRA_([A-Z0-9_]+_DEF_VERSION)\s+(\d+)", header))
+    assert len(constants) > 30
+    for name, value in constants.items():
+        assert getattr(_capi, name, None) == int(value), f"EMBRA_{name} = {value} is not mirrored in _capi.py"
+
+    def values(prefix):
+        return sorted(v for k, v in vars(_capi).items() if k.startswith(prefix) and not k.endswith("_VERSION"))
+
+    assert sorted(embra.KINDS.values()) == values("CONSTRAINT_")  # the names the World methods accept
+    assert sorted(embra.SHAPES.values()) == values("COLLIDER_")
+    assert sorted(embra.GENERATE.values()) == values("GENERATE_")
