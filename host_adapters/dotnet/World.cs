@@ -197,26 +197,35 @@ namespace Embra
             return s == null ? null : Encoding.UTF8.GetBytes(s + "\0");
         }
 
-        public void Dispose() { handle.Dispose(); }
+        /// <summary>Destroys the world; waits for a call in progress on another thread. Idempotent.</summary>
+        public void Dispose()
+        {
+            lock (gate) handle.Dispose();
+        }
         public bool IsDisposed { get { return handle.IsClosed; } }
         public WorldHandle Handle { get { return handle; } }
 
         delegate int Fn(IntPtr world);
+        readonly object gate = new object();
 
         /// <summary>Calls C with the world kept alive for the call; a disposed World passes NULL, which C
-        /// refuses with its own message.</summary>
+        /// refuses with its own message. The C library takes one thread at a time per world, so tasks
+        /// sharing one World take turns here instead of racing.</summary>
         void Call(Fn fn)
         {
-            bool added = false;
-            try
+            lock (gate)
             {
-                if (!handle.IsClosed) handle.DangerousAddRef(ref added);
-                int status = fn(added ? handle.DangerousGetHandle() : IntPtr.Zero);
-                if (status != Status.Ok) throw Errors.For(status, !added);
-            }
-            finally
-            {
-                if (added) handle.DangerousRelease();
+                bool added = false;
+                try
+                {
+                    if (!handle.IsClosed) handle.DangerousAddRef(ref added);
+                    int status = fn(added ? handle.DangerousGetHandle() : IntPtr.Zero);
+                    if (status != Status.Ok) throw Errors.For(status, !added);
+                }
+                finally
+                {
+                    if (added) handle.DangerousRelease();
+                }
             }
         }
 

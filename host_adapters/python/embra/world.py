@@ -1,12 +1,14 @@
 """The World: a Python view of one embra_world*, covering the whole C ABI.
 
 A refused call raises the exception of its status (see :mod:`embra.errors`) with the C library's
-message and leaves the world unchanged, exactly as the C function does. One thread at a time per
-World; different Worlds may step on different threads at once (ctypes releases the GIL for every
-call into libembra, so they really run in parallel).
+message and leaves the world unchanged, exactly as the C function does. The C library takes one
+thread at a time per world; a World holds a lock around each call, so threads sharing one World
+take turns (and close() waits for a call in progress) instead of racing. Different Worlds step on
+different threads at once: ctypes releases the GIL for every call into libembra.
 """
 
 import ctypes
+import threading
 from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 
 from . import _buffers as buf
@@ -99,6 +101,7 @@ class World:
         """Creates a world from embra_default_solver_def(), `solver` (a SolverDef or dict) and keyword
         settings (any SolverDef field: dt, substeps, iterations, gravity, damping, ...)."""
         self._ptr = None
+        self._lock = threading.Lock()
         d = lib.embra_default_solver_def()
         if solver is not None:
             _fill(d, as_dict(solver) if isinstance(solver, SolverDef) else dict(solver), "SolverDef")
@@ -111,6 +114,7 @@ class World:
     def _adopt(cls, ptr):
         w = cls.__new__(cls)
         w._ptr = ptr
+        w._lock = threading.Lock()
         return w
 
     @classmethod
@@ -131,10 +135,14 @@ class World:
 
     # --- lifetime ------------------------------------------------------------------------------
     def close(self):
-        """Destroys the world (embra_world_destroy). Idempotent."""
-        ptr, self._ptr = getattr(self, "_ptr", None), None
-        if ptr is not None and ptr.value:
-            lib.embra_world_destroy(ptr)
+        """Destroys the world (embra_world_destroy). Idempotent; waits for a call in progress."""
+        lock = getattr(self, "_lock", None)
+        if lock is None:  # __init__ failed before the world existed
+            return
+        with lock:
+            ptr, self._ptr = self._ptr, None
+            if ptr is not None and ptr.value:
+                lib.embra_world_destroy(ptr)
 
     @property
     def closed(self):
@@ -155,10 +163,13 @@ class World:
 
     def _call(self, name, *args):
         """Calls a C function with this world first; a closed World passes NULL, which C refuses."""
-        status = getattr(lib, name)(self._ptr, *args)
+        with self._lock:
+            ptr = self._ptr
+            status = getattr(lib, name)(ptr, *args)
+            if status != _capi.OK:
+                err = error_for(status)  # read the message before another call on this thread
         if status != _capi.OK:
-            err = error_for(status)
-            if self._ptr is None:
+            if ptr is None:
                 err = type(err)(f"{err.message} (this World was closed)")
             raise err
 

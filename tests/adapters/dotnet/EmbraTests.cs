@@ -341,6 +341,42 @@ namespace Embra.Tests
             Assert.IsFalse(alone[0].SequenceEqual(alone[1]));  // different scenes: equality is no coincidence
         }
 
+        static World Chain()
+        {
+            var w = new World();
+            var def = Native.embra_default_body_def();
+            def.Material.Mass = 0.5;
+            w.CreateBody(Enumerable.Range(0, 8).SelectMany(i => new[] { 0.1 * i, 0, 0 }).ToArray(),
+                         edges: Enumerable.Range(0, 7).SelectMany(i => new[] { i, i + 1 }).ToArray(), def: def);
+            w.CreatePin(0, new double[] { 0, 0, 0 });
+            return w;
+        }
+
+        [Test]
+        public void TasksSharingOneWorldTakeTurns()
+        {
+            double[] expected;
+            using (var alone = Chain())
+            {
+                alone.Step(60);
+                expected = alone.GetPositions();
+            }
+            using (var shared = Chain())
+            {
+                Task.WaitAll(Task.Run(() => shared.Step(30)), Task.Run(() => shared.Step(30)));
+                Assert.AreEqual(60, shared.Report.Frame);
+                Env.AssertBitIdentical(expected, shared.GetPositions());
+            }
+            // Disposed while a task steps: the task's loop ends with ObjectDisposedException, no crash.
+            var w = Chain();
+            var stepping = Task.Run(() => { while (true) w.Step(); });
+            while (w.Report.Frame < 5) { }
+            w.Dispose();
+            var e = Assert.Throws<AggregateException>(() => stepping.Wait());
+            Assert.That(e.InnerException, Is.InstanceOf<ObjectDisposedException>());
+            StringAssert.Contains("world is NULL", e.InnerException.Message);
+        }
+
         [Test]
         public void TwoTentsOnTwoTasksEqualOneAfterTheOther()
         {

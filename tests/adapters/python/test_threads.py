@@ -57,3 +57,43 @@ def test_two_tents_on_two_threads_equal_one_after_the_other():
     for t in threads:
         t.join()
     assert together == [alone, alone]
+
+
+def test_threads_sharing_one_world_take_turns():
+    """Two threads stepping one World 30 frames each: 60 frames, the bits of 60 frames on one thread;
+    closing it while a thread steps ends that thread's loop with the closed-world error, no crash."""
+    def build():
+        w = embra.World()
+        w.create_body([(0.1 * i, 0.0, 0.0) for i in range(8)], edges=[(i, i + 1) for i in range(7)], mass=0.5)
+        w.create_pin(0, (0.0, 0.0, 0.0))
+        return w
+
+    with build() as alone:
+        alone.step(60)
+        expected = struct.pack("<24d", *flat(alone.positions()))
+    with build() as shared:
+        threads = [threading.Thread(target=shared.step, args=(30,)) for _ in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert shared.report().frame == 60
+        assert struct.pack("<24d", *flat(shared.positions())) == expected
+
+    w = build()
+    outcome = []
+
+    def step_until_closed():
+        try:
+            while True:
+                w.step()
+        except embra.InvalidArgumentError as e:
+            outcome.append(str(e))
+
+    t = threading.Thread(target=step_until_closed)
+    t.start()
+    while w.report().frame < 5:
+        pass
+    w.close()
+    t.join()
+    assert outcome and "world is NULL" in outcome[0] and "closed" in outcome[0]
