@@ -243,7 +243,9 @@ def _candidates():
     here = os.path.dirname(os.path.abspath(__file__))
     names = [f"libembra.so.{ABI_VERSION}", "libembra.so"] if sys.platform.startswith("linux") else \
         ["libembra.dylib", "embra.dll", "libembra.so"]
-    for folder in (here, os.path.dirname(here)):
+    # beside the package (or its folder); then the library folder of an installed prefix, which
+    # holds the package in lib/python3/dist-packages/embra (cmake --install)
+    for folder in (here, os.path.dirname(here), os.path.normpath(os.path.join(here, "..", "..", ".."))):
         for name in names:
             path = os.path.join(folder, name)
             if os.path.exists(path):
