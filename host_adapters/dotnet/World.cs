@@ -154,6 +154,8 @@ namespace Embra
         public static int ConstraintArity(ConstraintKind kind) { return Native.embra_constraint_arity((int)kind); }
         public static SolverDef DefaultSolverDef() { return Native.embra_default_solver_def(); }
         public static Material DefaultMaterial() { return Native.embra_default_material(); }
+        public static BodyDef DefaultBodyDef() { return Native.embra_default_body_def(); }
+        public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
         internal static void Touch() { }
     }
 
