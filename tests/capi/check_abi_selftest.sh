@@ -50,6 +50,7 @@ expect pass private -DFIXTURE_PRIVATE
 expect fail removed -DFIXTURE_REMOVED
 expect fail grown_def -DFIXTURE_GROWN_DEF
 expect fail parameter -DFIXTURE_PARAMETER
+expect fail grown_report -DFIXTURE_GROWN_REPORT
 
 # A library with another SONAME (a bumped ABI version) needs its own baseline.
 "$cc" -std=c99 -g -fPIC -shared -fvisibility=hidden -Wl,-soname,libembra.so.1 -I"$src" -o "$work/libembra.so.1" \

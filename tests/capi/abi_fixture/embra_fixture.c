@@ -46,6 +46,13 @@ embra_status embra_world_step(embra_world* world, int32_t frames) {
   return 0;
 }
 
+embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report) {
+  if (!world || !out_report) return -1;
+  memset(out_report, 0, sizeof *out_report);
+  out_report->frame = world->frame;
+  return 0;
+}
+
 #ifndef FIXTURE_REMOVED
 embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
   return world && pin.generation ? 0 : -2;

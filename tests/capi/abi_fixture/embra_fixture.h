@@ -5,7 +5,9 @@
  *   FIXTURE_PRIVATE      the opaque world's private layout   -> compatible
  *   FIXTURE_REMOVED      a function removed                  -> incompatible
  *   FIXTURE_GROWN_DEF    a field appended to a def           -> incompatible (returned by value)
- *   FIXTURE_PARAMETER    a parameter's type changed          -> incompatible */
+ *   FIXTURE_PARAMETER    a parameter's type changed          -> incompatible
+ *   FIXTURE_GROWN_REPORT a field appended to an output struct -> incompatible (written by the library
+ *                        into a host's buffer of the old size) */
 #ifndef EMBRA_FIXTURE_H
 #define EMBRA_FIXTURE_H
 #include <stdint.h>
@@ -29,7 +31,16 @@ typedef struct embra_pin_def {
 #endif
 } embra_pin_def;
 
+typedef struct embra_step_report {
+  int64_t frame;
+  double kinetic_energy;
+#ifdef FIXTURE_GROWN_REPORT
+  double residual_max;
+#endif
+} embra_step_report;
+
 EMBRA_API embra_pin_def embra_default_pin_def(void);
+EMBRA_API embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report);
 EMBRA_API embra_status embra_world_create(embra_world** out_world);
 EMBRA_API void embra_world_destroy(embra_world* world);
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
