@@ -250,6 +250,23 @@ namespace Embra.Tests
         }
 
         [Test]
+        public void AStepThatGoesNonFinite()
+        {
+            using (var w = Square())
+            {
+                w.SetVelocities(new[] { 1e308, 0, 0 }, 1);  // overflows to infinity in the step
+                string before = Snapshot(w);
+                long frame = w.Report.Frame;
+                var e = Assert.Throws<EmbraNumericalException>(() => w.Step());
+                Assert.That(e, Is.InstanceOf<ArithmeticException>());
+                StringAssert.StartsWith("embra_world_step: non-finite", e.Message);
+                Assert.AreEqual(before, Snapshot(w));  // restored to the start of the frame
+                Assert.AreEqual(frame, w.Warning.Frame);
+                Assert.GreaterOrEqual(w.Warning.Particle, 0);
+            }
+        }
+
+        [Test]
         public void UseAfterDestroy()
         {
             using (var w = Square())

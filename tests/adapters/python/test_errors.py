@@ -132,3 +132,17 @@ def test_wrong_lengths_are_refused_before_c(world):
     with pytest.raises(ValueError, match="takes 2 particles"):
         world.add_constraint("distance", [0, 1, 2])
     assert snapshot(world) == before
+
+
+def test_a_step_that_goes_non_finite(world):
+    """A velocity of 1e308 m/s overflows in the step: NumericalError (an ArithmeticError) with the C
+    message, the world restored to the start of the frame, and a warning record saying where."""
+    world.set_velocities([(1e308, 0.0, 0.0)], first=1)
+    before = snapshot(world)
+    frame = world.report().frame
+    with pytest.raises(ArithmeticError) as e:
+        world.step()
+    assert isinstance(e.value, embra.NumericalError) and e.value.status_name == "EMBRA_ERROR_NUMERICAL"
+    assert str(e.value).startswith("embra_world_step: non-finite")
+    assert snapshot(world) == before and world.report().frame == frame
+    assert world.warning().frame == frame and world.warning().particle >= 0
