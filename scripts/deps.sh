@@ -9,6 +9,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format binutils
   python3-jsonschema
+  python3-pytest python3-numpy
+  mono-mcs nunit-console libnunit-cil-dev
+  abigail-tools
 )
 
 missing=()

@@ -1,0 +1,544 @@
+// The managed side of embra: a SafeHandle owning each world, exceptions carrying the C message,
+// and World, whose methods cover the whole C ABI with flat double[] / int[] arrays pinned in place
+// (no per-element marshalling). One thread at a time per World; different Worlds may step on
+// different threads (or tasks) at once.
+using System;
+using System.Runtime.InteropServices;
+using System.Text;
+
+namespace Embra
+{
+    /// <summary>What every embra exception carries besides its .NET type.</summary>
+    public interface IEmbraException
+    {
+        /// <summary>The embra_status (negative).</summary>
+        int Status { get; }
+        /// <summary>embra_status_name(Status), e.g. "EMBRA_ERROR_STALE_ID".</summary>
+        string StatusName { get; }
+    }
+
+    /// <summary>EMBRA_ERROR_INVALID_ARGUMENT (and BUFFER_TOO_SMALL): NULL, out of range, non-finite, wrong count.</summary>
+    public class EmbraArgumentException : ArgumentException, IEmbraException
+    {
+        public EmbraArgumentException(int status, string message) : base(message) { Status = status; }
+        public int Status { get; private set; }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>EMBRA_ERROR_SCHEMA: a JSON scene does not match its schema (the message starts with the pointer).</summary>
+    public class EmbraSchemaException : FormatException, IEmbraException
+    {
+        public EmbraSchemaException(string message) : base(message) { }
+        public int Status { get { return Embra.Status.Schema; } }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>EMBRA_ERROR_STALE_ID, VERSION and LOCKED: the call does not fit the world's state.</summary>
+    public class EmbraInvalidOperationException : InvalidOperationException, IEmbraException
+    {
+        public EmbraInvalidOperationException(int status, string message) : base(message) { Status = status; }
+        public int Status { get; private set; }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>A call on a disposed World: the C library refused its NULL world, with its message.</summary>
+    public class EmbraObjectDisposedException : ObjectDisposedException, IEmbraException
+    {
+        public EmbraObjectDisposedException(int status, string message) : base("Embra.World", message) { Status = status; }
+        public int Status { get; private set; }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>EMBRA_ERROR_NUMERICAL: the step went non-finite; the world is as before the step.</summary>
+    public class EmbraNumericalException : ArithmeticException, IEmbraException
+    {
+        public EmbraNumericalException(string message) : base(message) { }
+        public int Status { get { return Embra.Status.Numerical; } }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>EMBRA_ERROR_INTERNAL (a bug in embra, or out of memory) and unknown codes.</summary>
+    public class EmbraException : Exception, IEmbraException
+    {
+        public EmbraException(int status, string message) : base(message) { Status = status; }
+        public int Status { get; private set; }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    public static class Errors
+    {
+        public static string LastMessage()
+        {
+            return Utf8(Native.embra_last_error_message());
+        }
+
+        public static string StatusName(int status)
+        {
+            return Utf8(Native.embra_status_name(status));
+        }
+
+        internal static string Utf8(IntPtr text)
+        {
+            if (text == IntPtr.Zero) return "";
+            int n = 0;
+            while (Marshal.ReadByte(text, n) != 0) ++n;
+            var bytes = new byte[n];
+            Marshal.Copy(text, bytes, 0, n);
+            return Encoding.UTF8.GetString(bytes);
+        }
+
+        /// <summary>The exception for a failed status, with this thread's last C message.</summary>
+        public static Exception For(int status, bool disposed = false)
+        {
+            string message = LastMessage();
+            if (disposed) return new EmbraObjectDisposedException(status, message + " (this World was disposed)");
+            switch (status)
+            {
+                case Status.InvalidArgument:
+                case Status.BufferTooSmall:
+                    return new EmbraArgumentException(status, message);
+                case Status.Schema:
+                    return new EmbraSchemaException(message);
+                case Status.StaleId:
+                case Status.Version:
+                case Status.Locked:
+                    return new EmbraInvalidOperationException(status, message);
+                case Status.Numerical:
+                    return new EmbraNumericalException(message);
+                default:
+                    return new EmbraException(status, message);
+            }
+        }
+
+        public static void Check(int status)
+        {
+            if (status != Status.Ok) throw For(status);
+        }
+    }
+
+    /// <summary>Owns one embra_world*; releasing it calls embra_world_destroy exactly once.</summary>
+    public sealed class WorldHandle : SafeHandle
+    {
+        internal WorldHandle(IntPtr world) : base(IntPtr.Zero, true) { SetHandle(world); }
+        public override bool IsInvalid { get { return handle == IntPtr.Zero; } }
+        protected override bool ReleaseHandle()
+        {
+            Native.embra_world_destroy(handle);
+            return true;
+        }
+    }
+
+    /// <summary>A body's id and its particles [First, First + Count).</summary>
+    public struct Body
+    {
+        public BodyId Id;
+        public int First, Count;
+    }
+
+    public static class Library
+    {
+        static Library()
+        {
+            // Header and library must agree before anything else (embra_check_abi).
+            Errors.Check(Native.embra_check_abi(Native.AbiVersion));
+        }
+
+        public static void CheckAbi(int headerAbiVersion = Native.AbiVersion)
+        {
+            Errors.Check(Native.embra_check_abi(headerAbiVersion));
+        }
+
+        public static int Version { get { return Native.embra_version(); } }
+        public static string VersionString { get { return Errors.Utf8(Native.embra_version_string()); } }
+        public static int AbiVersion { get { return Native.embra_abi_version(); } }
+        public static int ConstraintArity(ConstraintKind kind) { return Native.embra_constraint_arity((int)kind); }
+        public static SolverDef DefaultSolverDef() { return Native.embra_default_solver_def(); }
+        public static Material DefaultMaterial() { return Native.embra_default_material(); }
+        public static BodyDef DefaultBodyDef() { return Native.embra_default_body_def(); }
+        public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
+        internal static void Touch() { }
+    }
+
+    /// <summary>An embra world. Dispose it (using) to destroy it; a disposed World refuses every call
+    /// with an ObjectDisposedException carrying the C library's message.</summary>
+    public sealed unsafe class World : IDisposable
+    {
+        readonly WorldHandle handle;
+
+        World(IntPtr world) { handle = new WorldHandle(world); }
+
+        /// <summary>A world with the given solver settings (default: embra_default_solver_def()).</summary>
+        public World(SolverDef? solver = null)
+        {
+            Library.Touch();
+            SolverDef def = solver ?? Native.embra_default_solver_def();
+            IntPtr world;
+            Errors.Check(Native.embra_world_create(out world, ref def));
+            handle = new WorldHandle(world);
+        }
+
+        public static World LoadJson(string json, string baseDir = null)
+        {
+            Library.Touch();
+            byte[] text = Encoding.UTF8.GetBytes(json);
+            IntPtr world;
+            Errors.Check(Native.embra_world_load_json(out world, text, text.LongLength, CString(baseDir)));
+            return new World(world);
+        }
+
+        public static World LoadFile(string path)
+        {
+            Library.Touch();
+            IntPtr world;
+            Errors.Check(Native.embra_world_load_file(out world, CString(path)));
+            return new World(world);
+        }
+
+        static byte[] CString(string s)
+        {
+            return s == null ? null : Encoding.UTF8.GetBytes(s + "\0");
+        }
+
+        /// <summary>Destroys the world; waits for a call in progress on another thread. Idempotent.</summary>
+        public void Dispose()
+        {
+            lock (gate) handle.Dispose();
+        }
+        public bool IsDisposed { get { return handle.IsClosed; } }
+        public WorldHandle Handle { get { return handle; } }
+
+        delegate int Fn(IntPtr world);
+        readonly object gate = new object();
+
+        /// <summary>Calls C with the world kept alive for the call; a disposed World passes NULL, which C
+        /// refuses with its own message. The C library takes one thread at a time per world, so tasks
+        /// sharing one World take turns here instead of racing.</summary>
+        void Call(Fn fn)
+        {
+            lock (gate)
+            {
+                bool added = false;
+                try
+                {
+                    if (!handle.IsClosed) handle.DangerousAddRef(ref added);
+                    int status = fn(added ? handle.DangerousGetHandle() : IntPtr.Zero);
+                    if (status != Status.Ok) throw Errors.For(status, !added);
+                }
+                finally
+                {
+                    if (added) handle.DangerousRelease();
+                }
+            }
+        }
+
+        static void Need(bool ok, string message)
+        {
+            if (!ok) throw new ArgumentException(message);
+        }
+
+        static double[] Three(double[] v, string name)
+        {
+            if (v == null || v.Length != 3) throw new ArgumentException(name + ": expected 3 numbers");
+            return v;
+        }
+
+        // --- solver settings ------------------------------------------------------------------
+        public SolverDef Solver
+        {
+            get { var d = new SolverDef(); Call(w => Native.embra_world_get_solver(w, out d)); return d; }
+            set { var d = value; Call(w => Native.embra_world_set_solver(w, ref d)); }
+        }
+
+        public void SetGravity(double x, double y, double z)
+        {
+            var g = new[] { x, y, z };
+            Call(w => Native.embra_world_set_gravity(w, g));
+        }
+
+        public WorldCounts Counts
+        {
+            get { var c = new WorldCounts(); Call(w => Native.embra_world_get_counts(w, out c)); return c; }
+        }
+
+        // --- groups -----------------------------------------------------------------------------
+        public GroupId CreateGroup(int order = 0, int weight = 1)
+        {
+            var d = Native.embra_default_group_def();
+            d.Order = order;
+            d.Weight = weight;
+            var g = new GroupId();
+            Call(w => Native.embra_group_create(w, ref d, out g));
+            return g;
+        }
+
+        public void DestroyGroup(GroupId group) { Call(w => Native.embra_group_destroy(w, group)); }
+        public void SetGroupOrder(GroupId group, int order) { Call(w => Native.embra_group_set_order(w, group, order)); }
+        public void SetGroupWeight(GroupId group, int weight) { Call(w => Native.embra_group_set_weight(w, group, weight)); }
+
+        public GroupId DefaultGroup
+        {
+            get { var g = new GroupId(); Call(w => Native.embra_world_default_group(w, out g)); return g; }
+        }
+
+        public GroupId ContactGroup
+        {
+            get { var g = new GroupId(); Call(w => Native.embra_world_contact_group(w, out g)); return g; }
+        }
+
+        public GroupReport GroupReport(GroupId group)
+        {
+            var r = new GroupReport();
+            Call(w => Native.embra_group_get_report(w, group, out r));
+            return r;
+        }
+
+        // --- bodies -----------------------------------------------------------------------------
+        /// <summary>Adds a body (embra_body_create). positions: xyz per vertex; triangles, edges, tets:
+        /// body-local indices, 3, 2, 4 per element; masses (kg per vertex) and uvs (2 per vertex) optional.
+        /// `def` supplies the material, generate flags and groups (its pointers and counts are set here).</summary>
+        public Body CreateBody(double[] positions, int[] triangles = null, int[] edges = null, int[] tets = null,
+                               double[] masses = null, double[] uvs = null, BodyDef? def = null)
+        {
+            Need(positions != null && positions.Length % 3 == 0, "positions: a whole number of xyz triples is required");
+            int n = positions.Length / 3;
+            Need(triangles == null || triangles.Length % 3 == 0, "triangles: 3 indices per triangle");
+            Need(edges == null || edges.Length % 2 == 0, "edges: 2 indices per edge");
+            Need(tets == null || tets.Length % 4 == 0, "tets: 4 indices per tetrahedron");
+            Need(masses == null || masses.Length == n, "masses: one per vertex");
+            Need(uvs == null || uvs.Length == 2 * n, "uvs: two per vertex");
+            BodyDef d = def ?? Native.embra_default_body_def();
+            var body = new Body();
+            fixed (double* p = positions, m = masses, uv = uvs)
+            fixed (int* t = triangles, e = edges, k = tets)
+            {
+                d.VertexCount = n;
+                d.Positions = (IntPtr)p;
+                d.Masses = (IntPtr)m;
+                d.Uvs = (IntPtr)uv;
+                d.TriangleCount = triangles == null ? 0 : triangles.Length / 3;
+                d.Triangles = (IntPtr)t;
+                d.EdgeCount = edges == null ? 0 : edges.Length / 2;
+                d.Edges = (IntPtr)e;
+                d.TetCount = tets == null ? 0 : tets.Length / 4;
+                d.Tets = (IntPtr)k;
+                BodyId id = new BodyId();
+                int first = 0;
+                Call(w => Native.embra_body_create(w, ref d, out id, out first));
+                body.Id = id;
+                body.First = first;
+                body.Count = n;
+            }
+            return body;
+        }
+
+        public void GetBodyParticles(BodyId body, out int first, out int count)
+        {
+            int f = 0, c = 0;
+            Call(w => Native.embra_body_get_particles(w, body, out f, out c));
+            first = f;
+            count = c;
+        }
+
+        public void SetRestScale(BodyId body, double scale, double scaleU = 1.0, double scaleV = 1.0)
+        {
+            Call(w => Native.embra_body_set_rest_scale(w, body, scale, scaleU, scaleV));
+        }
+
+        /// <summary>A body's triangles as world particle indices, 3 per triangle.</summary>
+        public int[] BodyTriangles(BodyId body)
+        {
+            long n = 0;
+            Call(w => Native.embra_body_get_triangles(w, body, null, 0, out n));
+            var out_ = new int[n];
+            Call(w => Native.embra_body_get_triangles(w, body, out_, out_.LongLength, out n));
+            return out_;
+        }
+
+        // --- constraints ------------------------------------------------------------------------
+        /// <summary>One constraint; rest null measures it from the current positions.</summary>
+        public void AddConstraint(ConstraintKind kind, int[] particles, double? rest = null, double compliance = 0.0,
+                                  GroupId group = default(GroupId))
+        {
+            int arity = Native.embra_constraint_arity((int)kind);
+            Need(particles != null && particles.Length <= 4 && (arity == 0 || particles.Length == arity),
+                 "particles: kind " + kind + " takes " + arity + " particles");
+            var def = Native.embra_default_constraint_def();  // filled on the stack (fixed buffer), then captured
+            def.Kind = (int)kind;
+            def.Group = group;
+            for (int i = 0; i < particles.Length; ++i) def.Particles[i] = particles[i];
+            if (rest.HasValue)
+            {
+                def.RestFromCurrent = 0;
+                def.Rest = rest.Value;
+            }
+            def.Compliance = compliance;
+            var d = def;
+            Call(w => Native.embra_constraint_add(w, ref d));
+        }
+
+        /// <summary>Many constraints of one kind at once, all or none: particles holds arity indices per
+        /// constraint; rest and compliances one value per constraint, or null.</summary>
+        public int AddConstraints(ConstraintKind kind, int[] particles, double[] rest = null, double[] compliances = null,
+                                  double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            int arity = Native.embra_constraint_arity((int)kind);
+            Need(particles != null && (arity == 0 || particles.Length % arity == 0),
+                 "particles: a whole number of " + arity + "-tuples is required");
+            int count = arity == 0 ? particles.Length : particles.Length / arity;
+            Need(rest == null || rest.Length == count, "rest: one value per constraint");
+            Need(compliances == null || compliances.Length == count, "compliances: one value per constraint");
+            var d = Native.embra_default_constraint_batch_def();
+            d.Kind = (int)kind;
+            d.Group = group;
+            d.Count = count;
+            d.Compliance = compliance;
+            fixed (int* p = particles)
+            fixed (double* r = rest, c = compliances)
+            {
+                d.Particles = (IntPtr)p;
+                d.Rest = (IntPtr)r;
+                d.Compliances = (IntPtr)c;
+                Call(w => Native.embra_constraints_add(w, ref d));
+            }
+            return count;
+        }
+
+        // --- pins -------------------------------------------------------------------------------
+        /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
+        public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Three(target, "target");
+            var def = Native.embra_default_pin_def();  // filled while on the stack (fixed buffer), then captured
+            def.Particle = particle;
+            for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            def.Compliance = compliance;
+            def.Group = group;
+            var d = def;
+            var pin = new PinId();
+            Call(w => Native.embra_pin_create(w, ref d, out pin));
+            return pin;
+        }
+
+        public void DestroyPin(PinId pin) { Call(w => Native.embra_pin_destroy(w, pin)); }
+
+        public void SetPinTarget(PinId pin, double[] target)
+        {
+            Three(target, "target");
+            Call(w => Native.embra_pin_set_target(w, pin, target));
+        }
+
+        public double[] PinTarget(PinId pin)
+        {
+            var t = new double[3];
+            Call(w => Native.embra_pin_get_target(w, pin, t));
+            return t;
+        }
+
+        // --- colliders --------------------------------------------------------------------------
+        /// <summary>A collider from a def (from Native.embra_default_collider_def(), fields set), with
+        /// the local vertices (and triangles) of a convex or mesh shape.</summary>
+        public ColliderId CreateCollider(ColliderDef def, double[] vertices = null, int[] triangles = null)
+        {
+            Need(vertices == null || vertices.Length % 3 == 0, "vertices: a whole number of xyz triples is required");
+            Need(triangles == null || triangles.Length % 3 == 0, "triangles: 3 indices per triangle");
+            var c = new ColliderId();
+            fixed (double* v = vertices)
+            fixed (int* t = triangles)
+            {
+                if (vertices != null)
+                {
+                    def.Vertices = (IntPtr)v;
+                    def.VertexCount = vertices.Length / 3;
+                }
+                if (triangles != null)
+                {
+                    def.Triangles = (IntPtr)t;
+                    def.TriangleCount = triangles.Length / 3;
+                }
+                Call(w => Native.embra_collider_create(w, ref def, out c));
+            }
+            return c;
+        }
+
+        public void DestroyCollider(ColliderId collider) { Call(w => Native.embra_collider_destroy(w, collider)); }
+
+        public void SetColliderTransform(ColliderId collider, double[] position, double[] rotation)
+        {
+            Three(position, "position");
+            Need(rotation != null && rotation.Length == 4, "rotation: a quaternion {w, x, y, z}");
+            Call(w => Native.embra_collider_set_transform(w, collider, position, rotation));
+        }
+
+        // --- stepping and reading back ----------------------------------------------------------
+        public void Step(int frames = 1)
+        {
+            for (int i = 0; i < frames; ++i) Call(Native.embra_world_step);
+        }
+
+        public StepReport Report
+        {
+            get { var r = new StepReport(); Call(w => Native.embra_world_get_report(w, out r)); return r; }
+        }
+
+        public Warning Warning
+        {
+            get { var r = new Warning(); Call(w => Native.embra_world_get_warning(w, out r)); return r; }
+        }
+
+        /// <summary>Positions (m) of particles [first, first + count) as xyz, into `into` when given
+        /// (capacity = its length) or a new array; count -1 = to the last particle.</summary>
+        public double[] GetPositions(int first = 0, int count = -1, double[] into = null)
+        {
+            return Read(Native.embra_world_get_positions, first, count, into);
+        }
+
+        public double[] GetVelocities(int first = 0, int count = -1, double[] into = null)
+        {
+            return Read(Native.embra_world_get_velocities, first, count, into);
+        }
+
+        delegate int ReadFn(IntPtr world, double[] xyz, long capacity, int first, int count);
+
+        double[] Read(ReadFn fn, int first, int count, double[] into)
+        {
+            if (count == -1) count = Math.Max(Counts.Particles - first, 0);
+            double[] xyz = into ?? new double[3 * (long)Math.Max(count, 0)];
+            Call(w => fn(w, xyz, xyz.LongLength, first, count));
+            return xyz;
+        }
+
+        /// <summary>Moves particles [first, first + xyz.Length / 3) to xyz (m); velocities are kept.</summary>
+        public void SetPositions(double[] xyz, int first = 0)
+        {
+            Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
+            Call(w => Native.embra_world_set_positions(w, xyz, first, xyz.Length / 3));
+        }
+
+        public void SetVelocities(double[] xyz, int first = 0)
+        {
+            Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
+            Call(w => Native.embra_world_set_velocities(w, xyz, first, xyz.Length / 3));
+        }
+
+        // --- JSON scenes ------------------------------------------------------------------------
+        public string SaveJson()
+        {
+            long n = 0;
+            Call(w => Native.embra_world_save_json(w, null, 0, out n));
+            var text = new byte[n];
+            Call(w => Native.embra_world_save_json(w, text, text.LongLength, out n));
+            return Encoding.UTF8.GetString(text, 0, (int)n - 1);
+        }
+
+        public void SaveFile(string path)
+        {
+            byte[] p = CString(path);
+            Call(w => Native.embra_world_save_file(w, p));
+        }
+
+        public long SceneFrames
+        {
+            get { long f = 0; Call(w => Native.embra_world_get_scene_frames(w, out f)); return f; }
+        }
+    }
+}

@@ -1,0 +1,75 @@
+"""embra for Python: the whole C ABI of libembra through ctypes and the standard library.
+
+    import embra
+    with embra.World(gravity=(0, 0, 9.81)) as world:
+        body = world.create_body(xyz, triangles=tri, mass=0.5)
+        world.create_pin(body.first, xyz[0])
+        world.step(100)
+        print(world.positions())
+
+libembra is found from $EMBRA_LIBRARY, next to this package, or the system's library path. numpy
+is optional: when installed, arrays go to and from C without copies.
+"""
+
+from . import _capi
+from ._capi import (ABI_VERSION, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
+                    GroupId, GroupReport, Material, PinDef, PinId, SolverDef, StepReport, WorldCounts, library_path)
+from ._capi import Warning as StepWarning
+from ._buffers import have_numpy
+from .errors import (BufferTooSmallError, EmbraError, InternalError, InvalidArgumentError, LockedError,
+                     NumericalError, SchemaError, StaleIdError, VersionError, check)
+from .world import GENERATE, KINDS, SHAPES, Body, World, as_dict
+
+_lib = _capi.lib
+
+
+def version():
+    """The library's version as MAJOR * 10000 + MINOR * 100 + PATCH."""
+    return _lib.embra_version()
+
+
+def version_string():
+    return _lib.embra_version_string().decode()
+
+
+def abi_version():
+    return _lib.embra_abi_version()
+
+
+def check_abi(header_abi_version=ABI_VERSION):
+    """Raises VersionError unless the library's ABI is `header_abi_version`."""
+    check(_lib.embra_check_abi(int(header_abi_version)))
+
+
+def status_name(status):
+    return _lib.embra_status_name(int(status)).decode()
+
+
+def last_error_message():
+    """The calling thread's last C error message ("" if none)."""
+    return _lib.embra_last_error_message().decode("utf-8", "replace")
+
+
+def constraint_arity(kind):
+    return _lib.embra_constraint_arity(KINDS[kind] if isinstance(kind, str) else int(kind))
+
+
+def default_solver_def():
+    return _lib.embra_default_solver_def()
+
+
+def default_material():
+    return _lib.embra_default_material()
+
+
+check_abi()  # these bindings and the loaded library must agree before anything else
+
+__version__ = version_string()
+__all__ = [
+    "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
+    "last_error_message", "constraint_arity", "default_solver_def", "default_material", "have_numpy",
+    "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError", "StaleIdError", "BufferTooSmallError",
+    "SchemaError", "VersionError", "LockedError", "NumericalError", "InternalError", "SolverDef", "Material",
+    "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef", "ColliderDef", "StepReport", "GroupReport",
+    "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "SHAPES", "KINDS", "GENERATE",
+]

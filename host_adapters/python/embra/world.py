@@ -1,0 +1,496 @@
+"""The World: a Python view of one embra_world*, covering the whole C ABI.
+
+A refused call raises the exception of its status (see :mod:`embra.errors`) with the C library's
+message and leaves the world unchanged, exactly as the C function does. The C library takes one
+thread at a time per world; a World holds a lock around each call, so threads sharing one World
+take turns (and close() waits for a call in progress) instead of racing. Different Worlds step on
+different threads at once: ctypes releases the GIL for every call into libembra.
+"""
+
+import ctypes
+import threading
+from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
+
+from . import _buffers as buf
+from . import _capi
+from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
+                    GroupId, GroupReport, Material, PinDef, PinId, SolverDef, StepReport, Warning, WorldCounts,
+                    lib)
+from .errors import EmbraError, check, error_for
+
+SHAPES = {"plane": _capi.COLLIDER_PLANE, "sphere": _capi.COLLIDER_SPHERE, "box": _capi.COLLIDER_BOX,
+          "capsule": _capi.COLLIDER_CAPSULE, "convex": _capi.COLLIDER_CONVEX, "mesh": _capi.COLLIDER_MESH}
+KINDS = {"distance": _capi.CONSTRAINT_DISTANCE, "edge_angle": _capi.CONSTRAINT_EDGE_ANGLE,
+         "dihedral": _capi.CONSTRAINT_DIHEDRAL, "tet_volume": _capi.CONSTRAINT_TET_VOLUME,
+         "weld": _capi.CONSTRAINT_WELD, "tether": _capi.CONSTRAINT_TETHER}
+GENERATE = {"stretch": _capi.GENERATE_STRETCH, "shear": _capi.GENERATE_SHEAR, "bend": _capi.GENERATE_BEND,
+            "volume": _capi.GENERATE_VOLUME}
+
+
+def as_dict(struct):
+    """A ctypes struct (def, report, counts) as a plain dict, arrays as tuples, nested structs as dicts."""
+    out = {}
+    for name, _ in struct._fields_:
+        v = getattr(struct, name)
+        if isinstance(v, ctypes.Array):
+            v = tuple(v)
+        elif isinstance(v, ctypes.Structure) and not isinstance(v, _capi._Id):
+            v = as_dict(v)
+        out[name] = v
+    return out
+
+
+def _fill(struct, fields, what):
+    """Sets named fields of a ctypes struct from keyword arguments; unknown names are a TypeError."""
+    names = {name: ctype for name, ctype in struct._fields_}
+    for key, value in fields.items():
+        if key not in names:
+            raise TypeError(f"{what} has no field '{key}' (fields: {', '.join(names)})")
+        ctype = names[key]
+        if issubclass(ctype, ctypes.Array):
+            values = list(value)
+            if len(values) != ctype._length_:
+                raise ValueError(f"{what}.{key}: expected {ctype._length_} numbers, got {len(values)}")
+            setattr(struct, key, ctype(*values))
+        elif issubclass(ctype, _capi._Id):
+            setattr(struct, key, _id(value, ctype, f"{what}.{key}"))
+        elif issubclass(ctype, ctypes.Structure):
+            inner = getattr(struct, key)
+            _fill(inner, as_dict(value) if isinstance(value, ctypes.Structure) else dict(value), f"{what}.{key}")
+        elif ctype in (c_int32, c_int64) or ctype is ctypes.c_uint32:
+            setattr(struct, key, buf.int32(value, f"{what}.{key}") if ctype is c_int32 else int(value))
+        else:
+            setattr(struct, key, float(value))
+    return struct
+
+
+def _id(value, cls, name):
+    if value is None:
+        return cls()
+    if isinstance(value, Body) and cls is BodyId:
+        return value.id
+    if not isinstance(value, cls):
+        raise TypeError(f"{name}: expected {cls.__name__}, got {type(value).__name__}")
+    return value
+
+
+def _enum(value, table, name):
+    if isinstance(value, str):
+        if value not in table:
+            raise ValueError(f"{name}: unknown name '{value}' (known: {', '.join(table)})")
+        return table[value]
+    return buf.int32(value, name)
+
+
+class Body:
+    """A body's id and its particle range [first, first + count)."""
+
+    __slots__ = ("id", "first", "count")
+
+    def __init__(self, body_id, first, count):
+        self.id, self.first, self.count = body_id, first, count
+
+    def __repr__(self):
+        return f"Body(index={self.id.index}, first={self.first}, count={self.count})"
+
+
+class World:
+    """An embra world. Use it as a context manager, or call close(); a closed World refuses every call."""
+
+    def __init__(self, solver=None, **settings):
+        """Creates a world from embra_default_solver_def(), `solver` (a SolverDef or dict) and keyword
+        settings (any SolverDef field: dt, substeps, iterations, gravity, damping, ...)."""
+        self._ptr = None
+        self._lock = threading.Lock()
+        d = lib.embra_default_solver_def()
+        if solver is not None:
+            _fill(d, as_dict(solver) if isinstance(solver, SolverDef) else dict(solver), "SolverDef")
+        _fill(d, settings, "SolverDef")
+        ptr = c_void_p()
+        check(lib.embra_world_create(byref(ptr), byref(d)))
+        self._ptr = ptr
+
+    @classmethod
+    def _adopt(cls, ptr):
+        w = cls.__new__(cls)
+        w._ptr = ptr
+        w._lock = threading.Lock()
+        return w
+
+    @classmethod
+    def load_json(cls, text, base_dir=None):
+        """A world from scene JSON text (str or bytes); `base_dir` resolves relative OBJ paths."""
+        data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
+        ptr = c_void_p()
+        check(lib.embra_world_load_json(byref(ptr), data, len(data),
+                                        None if base_dir is None else str(base_dir).encode()))
+        return cls._adopt(ptr)
+
+    @classmethod
+    def load_file(cls, path):
+        """A world from a scene file (relative OBJ paths resolve against its folder)."""
+        ptr = c_void_p()
+        check(lib.embra_world_load_file(byref(ptr), str(path).encode()))
+        return cls._adopt(ptr)
+
+    # --- lifetime ------------------------------------------------------------------------------
+    def close(self):
+        """Destroys the world (embra_world_destroy). Idempotent; waits for a call in progress."""
+        lock = getattr(self, "_lock", None)
+        if lock is None:  # __init__ failed before the world existed
+            return
+        with lock:
+            ptr, self._ptr = self._ptr, None
+            if ptr is not None and ptr.value:
+                lib.embra_world_destroy(ptr)
+
+    @property
+    def closed(self):
+        return self._ptr is None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be gone
+            pass
+
+    def _call(self, name, *args):
+        """Calls a C function with this world first; a closed World passes NULL, which C refuses."""
+        with self._lock:
+            ptr = self._ptr
+            status = getattr(lib, name)(ptr, *args)
+            if status != _capi.OK:
+                err = error_for(status)  # read the message before another call on this thread
+        if status != _capi.OK:
+            if ptr is None:
+                err = type(err)(f"{err.message} (this World was closed)")
+            raise err
+
+    # --- solver settings -----------------------------------------------------------------------
+    @property
+    def solver(self):
+        """The solver settings (a SolverDef copy)."""
+        d = SolverDef()
+        self._call("embra_world_get_solver", byref(d))
+        return d
+
+    def set_solver(self, solver=None, **settings):
+        """Replaces the settings: the current ones, then `solver` (SolverDef or dict), then keywords."""
+        d = self.solver
+        if solver is not None:
+            _fill(d, as_dict(solver) if isinstance(solver, SolverDef) else dict(solver), "SolverDef")
+        _fill(d, settings, "SolverDef")
+        self._call("embra_world_set_solver", byref(d))
+
+    def set_gravity(self, gravity):
+        """Gravity in m/s^2 from the next step on (reverse it for the Gaudi paradigm)."""
+        self._call("embra_world_set_gravity", buf.d3(gravity, "gravity"))
+
+    def counts(self):
+        c = WorldCounts()
+        self._call("embra_world_get_counts", byref(c))
+        return c
+
+    @property
+    def particle_count(self):
+        return self.counts().particles
+
+    # --- groups --------------------------------------------------------------------------------
+    def create_group(self, order=0, weight=1):
+        d = lib.embra_default_group_def()
+        d.order, d.weight = buf.int32(order, "order"), buf.int32(weight, "weight")
+        g = GroupId()
+        self._call("embra_group_create", byref(d), byref(g))
+        return g
+
+    def destroy_group(self, group):
+        self._call("embra_group_destroy", _id(group, GroupId, "group"))
+
+    def set_group_order(self, group, order):
+        self._call("embra_group_set_order", _id(group, GroupId, "group"), buf.int32(order, "order"))
+
+    def set_group_weight(self, group, weight):
+        self._call("embra_group_set_weight", _id(group, GroupId, "group"), buf.int32(weight, "weight"))
+
+    def default_group(self):
+        g = GroupId()
+        self._call("embra_world_default_group", byref(g))
+        return g
+
+    def contact_group(self):
+        g = GroupId()
+        self._call("embra_world_contact_group", byref(g))
+        return g
+
+    def group_report(self, group):
+        r = GroupReport()
+        self._call("embra_group_get_report", _id(group, GroupId, "group"), byref(r))
+        return r
+
+    # --- bodies --------------------------------------------------------------------------------
+    def create_body(self, positions, *, triangles=None, edges=None, tets=None, masses=None, uvs=None,
+                    generate=None, material=None, stretch_group=None, shear_group=None, bend_group=None,
+                    volume_group=None, **material_fields):
+        """Adds a body (embra_body_create) and returns its Body (id, first particle, count).
+
+        positions: xyz per vertex (flat or nested, numpy (n, 3) used in place); triangles, edges,
+        tets: body-local vertex indices; masses (kg per vertex), uvs (2 per vertex); generate: flags
+        or names ("stretch", "shear", "bend", "volume"); material: a Material or dict, and/or
+        material fields as keywords (mass=0.5, stretch_compliance=1e-2, ...)."""
+        d = lib.embra_default_body_def()
+        keep = []
+
+        def elements(data, width, name):
+            p, n, k = buf.ints_in(data, name)
+            if n % width:
+                raise ValueError(f"{name}: {n} indices is not a whole number of {width}-tuples")
+            keep.append(k)
+            return p, n // width
+
+        p, n, k = buf.doubles_in(positions, "positions")
+        if n % 3:
+            raise ValueError(f"positions: {n} numbers is not a whole number of xyz triples")
+        keep.append(k)
+        d.positions, d.vertex_count = p, buf.int32(n // 3, "vertex count")
+        if masses is not None:
+            p, m, k = buf.doubles_in(masses, "masses")
+            if m != n // 3:
+                raise ValueError(f"masses: {m} values for {n // 3} vertices")
+            keep.append(k)
+            d.masses = p
+        if uvs is not None:
+            p, m, k = buf.doubles_in(uvs, "uvs")
+            if m != 2 * (n // 3):
+                raise ValueError(f"uvs: {m} numbers for {n // 3} vertices (2 per vertex)")
+            keep.append(k)
+            d.uvs = p
+        if triangles is not None:
+            d.triangles, d.triangle_count = elements(triangles, 3, "triangles")
+        if edges is not None:
+            d.edges, d.edge_count = elements(edges, 2, "edges")
+        if tets is not None:
+            d.tets, d.tet_count = elements(tets, 4, "tets")
+        if generate is not None:
+            if isinstance(generate, (list, tuple, set, frozenset)):
+                flags = 0
+                for g in generate:
+                    flags |= _enum(g, GENERATE, "generate")
+                d.generate = flags
+            else:
+                d.generate = _enum(generate, GENERATE, "generate")
+        if material is not None:
+            _fill(d.material, as_dict(material) if isinstance(material, Material) else dict(material), "Material")
+        _fill(d.material, material_fields, "Material")
+        d.stretch_group = _id(stretch_group, GroupId, "stretch_group")
+        d.shear_group = _id(shear_group, GroupId, "shear_group")
+        d.bend_group = _id(bend_group, GroupId, "bend_group")
+        d.volume_group = _id(volume_group, GroupId, "volume_group")
+        body, first = BodyId(), c_int32()
+        self._call("embra_body_create", byref(d), byref(body), byref(first))
+        return Body(body, first.value, d.vertex_count)
+
+    def body_particles(self, body):
+        """(first, count) of a body's particles."""
+        first, count = c_int32(), c_int32()
+        self._call("embra_body_get_particles", _id(body, BodyId, "body"), byref(first), byref(count))
+        return first.value, count.value
+
+    def set_rest_scale(self, body, scale=1.0, scale_u=1.0, scale_v=1.0):
+        self._call("embra_body_set_rest_scale", _id(body, BodyId, "body"), float(scale), float(scale_u),
+                   float(scale_v))
+
+    def body_triangles(self, body):
+        """A body's triangles as world particle indices: numpy (t, 3) int32, or flat array('i')."""
+        b = _id(body, BodyId, "body")
+        n = c_int64()
+        self._call("embra_body_get_triangles", b, None, 0, byref(n))
+        if buf.np is not None:
+            out = buf.np.empty((n.value // 3, 3), dtype=buf.np.int32)
+            pointer = out.ctypes.data_as(ctypes.POINTER(c_int32))
+        else:
+            from array import array
+            out = array(buf._INT32_CODE, bytes(4 * n.value))
+            pointer = ctypes.cast((c_int32 * n.value).from_buffer(out), ctypes.POINTER(c_int32))
+        self._call("embra_body_get_triangles", b, pointer, n.value, byref(n))
+        return out
+
+    # --- constraints ---------------------------------------------------------------------------
+    def add_constraint(self, kind, particles, rest=None, compliance=0.0, group=None):
+        """One constraint (embra_constraint_add); rest None measures it from current positions."""
+        d = lib.embra_default_constraint_def()
+        d.kind = _enum(kind, KINDS, "kind")
+        ids = [buf.int32(p, "particles") for p in particles]
+        arity = lib.embra_constraint_arity(d.kind)
+        if arity and len(ids) != arity:
+            raise ValueError(f"particles: kind {kind} takes {arity} particles, got {len(ids)}")
+        if len(ids) > 4:
+            raise ValueError(f"particles: at most 4, got {len(ids)}")
+        for i, p in enumerate(ids):
+            d.particles[i] = p
+        d.group = _id(group, GroupId, "group")
+        if rest is not None:
+            d.rest_from_current, d.rest = 0, float(rest)
+        d.compliance = float(compliance)
+        self._call("embra_constraint_add", byref(d))
+
+    def add_constraints(self, kind, particles, rest=None, compliances=None, compliance=0.0, group=None):
+        """Many constraints of one kind at once (embra_constraints_add), all or none.
+
+        particles: arity indices per constraint (flat, nested or numpy (count, arity)); rest and
+        compliances: one value per constraint or None."""
+        d = lib.embra_default_constraint_batch_def()
+        d.kind = _enum(kind, KINDS, "kind")
+        arity = lib.embra_constraint_arity(d.kind)
+        p, n, keep_p = buf.ints_in(particles, "particles")
+        if arity and n % arity:
+            raise ValueError(f"particles: {n} indices is not a whole number of {arity}-tuples")
+        count = n // arity if arity else n
+        d.count, d.particles = buf.int32(count, "count"), p
+        keep = [keep_p]
+        if rest is not None:
+            r, m, k = buf.doubles_in(rest, "rest")
+            if m != count:
+                raise ValueError(f"rest: {m} values for {count} constraints")
+            d.rest = r
+            keep.append(k)
+        if compliances is not None:
+            c, m, k = buf.doubles_in(compliances, "compliances")
+            if m != count:
+                raise ValueError(f"compliances: {m} values for {count} constraints")
+            d.compliances = c
+            keep.append(k)
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        self._call("embra_constraints_add", byref(d))
+        return count
+
+    # --- pins ----------------------------------------------------------------------------------
+    def create_pin(self, particle, target, compliance=0.0, group=None):
+        """Holds `particle` at `target` (m); compliance 0 = hard, > 0 (m/N) a soft pin in `group`."""
+        d = lib.embra_default_pin_def()
+        d.particle = buf.int32(particle, "particle")
+        d.target = buf.d3(target, "target")
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        pin = PinId()
+        self._call("embra_pin_create", byref(d), byref(pin))
+        return pin
+
+    def destroy_pin(self, pin):
+        self._call("embra_pin_destroy", _id(pin, PinId, "pin"))
+
+    def set_pin_target(self, pin, target):
+        self._call("embra_pin_set_target", _id(pin, PinId, "pin"), buf.d3(target, "target"))
+
+    def pin_target(self, pin):
+        out = (c_double * 3)()
+        self._call("embra_pin_get_target", _id(pin, PinId, "pin"), out)
+        return tuple(out)
+
+    # --- colliders -----------------------------------------------------------------------------
+    def create_collider(self, shape, *, vertices=None, triangles=None, **fields):
+        """A collider: shape ("plane", "sphere", "box", "capsule", "convex", "mesh" or its number),
+        ColliderDef fields as keywords (position, rotation {w,x,y,z}, radius, half_extents, ...),
+        and for convex and mesh shapes their local vertices (and triangles)."""
+        d = lib.embra_default_collider_def()
+        d.shape = _enum(shape, SHAPES, "shape")
+        _fill(d, fields, "ColliderDef")
+        keep = []
+        if vertices is not None:
+            p, n, k = buf.doubles_in(vertices, "vertices")
+            if n % 3:
+                raise ValueError(f"vertices: {n} numbers is not a whole number of xyz triples")
+            d.vertices, d.vertex_count = p, buf.int32(n // 3, "vertex count")
+            keep.append(k)
+        if triangles is not None:
+            p, n, k = buf.ints_in(triangles, "triangles")
+            if n % 3:
+                raise ValueError(f"triangles: {n} indices is not a whole number of triples")
+            d.triangles, d.triangle_count = p, buf.int32(n // 3, "triangle count")
+            keep.append(k)
+        c = ColliderId()
+        self._call("embra_collider_create", byref(d), byref(c))
+        return c
+
+    def destroy_collider(self, collider):
+        self._call("embra_collider_destroy", _id(collider, ColliderId, "collider"))
+
+    def set_collider_transform(self, collider, position, rotation=(1.0, 0.0, 0.0, 0.0)):
+        self._call("embra_collider_set_transform", _id(collider, ColliderId, "collider"),
+                   buf.d3(position, "position"), buf.d4(rotation, "rotation"))
+
+    # --- stepping and reading back -------------------------------------------------------------
+    def step(self, frames=1):
+        """Advances `frames` frames. NumericalError: the world is as before the failing frame."""
+        for _ in range(buf.int32(frames, "frames")):
+            self._call("embra_world_step")
+
+    def report(self):
+        r = StepReport()
+        self._call("embra_world_get_report", byref(r))
+        return r
+
+    def warning(self):
+        w = Warning()
+        self._call("embra_world_get_warning", byref(w))
+        return w
+
+    def _read(self, name, first, count, out):
+        first = buf.int32(first, "first")
+        if count is None:
+            count = max(self.particle_count - first, 0)
+        count = buf.int32(count, "count")
+        result, pointer, capacity, keep = buf.doubles_out(max(count, 0), out, "out")
+        self._call(name, pointer, capacity, first, count)
+        del keep
+        return result
+
+    def positions(self, first=0, count=None, out=None):
+        """Positions (m) of particles [first, first + count): numpy (count, 3) written in place by C
+        when numpy is installed, else a flat array('d'); or into `out` (a writable double buffer)."""
+        return self._read("embra_world_get_positions", first, count, out)
+
+    def velocities(self, first=0, count=None, out=None):
+        """Velocities (m/s), as positions()."""
+        return self._read("embra_world_get_velocities", first, count, out)
+
+    def _write(self, name, xyz, first):
+        p, n, keep = buf.doubles_in(xyz, "xyz")
+        if n % 3:
+            raise ValueError(f"xyz: {n} numbers is not a whole number of xyz triples")
+        self._call(name, p, buf.int32(first, "first"), buf.int32(n // 3, "count"))
+        del keep
+
+    def set_positions(self, xyz, first=0):
+        """Moves particles [first, first + len) to xyz (m); velocities are kept."""
+        self._write("embra_world_set_positions", xyz, first)
+
+    def set_velocities(self, xyz, first=0):
+        self._write("embra_world_set_velocities", xyz, first)
+
+    # --- JSON scenes ---------------------------------------------------------------------------
+    def save_json(self):
+        """The world as scene JSON text (complete: loading it steps on bit-identically)."""
+        n = c_int64()
+        self._call("embra_world_save_json", None, 0, byref(n))
+        out = (c_char * n.value)()
+        self._call("embra_world_save_json", out, n.value, byref(n))
+        return out.raw[:n.value - 1].decode("utf-8")
+
+    def save_file(self, path):
+        self._call("embra_world_save_file", str(path).encode())
+
+    def scene_frames(self):
+        f = c_int64()
+        self._call("embra_world_get_scene_frames", byref(f))
+        return f.value
+
+
+__all__ = ["World", "Body", "as_dict", "SHAPES", "KINDS", "GENERATE", "EmbraError"]

@@ -1,0 +1,607 @@
+// The C# bindings against the C host: the Gaudi tent bit for bit, every error path as a .NET
+// exception with the C message, worlds on parallel tasks, and the Grasshopper-style component.
+// Environment (tests/adapters/CMakeLists.txt): EMBRA_CLI (the `embra` command), EMBRA_SOURCE_DIR.
+using System;
+using System.Collections.Generic;
+using System.Diagnostics;
+using System.Globalization;
+using System.IO;
+using System.Linq;
+using System.Reflection;
+using System.Text.RegularExpressions;
+using System.Threading.Tasks;
+using Embra;
+using Embra.Grasshopper;
+using NUnit.Framework;
+
+namespace Embra.Tests
+{
+    static class Tent
+    {
+        /// <summary>The mesh of `embra demo tent` (host_adapters/cli/embra_cli.c), same arithmetic, same order.</summary>
+        public static void Mesh(int rows, double side, out double[] xyz, out int[] tri, out int[] corners)
+        {
+            double h = side * Math.Sqrt(3.0) / 2.0;
+            int n = (rows + 1) * (rows + 2) / 2;
+            xyz = new double[3 * n];
+            tri = new int[3 * rows * rows];
+            int v = 0, t = 0;
+            for (int r = 0; r <= rows; ++r)
+                for (int c = 0; c <= rows - r; ++c)
+                {
+                    xyz[3 * v] = side * ((double)c + 0.5 * r) / rows - side / 2;
+                    xyz[3 * v + 1] = h * (double)r / rows - h / 3;
+                    xyz[3 * v + 2] = 0.0;
+                    ++v;
+                }
+            Func<int, int, int> idx = (r, c) => r * (rows + 1) - (r * (r - 1)) / 2 + c;
+            for (int r = 0; r < rows; ++r)
+                for (int c = 0; c < rows - r; ++c)
+                {
+                    tri[t++] = idx(r, c); tri[t++] = idx(r, c + 1); tri[t++] = idx(r + 1, c);
+                    if (c + 1 < rows - r) { tri[t++] = idx(r, c + 1); tri[t++] = idx(r + 1, c + 1); tri[t++] = idx(r + 1, c); }
+                }
+            corners = new[] { idx(0, 0), idx(0, rows), idx(rows, 0) };
+        }
+
+        public static double Draw(int frame) { return frame < 60 ? frame / 60.0 : 1.0; }
+
+        /// <summary>The tent built and stepped through World, as the C host does it.</summary>
+        public static double[] Run(int frames, int rows = 40)
+        {
+            double[] xyz; int[] tri, corners;
+            Mesh(rows, 1.0, out xyz, out tri, out corners);
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = +9.81; }
+            solver.Damping = 2.0;
+            solver.Substeps = 20;
+            solver.Iterations = 4;
+            solver.SettleSpeed = 1e-3;
+            using (var w = new World(solver))
+            {
+                var stretch = w.CreateGroup(0, 2);
+                var bend = w.CreateGroup(1, 1);
+                var def = Native.embra_default_body_def();
+                def.StretchGroup = stretch;
+                def.BendGroup = bend;
+                def.Material.Mass = 0.5;
+                def.Material.StretchCompliance = 1e-2;
+                def.Material.BendCompliance = 10.0;
+                var body = w.CreateBody(xyz, tri, def: def);
+                var pins = corners.Select(k => w.CreatePin(body.First + k, new[] { xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2] })).ToArray();
+                for (int f = 1; f <= frames; ++f)
+                {
+                    double draw = Draw(f);
+                    for (int k = 0; k < 3; ++k)
+                    {
+                        var target = new double[3];
+                        for (int c = 0; c < 3; ++c) target[c] = xyz[3 * corners[k] + c] * (1.0 - 0.1 * draw);
+                        w.SetPinTarget(pins[k], target);
+                    }
+                    w.Step();
+                }
+                return w.GetPositions(body.First, body.Count);
+            }
+        }
+    }
+
+    static class Env
+    {
+        public static string Source { get { return Environment.GetEnvironmentVariable("EMBRA_SOURCE_DIR"); } }
+
+        public static string TempDir()
+        {
+            string d = Path.Combine(Path.GetTempPath(), "embra-cs-" + Guid.NewGuid().ToString("N"));
+            Directory.CreateDirectory(d);
+            return d;
+        }
+
+        /// <summary>Runs the `embra` command and returns the 'v' lines of DIR/final.obj (%.17g: exact).</summary>
+        public static double[] Cli(params string[] args)
+        {
+            string dir = TempDir();
+            var start = new ProcessStartInfo(Environment.GetEnvironmentVariable("EMBRA_CLI"),
+                string.Join(" ", args.Select(a => "\"" + a + "\"")) + " --out \"" + dir + "\"")
+            { UseShellExecute = false, RedirectStandardOutput = true };
+            using (var p = Process.Start(start))
+            {
+                p.StandardOutput.ReadToEnd();
+                p.WaitForExit();
+                Assert.AreEqual(0, p.ExitCode, "embra " + string.Join(" ", args));
+            }
+            var values = new List<double>();
+            foreach (var line in File.ReadAllLines(Path.Combine(dir, "final.obj")))
+                if (line.StartsWith("v "))
+                    values.AddRange(line.Split(' ').Skip(1).Take(3).Select(s => double.Parse(s, CultureInfo.InvariantCulture)));
+            Directory.Delete(dir, true);
+            return values.ToArray();
+        }
+
+        public static void AssertBitIdentical(double[] expected, double[] actual)
+        {
+            Assert.AreEqual(expected.Length, actual.Length);
+            for (int i = 0; i < expected.Length; ++i)
+                if (BitConverter.DoubleToInt64Bits(expected[i]) != BitConverter.DoubleToInt64Bits(actual[i]))
+                    Assert.Fail("value " + i + " differs: " + expected[i].ToString("R") + " vs " + actual[i].ToString("R"));
+        }
+    }
+
+    [TestFixture]
+    public class TentTests
+    {
+        [Test]
+        public void TentBuiltInCSharpMatchesTheCHostBitForBit()
+        {
+            double[] c = Env.Cli("demo", "tent", "--frames", "100", "--every", "1000");
+            double[] cs = Tent.Run(100);
+            Assert.AreEqual(3 * 861, cs.Length);
+            Env.AssertBitIdentical(c, cs);
+            Assert.Greater(Enumerable.Range(0, 861).Max(i => cs[3 * i + 2]), 0.05);  // it has risen: the comparison means something
+        }
+
+        [Test]
+        public void TentSceneLoadedInCSharpMatchesTheCHostBitForBit()
+        {
+            string scene = Path.Combine(Env.Source, "examples", "gaudi_tent.json");
+            double[] c = Env.Cli("run", scene, "--frames", "100");
+            using (var w = World.LoadFile(scene))
+            {
+                Assert.AreEqual(600, w.SceneFrames);
+                w.Step(100);
+                Assert.AreEqual(100, w.Report.Frame);
+                Env.AssertBitIdentical(c, w.GetPositions());
+            }
+            using (var w = World.LoadJson(File.ReadAllText(scene)))
+            {
+                w.Step(100);
+                Env.AssertBitIdentical(c, w.GetPositions());
+            }
+        }
+
+        [Test]
+        public void TentThroughTheComponentMatchesTheCHostBitForBit()
+        {
+            double[] c = Env.Cli("demo", "tent", "--frames", "100", "--every", "1000");
+            double[] xyz; int[] tri, corners;
+            Tent.Mesh(40, 1.0, out xyz, out tri, out corners);
+            var vertices = Enumerable.Range(0, xyz.Length / 3).Select(i => new Point3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2])).ToList();
+            var faces = Enumerable.Range(0, tri.Length / 3).Select(i => new MeshFace(tri[3 * i], tri[3 * i + 1], tri[3 * i + 2])).ToList();
+            using (var component = new FormFindingComponent())
+            {
+                var da = new DataAccess()
+                    .Set(FormFindingComponent.InVertices, vertices).Set(FormFindingComponent.InFaces, faces)
+                    .Set(FormFindingComponent.InAnchors, corners.ToList())
+                    .Set(FormFindingComponent.InGravity, new Point3d(0, 0, 9.81)).Set(FormFindingComponent.InMass, 0.5)
+                    .Set(FormFindingComponent.InStretchCompliance, 1e-2).Set(FormFindingComponent.InBendCompliance, 10.0)
+                    .Set(FormFindingComponent.InStretchWeight, 2).Set(FormFindingComponent.InDamping, 2.0)
+                    .Set(FormFindingComponent.InSubsteps, 20).Set(FormFindingComponent.InIterations, 4)
+                    .Set(FormFindingComponent.InReset, true).Set(FormFindingComponent.InRun, false);
+                component.ComputeData(da);  // Reset: build, no step
+                da.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                for (int f = 1; f <= 100; ++f)  // the timer ticks; the author drags the anchors inwards
+                {
+                    double draw = Tent.Draw(f);
+                    da.Set(FormFindingComponent.InAnchorTargets, corners.Select(k => new Point3d(
+                        xyz[3 * k] * (1.0 - 0.1 * draw), xyz[3 * k + 1] * (1.0 - 0.1 * draw), xyz[3 * k + 2] * (1.0 - 0.1 * draw))).ToList());
+                    component.ComputeData(da);
+                    Assert.IsEmpty(component.RuntimeMessages);
+                }
+                Assert.AreEqual(100, da.Get<int>(FormFindingComponent.OutFrame));
+                var points = da.GetList<Point3d>(FormFindingComponent.OutVertices);
+                Env.AssertBitIdentical(c, points.SelectMany(p => new[] { p.X, p.Y, p.Z }).ToArray());
+                Assert.That(da.GetList<double>(FormFindingComponent.OutAnchorErrors).All(e => e == 0.0));  // hard anchors
+            }
+        }
+    }
+
+    [TestFixture]
+    public class ErrorTests
+    {
+        static World Square()
+        {
+            var w = new World();
+            w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 }, new[] { 0, 1, 2, 0, 2, 3 });
+            w.Step(3);
+            return w;
+        }
+
+        static string Snapshot(World w)
+        {
+            var bits = w.GetPositions().Concat(w.GetVelocities()).Select(v => BitConverter.DoubleToInt64Bits(v).ToString("x"));
+            var c = w.Counts;
+            return string.Join(",", bits) + "|" + c.Particles + "," + c.Pins + "," + c.Constraints + "|" + w.SaveJson();
+        }
+
+        [Test]
+        public void OutOfRangeIndex()
+        {
+            using (var w = Square())
+            {
+                string before = Snapshot(w);
+                var e = Assert.Throws<EmbraArgumentException>(() => w.CreatePin(4, new double[] { 0, 0, 0 }));
+                Assert.That(e, Is.InstanceOf<ArgumentException>());
+                Assert.AreEqual(Status.InvalidArgument, e.Status);
+                Assert.AreEqual("EMBRA_ERROR_INVALID_ARGUMENT", e.StatusName);
+                StringAssert.StartsWith("embra_pin_create: ", e.Message);
+                Assert.AreEqual(Errors.LastMessage(), e.Message);  // the C message, verbatim
+                Assert.Throws<EmbraArgumentException>(() => w.GetPositions(2, 5));
+                var bulk = Assert.Throws<EmbraArgumentException>(() => w.AddConstraints(ConstraintKind.Distance, new[] { 0, 1, 2, 99 }));
+                StringAssert.StartsWith("embra_constraints_add: ", bulk.Message);
+                Assert.Throws<EmbraArgumentException>(() => w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0 }, new[] { 0, 1, 7 }));
+                var small = Assert.Throws<EmbraArgumentException>(() => w.GetPositions(0, 4, new double[6]));
+                Assert.AreEqual(Status.BufferTooSmall, small.Status);
+                Assert.AreEqual(before, Snapshot(w));
+            }
+        }
+
+        [Test]
+        public void NaN()
+        {
+            using (var w = Square())
+            {
+                string before = Snapshot(w);
+                var e = Assert.Throws<EmbraArgumentException>(() => w.SetGravity(0, double.NaN, 0));
+                StringAssert.StartsWith("embra_world_set_gravity: ", e.Message);
+                StringAssert.Contains("finite", e.Message);
+                Assert.Throws<EmbraArgumentException>(() => w.SetPositions(new[] { double.NaN, 0, 0 }, 1));
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePin(0, new[] { 0, 0, double.PositiveInfinity }));
+                Assert.AreEqual(before, Snapshot(w));
+            }
+        }
+
+        [Test]
+        public void AStepThatGoesNonFinite()
+        {
+            using (var w = Square())
+            {
+                w.SetVelocities(new[] { 1e308, 0, 0 }, 1);  // overflows to infinity in the step
+                string before = Snapshot(w);
+                long frame = w.Report.Frame;
+                var e = Assert.Throws<EmbraNumericalException>(() => w.Step());
+                Assert.That(e, Is.InstanceOf<ArithmeticException>());
+                StringAssert.StartsWith("embra_world_step: non-finite", e.Message);
+                Assert.AreEqual(before, Snapshot(w));  // restored to the start of the frame
+                Assert.AreEqual(frame, w.Warning.Frame);
+                Assert.GreaterOrEqual(w.Warning.Particle, 0);
+            }
+        }
+
+        [Test]
+        public void UseAfterDestroy()
+        {
+            using (var w = Square())
+            {
+                var pin = w.CreatePin(0, new double[] { 0, 0, 0 });
+                w.DestroyPin(pin);
+                string before = Snapshot(w);
+                var e = Assert.Throws<EmbraInvalidOperationException>(() => w.SetPinTarget(pin, new double[] { 1, 0, 0 }));
+                Assert.AreEqual(Status.StaleId, e.Status);
+                StringAssert.StartsWith("embra_pin_set_target: ", e.Message);
+                var g = w.CreateGroup();
+                w.DestroyGroup(g);
+                Assert.Throws<EmbraInvalidOperationException>(() => w.SetGroupWeight(g, 2));
+                Assert.AreEqual(before.Split('|')[0], Snapshot(w).Split('|')[0]);
+            }
+            var disposed = new World();
+            disposed.Dispose();
+            disposed.Dispose();  // idempotent
+            Assert.IsTrue(disposed.IsDisposed);
+            var d = Assert.Throws<EmbraObjectDisposedException>(() => disposed.Step());
+            Assert.That(d, Is.InstanceOf<ObjectDisposedException>());
+            StringAssert.Contains("embra_world_step: world is NULL", d.Message);
+            Assert.Throws<EmbraObjectDisposedException>(() => disposed.GetPositions());
+        }
+
+        [Test]
+        public void BadScenesAndVersions()
+        {
+            var e = Assert.Throws<EmbraSchemaException>(() => World.LoadJson("{\"format\": \"embra-scene\", \"version\": 1, \"solver\": {\"dt\": 0}}"));
+            StringAssert.Contains("/solver/dt", e.Message);
+            Assert.That(e, Is.InstanceOf<FormatException>());
+            Assert.Throws<EmbraArgumentException>(() => World.LoadFile("/nonexistent-embra-dir/scene.json"));
+            var v = Assert.Throws<EmbraInvalidOperationException>(() => Library.CheckAbi(Native.AbiVersion + 1));
+            Assert.AreEqual(Status.Version, v.Status);
+            var solver = Library.DefaultSolverDef();
+            solver.Version = 7;
+            Assert.Throws<EmbraInvalidOperationException>(() => new World(solver));
+        }
+    }
+
+    [TestFixture]
+    public class ThreadTests
+    {
+        static double[] Cloth(int seed)
+        {
+            const int grid = 8;
+            var xyz = new double[3 * grid * grid];
+            for (int i = 0; i < grid; ++i)
+                for (int j = 0; j < grid; ++j)
+                {
+                    xyz[3 * (i * grid + j)] = 0.1 * j;
+                    xyz[3 * (i * grid + j) + 1] = 0.1 * i;
+                    xyz[3 * (i * grid + j) + 2] = 0.05 * seed;
+                }
+            var tri = new List<int>();
+            for (int i = 0; i + 1 < grid; ++i)
+                for (int j = 0; j + 1 < grid; ++j)
+                {
+                    int v = i * grid + j;
+                    tri.AddRange(new[] { v, v + 1, v + grid + 1, v, v + grid + 1, v + grid });
+                }
+            var solver = Library.DefaultSolverDef();
+            solver.Iterations = 2;
+            using (var w = new World(solver))
+            {
+                var def = Native.embra_default_body_def();
+                def.Material.Mass = 0.1 * (seed + 1);
+                var body = w.CreateBody(xyz, tri.ToArray(), def: def);
+                w.CreatePin(body.First, new[] { xyz[0], xyz[1], xyz[2] });
+                w.CreatePin(body.First + grid - 1, new[] { xyz[3 * grid - 3], xyz[3 * grid - 2], xyz[3 * grid - 1] });
+                for (int f = 0; f < 60; ++f)
+                {
+                    w.Step();
+                    var e = Assert.Throws<EmbraArgumentException>(() => w.CreatePin(10000 + seed, new double[] { 0, 0, 0 }));
+                    StringAssert.Contains((10000 + seed).ToString(), e.Message);  // this task's message, not the other's
+                }
+                return w.GetPositions();
+            }
+        }
+
+        [Test]
+        public void TwoWorldsOnTwoTasksEqualOneAfterTheOther()
+        {
+            var alone = new[] { Cloth(0), Cloth(1) };
+            var tasks = new[] { Task.Run(() => Cloth(0)), Task.Run(() => Cloth(1)) };
+            Task.WaitAll(tasks);
+            Env.AssertBitIdentical(alone[0], tasks[0].Result);
+            Env.AssertBitIdentical(alone[1], tasks[1].Result);
+            Assert.IsFalse(alone[0].SequenceEqual(alone[1]));  // different scenes: equality is no coincidence
+        }
+
+        static World Chain()
+        {
+            var w = new World();
+            var def = Native.embra_default_body_def();
+            def.Material.Mass = 0.5;
+            w.CreateBody(Enumerable.Range(0, 8).SelectMany(i => new[] { 0.1 * i, 0, 0 }).ToArray(),
+                         edges: Enumerable.Range(0, 7).SelectMany(i => new[] { i, i + 1 }).ToArray(), def: def);
+            w.CreatePin(0, new double[] { 0, 0, 0 });
+            return w;
+        }
+
+        [Test]
+        public void TasksSharingOneWorldTakeTurns()
+        {
+            double[] expected;
+            using (var alone = Chain())
+            {
+                alone.Step(60);
+                expected = alone.GetPositions();
+            }
+            using (var shared = Chain())
+            {
+                Task.WaitAll(Task.Run(() => shared.Step(30)), Task.Run(() => shared.Step(30)));
+                Assert.AreEqual(60, shared.Report.Frame);
+                Env.AssertBitIdentical(expected, shared.GetPositions());
+            }
+            // Disposed while a task steps: the task's loop ends with ObjectDisposedException, no crash.
+            var w = Chain();
+            var stepping = Task.Run(() => { while (true) w.Step(); });
+            while (w.Report.Frame < 5) { }
+            w.Dispose();
+            var e = Assert.Throws<AggregateException>(() => stepping.Wait());
+            Assert.That(e.InnerException, Is.InstanceOf<ObjectDisposedException>());
+            StringAssert.Contains("world is NULL", e.InnerException.Message);
+        }
+
+        [Test]
+        public void TwoTentsOnTwoTasksEqualOneAfterTheOther()
+        {
+            double[] alone = Tent.Run(20);
+            var tasks = new[] { Task.Run(() => Tent.Run(20)), Task.Run(() => Tent.Run(20)) };
+            Task.WaitAll(tasks);
+            Env.AssertBitIdentical(alone, tasks[0].Result);
+            Env.AssertBitIdentical(alone, tasks[1].Result);
+        }
+    }
+
+    [TestFixture]
+    public class ApiTests
+    {
+        [Test]
+        public void EveryHeaderFunctionIsBound()
+        {
+            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
+            var declared = new HashSet<string>(Regex.Matches(header, @"EMBRA_API[^;(]*?\b(embra_\w+)\s*\(").Cast<Match>().Select(m => m.Groups[1].Value));
+            var bound = new HashSet<string>(typeof(Native).GetMethods(BindingFlags.Public | BindingFlags.Static)
+                .Where(m => m.GetCustomAttributes(typeof(System.Runtime.InteropServices.DllImportAttribute), false).Length > 0)
+                .Select(m => m.Name));
+            Assert.Greater(declared.Count, 40);
+            CollectionAssert.AreEquivalent(declared, bound);
+        }
+
+        static string Pascal(string upper)
+        {
+            return string.Concat(upper.ToLowerInvariant().Split('_').Select(w => char.ToUpperInvariant(w[0]) + w.Substring(1)));
+        }
+
+        [Test]
+        public void EveryHeaderConstantIsMirrored()
+        {
+            // EMBRA_ERROR_STALE_ID -> Status.StaleId, EMBRA_CONSTRAINT_EDGE_ANGLE -> ConstraintKind.EdgeAngle, ...
+            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
+            var constants = Regex.Matches(header, @"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)").Cast<Match>()
+                .ToDictionary(m => m.Groups[1].Value, m => int.Parse(m.Groups[2].Value));
+            Assert.GreaterOrEqual(constants.Count, 25);
+            var mirrors = new[] {
+                Tuple.Create("ERROR_", typeof(Status)), Tuple.Create("OK", typeof(Status)),
+                Tuple.Create("CONSTRAINT_", typeof(ConstraintKind)), Tuple.Create("COLLIDER_", typeof(ColliderShape)),
+                Tuple.Create("GENERATE_", typeof(Generate)) };
+            foreach (var c in constants)
+            {
+                var mirror = mirrors.FirstOrDefault(m => c.Key.StartsWith(m.Item1));
+                Assert.IsNotNull(mirror, "EMBRA_" + c.Key + " has no C# mirror");
+                string name = Pascal(mirror.Item1 == "OK" ? "OK" : c.Key.Substring(mirror.Item1.Length));
+                int value;
+                if (mirror.Item2.IsEnum)
+                    value = (int)Enum.Parse(mirror.Item2, name);
+                else
+                    value = (int)mirror.Item2.GetField(name).GetValue(null);
+                Assert.AreEqual(c.Value, value, "EMBRA_" + c.Key);
+            }
+            foreach (Match m in Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_DEF_VERSION\s+(\d+)"))
+            {
+                var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value) + "Def");
+                Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_DEF_VERSION");
+                Assert.AreEqual(int.Parse(m.Groups[2].Value), (int)def.GetField("CurrentVersion").GetValue(null));
+            }
+        }
+
+        [Test]
+        public void DefaultsAndVersions()
+        {
+            var s = Library.DefaultSolverDef();
+            Assert.AreEqual(SolverDef.CurrentVersion, s.Version);
+            Assert.AreEqual(20, s.Substeps);
+            Assert.AreEqual(1.0 / 60.0, s.Dt);
+            unsafe { Assert.AreEqual(-9.81, s.Gravity[2]); }
+            var m = Library.DefaultMaterial();
+            Assert.AreEqual(1.0, m.Density);
+            Assert.AreEqual(0.5, m.FrictionStatic);
+            Assert.AreEqual(ColliderDef.CurrentVersion, Native.embra_default_collider_def().Version);
+            Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Dihedral));
+            Assert.AreEqual(Native.AbiVersion, Library.AbiVersion);
+            var parts = Library.VersionString.Split('.').Select(int.Parse).ToArray();
+            Assert.AreEqual(parts[0] * 10000 + parts[1] * 100 + parts[2], Library.Version);
+        }
+
+        [Test]
+        public void FreeFallIsSymplecticEulerInClosedForm()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            using (var w = new World(solver))
+            {
+                var def = Native.embra_default_body_def();
+                def.Material.Mass = 2.0;
+                w.CreateBody(new[] { 0.0, 0.0, 5.0 }, def: def);
+                w.Step(30);
+                int n = 300;
+                double h = (1.0 / 60.0) / 10;
+                Assert.AreEqual(5.0 - 9.81 * h * h * n * (n + 1) / 2, w.GetPositions()[2], 1e-10);
+                Assert.AreEqual(-9.81 * n * h, w.GetVelocities()[2], 1e-9);
+            }
+        }
+
+        [Test]
+        public void GroupsBulkConstraintsPinsCollidersAndJson()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Iterations = 20;
+            using (var w = new World(solver))
+            {
+                Assert.AreNotEqual(w.DefaultGroup, w.ContactGroup);
+                var links = w.CreateGroup(5, 3);
+                w.SetGroupOrder(links, 4);
+                w.SetGroupWeight(links, 2);
+                var def = Native.embra_default_body_def();
+                def.Generate = 0;
+                def.Material.Mass = 0.6;
+                var xyz = Enumerable.Range(0, 6).SelectMany(i => new[] { 0.1 * i, 0, 0 }).ToArray();
+                var body = w.CreateBody(xyz, def: def);
+                int first, count;
+                w.GetBodyParticles(body.Id, out first, out count);
+                Assert.AreEqual(6, count);
+                Assert.AreEqual(5, w.AddConstraints(ConstraintKind.Distance, new[] { 0, 1, 1, 2, 2, 3, 3, 4, 4, 5 }, group: links));
+                w.AddConstraint(ConstraintKind.Tether, new[] { 0, 5 }, 0.6, 1e-3, links);
+                var pin = w.CreatePin(0, new double[] { 0, 0, 0 });
+                w.SetPinTarget(pin, new[] { 0.0, 0.0, 0.25 });
+                CollectionAssert.AreEqual(new[] { 0.0, 0.0, 0.25 }, w.PinTarget(pin));
+                var floor = Native.embra_default_collider_def();
+                floor.Shape = (int)ColliderShape.Plane;
+                unsafe { floor.Position[2] = -0.3; }
+                var c = w.CreateCollider(floor);
+                w.SetColliderTransform(c, new[] { 0.0, 0.0, -0.35 }, new[] { 1.0, 0, 0, 0 });
+                w.Step(120);
+                var p = w.GetPositions();
+                for (int i = 0; i < 5; ++i)
+                {
+                    double dx = p[3 * i + 3] - p[3 * i], dy = p[3 * i + 4] - p[3 * i + 1], dz = p[3 * i + 5] - p[3 * i + 2];
+                    Assert.AreEqual(0.1, Math.Sqrt(dx * dx + dy * dy + dz * dz), 1e-6);
+                }
+                Assert.That(Enumerable.Range(0, 6).All(i => p[3 * i + 2] >= -0.35 - 1e-9));  // above the floor
+                Assert.Less(w.GroupReport(links).ResidualMax, 1e-6);
+                Assert.AreEqual(-1, w.Warning.Frame);
+                w.SetRestScale(body.Id, 1.0);
+                string json = w.SaveJson();
+                string file = Path.Combine(Env.TempDir(), "mid.json");
+                w.SaveFile(file);
+                using (var a = World.LoadJson(json))
+                using (var b = World.LoadFile(file))
+                {
+                    w.Step(10); a.Step(10); b.Step(10);
+                    Env.AssertBitIdentical(w.GetPositions(), a.GetPositions());
+                    Env.AssertBitIdentical(w.GetPositions(), b.GetPositions());
+                }
+                w.DestroyCollider(c);
+                w.DestroyGroup(links);
+                Assert.AreEqual(0, w.Counts.Constraints);
+                w.SetVelocities(new double[] { 1, 2, 3 }, 5);
+                CollectionAssert.AreEqual(new double[] { 1, 2, 3 }, w.GetVelocities(5, 1));
+                var s = w.Solver;
+                s.Substeps = 7;
+                w.Solver = s;
+                Assert.AreEqual(7, w.Solver.Substeps);
+            }
+        }
+
+        [Test]
+        public void ComponentHangsAClothAndReportsErrors()
+        {
+            // A 5 x 5 quad net, two corners anchored, a weight-5 length goal across the bottom edge.
+            var vertices = new List<Point3d>();
+            for (int i = 0; i < 5; ++i)
+                for (int j = 0; j < 5; ++j) vertices.Add(new Point3d(0.25 * j, 0, -0.25 * i));
+            var faces = new List<MeshFace>();
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) faces.Add(new MeshFace(5 * i + j, 5 * i + j + 1, 5 * i + j + 6, 5 * i + j + 5));
+            var goals = new List<Goal> { Goal.Length(20, 24, 0.5, 0, 5), Goal.Angle(0, 1, 5) };
+            using (var component = new FormFindingComponent())
+            {
+                Assert.AreEqual(16, component.Inputs.Count);
+                var da = new DataAccess().Set(0, vertices).Set(1, faces).Set(2, new List<int> { 0, 4 }).Set(4, goals)
+                    .Set(FormFindingComponent.InIterations, 4).Set(FormFindingComponent.InStepsPerSolve, 30)
+                    .Set(FormFindingComponent.InReset, true).Set(FormFindingComponent.InRun, false);
+                component.ComputeData(da);
+                Assert.IsEmpty(component.RuntimeMessages);
+                var e0 = da.GetList<double>(FormFindingComponent.OutGoalErrors);
+                Assert.AreEqual(0.5, e0[0], 1e-12);  // 1 m apart, asked for 0.5 m
+                Assert.AreEqual(0.0, e0[1], 1e-12);  // measured from the input: met
+                da.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                for (int k = 0; k < 4; ++k) component.ComputeData(da);
+                Assert.AreEqual(120, da.Get<int>(FormFindingComponent.OutFrame));
+                var e1 = da.GetList<double>(FormFindingComponent.OutGoalErrors);
+                Assert.Less(e1[0], 1e-3);
+                var anchors = da.GetList<double>(FormFindingComponent.OutAnchorErrors);
+                Assert.That(anchors.All(a => a == 0.0));
+                var before = component.PositionsXyz();
+
+                // A NaN vertex on reset: the component shows the C message, keeps its world, never throws.
+                var bad = new List<Point3d>(vertices);
+                bad[7] = new Point3d(double.NaN, 0, 0);
+                da.Set(0, bad).Set(FormFindingComponent.InReset, true).Set(FormFindingComponent.InRun, false);
+                component.ComputeData(da);
+                Assert.AreEqual(1, component.RuntimeMessages.Count);
+                Assert.AreEqual(GH_RuntimeMessageLevel.Error, component.RuntimeMessages[0].Key);
+                StringAssert.StartsWith("embra_body_create: ", component.RuntimeMessages[0].Value);
+                Env.AssertBitIdentical(before, component.PositionsXyz());
+
+                // An anchor out of range: the same, with the index named.
+                da.Set(0, vertices).Set(2, new List<int> { 0, 99 });
+                component.ComputeData(da);
+                StringAssert.Contains("99", component.RuntimeMessages[0].Value);
+                Env.AssertBitIdentical(before, component.PositionsXyz());
+            }
+        }
+    }
+}

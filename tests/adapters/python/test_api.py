@@ -1,0 +1,250 @@
+"""The Python adapter covers the whole C ABI, and each part of it does what the header says."""
+
+import math
+import os
+import re
+import struct
+
+import pytest
+
+import embra
+from embra import _capi
+from tent import flat
+
+
+def test_every_header_function_is_bound(source_dir):
+    """Every EMBRA_API function of embra.h is in the prototype table, and nothing else is."""
+    with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
+        header = f.read()
+    declared = set(re.findall(r"EMBRA_API[^;(]*?\b(embra_\w+)\s*\(", header))
+    assert len(declared) > 40
+    assert declared == set(_capi.PROTOTYPES)
+
+
+def test_versions():
+    v = embra.version()
+    major, minor, patch = (int(x) for x in embra.version_string().split("."))
+    assert v == major * 10000 + minor * 100 + patch
+    assert embra.abi_version() == embra.ABI_VERSION
+    embra.check_abi()
+    with pytest.raises(embra.VersionError, match="embra_check_abi"):
+        embra.check_abi(embra.ABI_VERSION + 1)
+    assert embra.status_name(-2) == "EMBRA_ERROR_STALE_ID"
+    assert embra.status_name(0) == "EMBRA_OK"
+
+
+def test_defaults_are_the_documented_ones():
+    s = embra.default_solver_def()
+    assert (s.version, s.substeps, s.iterations, s.tethers, s.realign_passes) == (1, 20, 1, 2, 0)
+    assert s.dt == 1.0 / 60.0 and tuple(s.gravity) == (0.0, 0.0, -9.81) and s.settle_speed == 1e-3
+    m = embra.default_material()
+    assert (m.mass, m.density, m.stretch_compliance, m.bend_compliance) == (0.0, 1.0, 0.0, 1.0)
+    assert (m.friction_static, m.friction_dynamic) == (0.5, 0.3)
+    assert [embra.constraint_arity(k) for k in ("distance", "edge_angle", "dihedral", "tet_volume", "weld",
+                                                "tether")] == [2, 3, 4, 4, 2, 2]
+
+
+def test_free_fall_is_symplectic_euler_in_closed_form():
+    """One free particle: after N substeps of h, z = z0 + h^2 g N (N + 1) / 2 exactly (v0 = 0)."""
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10) as w:
+        body = w.create_body([(0.0, 0.0, 5.0)], mass=2.0)
+        w.step(30)
+        n, h = 300, (1.0 / 60.0) / 10
+        z = flat(w.positions(body.first, 1))[2]
+        assert abs(z - (5.0 - 9.81 * h * h * n * (n + 1) / 2)) < 1e-10  # rounding over 300 substeps
+        vz = flat(w.velocities(body.first, 1))[2]
+        assert abs(vz - (-9.81 * n * h)) < 1e-9  # v = (x - x_prev) / h: rounding over h
+        r = w.report()
+        assert r.frame == 30 and abs(r.time - 0.5) < 1e-12
+        assert abs(r.kinetic_energy - 0.5 * 2.0 * vz * vz) < 1e-9
+
+
+def test_groups_bulk_constraints_and_reports():
+    """A chain of 5 links added in bulk, hard, hanging from a pin: every link at its rest length."""
+    xyz = [(0.1 * i, 0.0, 0.0) for i in range(6)]
+    with embra.World(iterations=20) as w:
+        default, contact = w.default_group(), w.contact_group()
+        assert default != contact
+        links = w.create_group(order=5, weight=3)
+        w.set_group_order(links, 4)
+        w.set_group_weight(links, 2)
+        body = w.create_body(xyz, generate=0, mass=0.6)
+        assert w.body_particles(body) == (body.first, 6)
+        added = w.add_constraints("distance", [(i, i + 1) for i in range(5)], group=links)
+        assert added == 5 and w.counts().constraints == 5
+        w.add_constraint("tether", [0, 5], rest=0.6, compliance=1e-3, group=links)  # slack: never pulls
+        w.create_pin(0, xyz[0])
+        w.step(120)
+        assert w.counts().constraints == 6 and w.counts().groups == 3
+        p = flat(w.positions())
+        for i in range(5):
+            length = math.dist(p[3 * i:3 * i + 3], p[3 * i + 3:3 * i + 6])
+            assert abs(length - 0.1) < 1e-6
+        g = w.group_report(links)
+        assert g.count == 6 and g.residual_max < 1e-6
+        w.destroy_group(links)
+        assert w.counts().constraints == 0 and w.counts().groups == 2
+        assert w.warning().frame == -1
+
+
+def test_bulk_rest_and_compliances_arrays():
+    xyz = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (2.0, 0.0, 0.0)]
+    with embra.World(gravity=(0, 0, 0), iterations=50) as w:
+        w.create_body(xyz, generate=0, mass=3.0)
+        w.add_constraints(embra.KINDS["distance"], [0, 1, 1, 2], rest=[0.5, 0.25], compliances=[0.0, 0.0])
+        w.step(60)
+        p = flat(w.positions())
+        assert abs(math.dist(p[0:3], p[3:6]) - 0.5) < 1e-9
+        assert abs(math.dist(p[3:6], p[6:9]) - 0.25) < 1e-9
+
+
+def test_pin_targets_move_particles():
+    with embra.World() as w:
+        w.create_body([(0.0, 0.0, 0.0)], mass=1.0)
+        pin = w.create_pin(0, (0.0, 0.0, 0.0))
+        w.set_pin_target(pin, (0.25, -0.5, 1.0))
+        assert w.pin_target(pin) == (0.25, -0.5, 1.0)
+        w.step()
+        assert flat(w.positions()) == [0.25, -0.5, 1.0]
+
+
+def test_colliders_hold_a_falling_particle():
+    with embra.World() as w:
+        w.create_body([(0.0, 0.0, 2.0)], mass=1.0)
+        sphere = w.create_collider("sphere", position=(0.0, 0.0, 0.0), radius=1.0)
+        floor = w.create_collider("plane", position=(0.0, 0.0, -5.0))
+        w.step(120)
+        z = flat(w.positions())[2]
+        assert abs(z - 1.0) < 1e-6  # resting on top of the sphere
+        w.set_collider_transform(sphere, (0.0, 0.0, -1.0))
+        w.destroy_collider(floor)
+        w.step(60)
+        assert abs(flat(w.positions())[2] - 0.0) < 1e-6  # followed the sphere down
+        hull = [(-1, -1, -1), (1, -1, -1), (0, 1, -1), (0, 0, 1)]
+        w.create_collider("convex", position=(5, 0, 0), vertices=hull)
+        w.create_collider("mesh", position=(9, 0, 0), vertices=hull, triangles=[(0, 2, 1), (0, 1, 3), (1, 2, 3),
+                                                                                 (2, 0, 3)])
+        w.create_collider("box", position=(-5, 0, 0), half_extents=(1, 2, 3))
+        w.create_collider("capsule", position=(-9, 0, 0), radius=0.5, half_length=1.0)
+        assert w.counts().colliders == 5
+
+
+def test_rest_scale_shrinks_edges():
+    with embra.World(gravity=(0, 0, 0), iterations=10) as w:
+        body = w.create_body([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0)], edges=[(0, 1)], mass=1.0)
+        w.set_rest_scale(body, 0.5, 1.0, 1.0)
+        w.step(120)
+        p = flat(w.positions())
+        assert abs(math.dist(p[0:3], p[3:6]) - 0.5) < 1e-9
+
+
+def test_set_positions_and_velocities_round_trip():
+    with embra.World() as w:
+        w.create_body([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)], triangles=[(0, 1, 2)], mass=1.0)
+        w.set_positions([(0.5, 0.25, 2.0)], first=2)
+        w.set_velocities([(1.0, 2.0, 3.0), (4.0, 5.0, 6.0)], first=0)
+        assert flat(w.positions(2, 1)) == [0.5, 0.25, 2.0]
+        assert flat(w.velocities()) == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 0.0, 0.0, 0.0]
+        assert flat(w.body_triangles(embra.BodyId(0, 1))) == [0, 1, 2]
+
+
+def test_saved_scene_steps_on_bit_identically(tmp_path):
+    xyz = [(0.1 * j, 0.1 * i, 0.0) for i in range(4) for j in range(4)]
+    tri = [(v, v + 1, v + 5) for v in (0, 1, 2, 4, 5, 6, 8, 9, 10)] + \
+          [(v, v + 5, v + 4) for v in (0, 1, 2, 4, 5, 6, 8, 9, 10)]
+    with embra.World() as a:
+        a.create_body(xyz, triangles=tri, mass=0.2)
+        a.create_pin(0, xyz[0])
+        a.step(10)
+        text = a.save_json()
+        a.save_file(tmp_path / "mid.json")
+        with embra.World.load_json(text) as b, embra.World.load_file(tmp_path / "mid.json") as c:
+            for w in (a, b, c):
+                w.step(20)
+            pa, pb, pc = (struct.pack("<48d", *flat(w.positions())) for w in (a, b, c))
+            assert pa == pb == pc
+            assert b.save_json() == a.save_json()
+
+
+def test_solver_settings_round_trip():
+    with embra.World(substeps=7, damping=0.5) as w:
+        assert (w.solver.substeps, w.solver.damping) == (7, 0.5)
+        w.set_solver(iterations=3)
+        w.set_gravity((0.0, 0.0, 9.81))
+        s = embra.as_dict(w.solver)
+        assert (s["substeps"], s["iterations"], s["gravity"]) == (7, 3, (0.0, 0.0, 9.81))
+
+
+@pytest.mark.skipif(not embra.have_numpy(), reason="numpy not installed")
+def test_numpy_arrays_are_used_in_place():
+    import numpy as np
+    xyz = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    with embra.World() as w:
+        body = w.create_body(xyz, triangles=np.array([[0, 1, 2]]), mass=1.0)
+        out = np.zeros((3, 3))
+        address = out.ctypes.data
+        result = w.positions(body.first, 3, out=out)
+        assert result is out and out.ctypes.data == address  # C wrote into the caller's array
+        assert np.array_equal(out, xyz)
+        p = w.positions()
+        assert p.shape == (3, 3) and p.dtype == np.float64
+        w.set_positions(xyz[1:] + 1.0, first=1)
+        assert np.array_equal(w.positions(1, 2), xyz[1:] + 1.0)
+
+
+def test_without_numpy_arrays_are_flat_doubles():
+    from array import array
+    with embra.World() as w:
+        w.create_body(array("d", [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]), edges=array("i", [0, 1]), mass=1.0)
+        out = array("d", [0.0] * 6)
+        assert w.positions(out=out) is out and list(out) == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
+        if not embra.have_numpy():
+            assert isinstance(w.positions(), array)
+
+
+def _which_library(env, cwd):
+    import subprocess
+    import sys
+    code = "import embra; print(embra.library_path)"
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, check=True, capture_output=True, text=True)
+    return out.stdout.strip()
+
+
+def test_library_found_from_env_next_to_package_or_system(tmp_path, source_dir):
+    """$EMBRA_LIBRARY first; else a libembra next to the package; else the loader's own search."""
+    import shutil
+    lib = os.path.realpath(_capi.library_path)
+    pkg = os.path.join(source_dir, "host_adapters", "python", "embra")
+    env = {k: v for k, v in os.environ.items() if k not in ("EMBRA_LIBRARY", "LD_LIBRARY_PATH", "PYTHONPATH")}
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    beside = tmp_path / "beside"
+    shutil.copytree(pkg, beside / "embra")
+    shutil.copy(lib, beside / "embra" / f"libembra.so.{embra.ABI_VERSION}")
+    assert _which_library(env, beside) == str(beside / "embra" / f"libembra.so.{embra.ABI_VERSION}")
+    assert _which_library(dict(env, EMBRA_LIBRARY=lib), beside) == lib
+    system = tmp_path / "system"
+    shutil.copytree(pkg, system / "embra")
+    found = _which_library(dict(env, LD_LIBRARY_PATH=os.path.dirname(lib)), system)
+    assert found == f"libembra.so.{embra.ABI_VERSION}"  # by SONAME, through the dynamic loader's search
+    import subprocess
+    import sys
+    failed = subprocess.run([sys.executable, "-c", "import embra"], env=env, cwd=system, capture_output=True, text=True)
+    assert failed.returncode != 0 and "cannot load libembra" in failed.stderr and "EMBRA_LIBRARY" in failed.stderr
+
+
+def test_every_header_constant_is_mirrored(source_dir):
+    """Status codes, enum values and def versions of embra.h have the same values in embra._capi."""
+    with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
+        header = f.read()
+    constants = dict(re.findall(r"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)", header))
+    constants.update(re.findall(r"#define\s+EMBRA_([A-Z0-9_]+_DEF_VERSION)\s+(\d+)", header))
+    assert len(constants) > 30
+    for name, value in constants.items():
+        assert getattr(_capi, name, None) == int(value), f"EMBRA_{name} = {value} is not mirrored in _capi.py"
+
+    def values(prefix):
+        return sorted(v for k, v in vars(_capi).items() if k.startswith(prefix) and not k.endswith("_VERSION"))
+
+    assert sorted(embra.KINDS.values()) == values("CONSTRAINT_")  # the names the World methods accept
+    assert sorted(embra.SHAPES.values()) == values("COLLIDER_")
+    assert sorted(embra.GENERATE.values()) == values("GENERATE_")

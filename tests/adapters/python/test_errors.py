@@ -1,0 +1,148 @@
+"""Every refusal is Python's usual exception carrying the C message, and changes nothing."""
+
+import math
+import struct
+
+import pytest
+
+import embra
+from tent import flat
+
+SQUARE = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.0, 1.0, 0.0)]
+SQUARE_TRIS = [(0, 1, 2), (0, 2, 3)]
+
+
+@pytest.fixture
+def world():
+    with embra.World() as w:
+        w.create_body(SQUARE, triangles=SQUARE_TRIS, mass=1.0)
+        w.step(3)
+        yield w
+
+
+def snapshot(w):
+    """Everything a refused call must leave as it was: positions, velocities, counts, saved scene."""
+    return (struct.pack("<12d", *flat(w.positions())), struct.pack("<12d", *flat(w.velocities())),
+            embra.as_dict(w.counts()), w.save_json())
+
+
+def test_out_of_range_particle_index(world):
+    before = snapshot(world)
+    with pytest.raises(ValueError) as e:
+        world.create_pin(4, (0, 0, 0))
+    assert isinstance(e.value, embra.InvalidArgumentError)
+    assert e.value.status == -1 and e.value.status_name == "EMBRA_ERROR_INVALID_ARGUMENT"
+    assert str(e.value).startswith("embra_pin_create: ")
+    assert str(e.value) == e.value.message == embra.last_error_message()  # the C message, verbatim
+    with pytest.raises(embra.InvalidArgumentError, match="embra_world_get_positions"):
+        world.positions(first=2, count=5)
+    with pytest.raises(embra.InvalidArgumentError, match="embra_constraints_add"):
+        world.add_constraints("distance", [(0, 1), (2, 99)])
+    with pytest.raises(embra.InvalidArgumentError, match="embra_body_create"):
+        world.create_body(SQUARE, triangles=[(0, 1, 7)])
+    with pytest.raises(OverflowError):  # does not fit the C int32 at all: refused before C
+        world.create_pin(2**40, (0, 0, 0))
+    assert snapshot(world) == before
+
+
+def test_nan(world):
+    before = snapshot(world)
+    nan = math.nan
+    with pytest.raises(ValueError, match="embra_world_set_gravity: .*finite"):
+        world.set_gravity((0, nan, 0))
+    with pytest.raises(embra.InvalidArgumentError, match="embra_world_set_positions"):
+        world.set_positions([(nan, 0, 0)], first=1)
+    with pytest.raises(embra.InvalidArgumentError, match="embra_body_create"):
+        world.create_body([(0, 0, 0), (1, 0, 0), (0, nan, 0)], triangles=[(0, 1, 2)])
+    with pytest.raises(embra.InvalidArgumentError, match="embra_pin_create"):
+        world.create_pin(0, (0, 0, math.inf))
+    assert snapshot(world) == before
+
+
+def test_use_after_destroy(world):
+    pin = world.create_pin(0, (0, 0, 0))
+    world.destroy_pin(pin)
+    before = snapshot(world)
+    with pytest.raises(LookupError) as e:
+        world.set_pin_target(pin, (1, 0, 0))
+    assert isinstance(e.value, embra.StaleIdError)
+    assert str(e.value).startswith("embra_pin_set_target: ")
+    group = world.create_group()
+    world.destroy_group(group)
+    with pytest.raises(embra.StaleIdError, match="embra_group_set_weight"):
+        world.set_group_weight(group, 3)
+    sphere = world.create_collider("sphere", position=(0, 0, -2), radius=1.0)
+    world.destroy_collider(sphere)
+    with pytest.raises(embra.StaleIdError, match="embra_collider_set_transform"):
+        world.set_collider_transform(sphere, (0, 0, -3))
+    assert world.counts().pins == 0 and world.counts().colliders == 0
+
+
+def test_use_of_a_closed_world():
+    w = embra.World()
+    w.close()
+    w.close()  # idempotent
+    assert w.closed
+    for call in (w.step, w.counts, w.save_json, lambda: w.positions(0, 1)):
+        with pytest.raises(ValueError) as e:
+            call()
+        assert isinstance(e.value, embra.InvalidArgumentError)
+        assert "world is NULL" in str(e.value) and "closed" in str(e.value)
+    with embra.World() as inner:
+        pass
+    with pytest.raises(embra.InvalidArgumentError, match="embra_world_step: world is NULL"):
+        inner.step()
+
+
+def test_bad_def_version_and_values():
+    with pytest.raises(embra.VersionError, match="embra_world_create: embra_solver_def.version is 7"):
+        embra.World(version=7)
+    with pytest.raises(embra.InvalidArgumentError, match="embra_world_create"):
+        embra.World(dt=-1.0)
+    with pytest.raises(TypeError, match="no field 'gravty'"):
+        embra.World(gravty=(0, 0, 1))
+
+
+def test_bad_scene_json(source_dir):
+    with pytest.raises(embra.SchemaError) as e:
+        embra.World.load_json('{"format": "embra-scene", "version": 1, "solver": {"dt": 0}}')
+    assert "/solver/dt" in str(e.value) and str(e.value).startswith("embra_world_load_json: ")
+    with pytest.raises(embra.SchemaError):
+        embra.World.load_json("{ not json")
+    with pytest.raises(embra.InvalidArgumentError, match="embra_world_load_file"):
+        embra.World.load_file("/nonexistent-embra-dir/scene.json")
+
+
+def test_buffer_too_small_writes_nothing(world):
+    from array import array
+    out = array("d", [7.0] * 6)  # room for 2 particles, asked for 4
+    with pytest.raises(embra.BufferTooSmallError, match="embra_world_get_positions"):
+        world.positions(0, 4, out=out)
+    assert list(out) == [7.0] * 6
+
+
+def test_wrong_lengths_are_refused_before_c(world):
+    before = snapshot(world)
+    with pytest.raises(ValueError, match="whole number of xyz"):
+        world.set_positions([0.0, 1.0])
+    with pytest.raises(ValueError, match="masses"):
+        world.create_body(SQUARE, triangles=SQUARE_TRIS, masses=[1.0, 1.0])
+    with pytest.raises(ValueError, match="rest"):
+        world.add_constraints("distance", [(0, 1), (1, 2)], rest=[1.0])
+    with pytest.raises(ValueError, match="takes 2 particles"):
+        world.add_constraint("distance", [0, 1, 2])
+    assert snapshot(world) == before
+
+
+def test_a_step_that_goes_non_finite(world):
+    """A velocity of 1e308 m/s overflows in the step: NumericalError (an ArithmeticError) with the C
+    message, the world restored to the start of the frame, and a warning record saying where."""
+    world.set_velocities([(1e308, 0.0, 0.0)], first=1)
+    before = snapshot(world)
+    frame = world.report().frame
+    with pytest.raises(ArithmeticError) as e:
+        world.step()
+    assert isinstance(e.value, embra.NumericalError) and e.value.status_name == "EMBRA_ERROR_NUMERICAL"
+    assert str(e.value).startswith("embra_world_step: non-finite")
+    assert snapshot(world) == before and world.report().frame == frame
+    assert world.warning().frame == frame and world.warning().particle >= 0
