@@ -313,8 +313,14 @@ enum {
                                       across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
   EMBRA_CONSTRAINT_TET_VOLUME = 3, /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
   EMBRA_CONSTRAINT_WELD = 4,       /* 2 particles: x0 = x1 (rest must be 0) */
-  EMBRA_CONSTRAINT_TETHER = 5      /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
+  EMBRA_CONSTRAINT_TETHER = 5,     /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
                                       pulls only when overstretched */
+  EMBRA_CONSTRAINT_PLANARITY = 6,  /* 4 particles, a quad x0 x1 x2 x3 in order round it: signed
+                                      distance between its diagonals x0-x2 and x1-x3 = rest (m; 0 =
+                                      planar). (x1 - x0) . n / |n|, n = (x2 - x0) x (x3 - x1) */
+  EMBRA_CONSTRAINT_PLANE_OFFSET = 7 /* 4 particles: signed distance of x0 from the plane through
+                                      x1, x2, x3 = rest (m; positive on the side of the normal
+                                      (x2 - x1) x (x3 - x1)). x0 may slide along the plane */
 };
 /* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
 EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);

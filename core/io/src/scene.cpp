@@ -357,7 +357,8 @@ json material_json(const Material& m) {
 }
 
 const char* const kGenerateNames[] = {"stretch", "shear", "bend", "volume"};
-const char* const kKindNames[] = {"distance", "edge_angle", "dihedral", "tet_volume", "weld", "tether"};
+const char* const kKindNames[] = {"distance", "edge_angle", "dihedral", "tet_volume",
+                                  "weld",     "tether",     "planarity", "plane_offset"};
 
 /// Builds the world from a validated document, section by section; every error names its place.
 class Builder {
