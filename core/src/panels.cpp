@@ -159,8 +159,8 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
   }
   for (const PanelJoint& j : panel_joints(layout)) {
     const int k = j.corner, k1 = (j.corner + 1) % 4;
-    e.miter.push_back(miter_twist(x[layout.top(j.panel, k)], x[layout.top(j.panel, k1)],
-                                  x[layout.bottom(j.panel, k)], x[layout.bottom(j.panel, k1)]));
+    e.miter.push_back(miter_twist(x[layout.top(j.panel, k)], x[layout.top(j.panel, k1)], x[layout.bottom(j.panel, k)],
+                                  x[layout.bottom(j.panel, k1)]));
   }
   for (const ConicalVertex& c : conical_vertices(layout)) {
     double a[4];
@@ -318,7 +318,8 @@ std::string panel_cuts_json(const std::vector<PanelCut>& cuts) {
     s += p ? ",\n  " : "\n  ";
     s += "{\"panel\": " + std::to_string(p) + ", \"thickness\": " + fmt(c.thickness) +
          ", \"bottom_z\": " + fmt(c.bottom_z) + ", \"top\": [";
-    for (int k = 0; k < 4; ++k) s += std::string(k ? ", " : "") + "[" + fmt(c.top[k][0]) + ", " + fmt(c.top[k][1]) + "]";
+    for (int k = 0; k < 4; ++k)
+      s += std::string(k ? ", " : "") + "[" + fmt(c.top[k][0]) + ", " + fmt(c.top[k][1]) + "]";
     s += "], \"bottom\": [";
     for (int k = 0; k < 4; ++k)
       s += std::string(k ? ", " : "") + "[" + fmt(c.bottom[k][0]) + ", " + fmt(c.bottom[k][1]) + "]";
@@ -372,7 +373,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   // --- check everything first ---
   if (d.positions.empty() || d.positions.size() % 3 != 0)
     invalid("panel mesh positions must be a non-empty array of 3 numbers per vertex");
-  if (d.quads.empty() || d.quads.size() % 4 != 0) invalid("panel mesh quads must be a non-empty array of 4 indices per quad");
+  if (d.quads.empty() || d.quads.size() % 4 != 0)
+    invalid("panel mesh quads must be a non-empty array of 4 indices per quad");
   const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
   const int64_t np = static_cast<int64_t>(d.quads.size() / 4);
   if (8 * np + world.particle_count() > INT32_MAX / 4) invalid("too many panels");
@@ -525,7 +527,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   add(Kind::weld, ids, std::vector<double>(ids.size() / 2, 0.0), 0.0);
   // Planarity: the top quad, and every joint (miter face).
   ids.clear();
-  for (int32_t p = 0; p < np; ++p) ids.insert(ids.end(), {layout.top(p, 0), layout.top(p, 1), layout.top(p, 2), layout.top(p, 3)});
+  for (int32_t p = 0; p < np; ++p)
+    ids.insert(ids.end(), {layout.top(p, 0), layout.top(p, 1), layout.top(p, 2), layout.top(p, 3)});
   for (const PanelJoint& j : panel_joints(layout)) {
     const int k = j.corner, k1 = (j.corner + 1) % 4;
     ids.insert(ids.end(), {layout.top(j.panel, k), layout.top(j.panel, k1), layout.bottom(j.panel, k1),
@@ -536,7 +539,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   ids.clear();
   for (int32_t p = 0; p < np; ++p)
     for (int k = 0; k < 4; ++k)
-      ids.insert(ids.end(), {layout.bottom(p, k), layout.top(p, k), layout.top(p, (k + 1) % 4), layout.top(p, (k + 3) % 4)});
+      ids.insert(ids.end(),
+                 {layout.bottom(p, k), layout.top(p, k), layout.top(p, (k + 1) % 4), layout.top(p, (k + 3) % 4)});
   add(Kind::plane_offset, ids, std::vector<double>(ids.size() / 4, -d.thickness), 0.0);
   // The soft hold of each bottom corner near its top corner.
   if (d.slide_compliance > 0.0) {

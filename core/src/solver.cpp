@@ -663,6 +663,38 @@ void World::update_velocities(double h) {
       x_[i] -= tangential * std::min(mu_k * ct.lambda / len, 1.0);
   }
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
+  // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
+  // projection shares it (particle k moves w_k b_k / sum_j w_j b_j^2 of it).
+  for (const FaceContact& fc : face_contacts_) {
+    if (fc.lambda <= 0.0) continue;
+    const Collider& c = colliders_[fc.collider];
+    const Vec3 bary = closest_barycentric(c.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
+    Vec3 q = Vec3::Zero(), moved = Vec3::Zero();
+    double denom = 0.0, mu_s = 0.0, mu_k = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t i = fc.ids[k];
+      q += bary[k] * x_[i];
+      moved += bary[k] * (x_[i] - x_prev_[i]);
+      denom += w_[i] * bary[k] * bary[k];
+      mu_s += bary[k] * mu_s_[i];
+      mu_k += bary[k] * mu_k_[i];
+    }
+    if (denom <= 0.0) continue;
+    const Vec3 n = (q - c.position).normalized();
+    const Vec3 slip = moved - (q - collider_point_before(c, q));
+    const Vec3 tangential = slip - slip.dot(n) * n;
+    const double len = tangential.norm();
+    mu_s = std::sqrt(mu_s * c.desc.friction_static);
+    mu_k = std::sqrt(mu_k * c.desc.friction_dynamic);
+    // lambda is the push of the contact point (in length: sum_k w_k b_k^2 lambda moves it by that).
+    const double push = fc.lambda * denom;
+    Vec3 remove = Vec3::Zero();
+    if (len < mu_s * push)
+      remove = tangential;
+    else if (len > 0.0)
+      remove = tangential * std::min(mu_k * push / len, 1.0);
+    for (int k = 0; k < 3; ++k) x_[fc.ids[k]] -= (w_[fc.ids[k]] * bary[k] / denom) * remove;
+  }
   const double inv_h = 1.0 / h;
   for (size_t i = 0; i < x_.size(); ++i) {
     v_[i] = (x_[i] - x_prev_[i]) * inv_h;
@@ -749,9 +781,8 @@ void World::measure() {
   report_.residual_max = all_max;
   report_.residual_rms = all_n > 0 ? std::sqrt(all_sq / static_cast<double>(all_n)) : 0.0;
   report_.constraint_count = all_n;
-  report_.contact_count =
-      static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size() + self_contacts_.size() +
-                           face_contacts_.size());
+  report_.contact_count = static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size() +
+                                               self_contacts_.size() + face_contacts_.size());
   report_.settled = report_.max_speed <= settings_.settle_speed;
 }
 

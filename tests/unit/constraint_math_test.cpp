@@ -195,8 +195,8 @@ TEST(ConstraintMath, PlaneOffsetValueAndGradient) {
     ++checked;
     const Eigen::Hyperplane<double, 3> plane(n.normalized(), x[1]);
     EXPECT_NEAR(eval_plane_offset(x[0], x[1], x[2], x[3]).value, plane.signedDistance(x[0]), 1e-14);
-    check_gradient<4>([](const Points<4>& p) { return eval_plane_offset(p[0], p[1], p[2], p[3]); }, x,
-                      "plane_offset", i);
+    check_gradient<4>([](const Points<4>& p) { return eval_plane_offset(p[0], p[1], p[2], p[3]); }, x, "plane_offset",
+                      i);
   }
   EXPECT_EQ(checked, kConfigs);
   // 0.3 above the plane z = 0 (counter-clockwise triangle seen from above: normal +z).

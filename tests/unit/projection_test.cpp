@@ -51,9 +51,8 @@ std::vector<Vec3> random_config(Kind kind, Rng& rng) {
         if (std::abs(eval_tet_volume(x[0], x[1], x[2], x[3]).value) > 0.03) return x;
         break;
       case Kind::planarity:  // diagonals far from parallel, and apart
-        if ((x[2] - x[0]).normalized().cross((x[3] - x[1]).normalized()).norm() > 0.5 &&
-            (x[2] - x[0]).norm() > 0.5 && (x[3] - x[1]).norm() > 0.5 &&
-            std::abs(eval_quad_planarity(x[0], x[1], x[2], x[3]).value) > 0.05)
+        if ((x[2] - x[0]).normalized().cross((x[3] - x[1]).normalized()).norm() > 0.5 && (x[2] - x[0]).norm() > 0.5 &&
+            (x[3] - x[1]).norm() > 0.5 && std::abs(eval_quad_planarity(x[0], x[1], x[2], x[3]).value) > 0.05)
           return x;
         break;
       case Kind::plane_offset:  // a well-shaped triangle, the point off its plane

@@ -37,7 +37,7 @@ struct PanelMeshDesc {
   double density = 1.0;               // kg per unit area of the top layer (when mass is 0)
   double damping = 0.0;               // 1/s per particle
   double friction_static = 0.5, friction_dynamic = 0.3;
-  double slide_compliance = 1e-3;  // m/N of the soft distance from each bottom corner to its top corner
+  double slide_compliance = 1e-3;    // m/N of the soft distance from each bottom corner to its top corner
   PanelPins pins = PanelPins::none;  // hard pins at the mesh's corners (vertices on one panel only)
   Id group;                          // group of every constraint; null = the default group
 };
