@@ -439,21 +439,21 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   std::vector<Vec3> offset(nv, Vec3::Zero());  // bottom - top per mesh vertex
   for (int64_t v = 0; v < nv; ++v) {
     if (around[v].empty()) continue;
-    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-    Vec3 rhs = Vec3::Zero(), mean = Vec3::Zero();
-    for (const auto& f : around[v]) {
-      const Vec3& n = face_normal[f.first];
-      a += n * n.transpose();
-      rhs -= d.thickness * n;
-      mean += n;
+    // n_f . y = -thickness for every face f, in the least-squares sense; where the faces do not
+    // decide y (a flat vertex, a boundary) the point nearest -thickness * (mean normal) is taken:
+    // y = y0 + N^+ (r - N y0), with the pseudo-inverse of the stacked normals N.
+    const Eigen::Index m = static_cast<Eigen::Index>(around[v].size());
+    Eigen::MatrixXd normals(m, 3);
+    Vec3 mean = Vec3::Zero();
+    for (Eigen::Index f = 0; f < m; ++f) {
+      normals.row(f) = face_normal[around[v][f].first].transpose();
+      mean += face_normal[around[v][f].first];
     }
-    mean.normalize();
-    // Least squares n_f . y = -thickness for every face; a tiny pull towards -thickness * mean
-    // picks the point where the planes do not decide it (a flat vertex, a boundary).
-    constexpr double eps = 1e-10;
-    a += eps * Eigen::Matrix3d::Identity();
-    rhs -= eps * d.thickness * mean;
-    offset[v] = a.ldlt().solve(rhs);
+    const Vec3 y0 = -d.thickness * mean.normalized();
+    const Eigen::VectorXd r = Eigen::VectorXd::Constant(m, -d.thickness) - normals * y0;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normals, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    svd.setThreshold(1e-9);
+    offset[v] = y0 + svd.solve(r);
   }
 
   // --- particles ---
