@@ -138,10 +138,11 @@ static void test_drape(const char* dir) {
     CHECK_NEAR(own_planarity, reported, 1e-15);
   }
   CAPI_CONTEXT("%s", "");
-  printf("drape: settled from frame %d; at frame 100 thickness %.3e, planarity %.3e / %.3e, miter %.3e; "
-         "within tolerance again from frame %d; deepest face inside the sphere %.3e\n",
-         settled_from, at100.thickness.max, at100.planarity_top.max, at100.planarity_bottom.max, at100.miter.max,
-         back_from, worst_inside);
+  printf(
+      "drape: settled from frame %d; at frame 100 thickness %.3e, planarity %.3e / %.3e, miter %.3e; "
+      "within tolerance again from frame %d; deepest face inside the sphere %.3e\n",
+      settled_from, at100.thickness.max, at100.planarity_top.max, at100.planarity_bottom.max, at100.miter.max,
+      back_from, worst_inside);
   CHECK(settled_from > 0 && settled_from <= 100);
   CHECK(at100.thickness.max <= 5e-5);
   CHECK(at100.planarity_top.max <= 1e-6);
