@@ -48,6 +48,10 @@ std::shared_ptr<const ColliderGeometry> build_collider_geometry(const ColliderDe
 /// for an open mesh the unsigned distance) and the outward unit normal there.
 double shape_distance(const ColliderDesc& desc, const ColliderGeometry& g, const Vec3& p, Vec3& normal);
 
+/// Barycentric coordinates (weights of a, b, c; non-negative, summing to 1) of the point of triangle
+/// (a, b, c) closest to p (Ericson, Real-Time Collision Detection 5.1.5). Used by face contacts.
+Vec3 closest_barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// Local bounds of the solid (without clearance).
 void shape_bounds(const ColliderDesc& desc, const ColliderGeometry& g, Vec3& lo, Vec3& hi);
 

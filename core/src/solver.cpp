@@ -250,6 +250,10 @@ auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
     return eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]);
   else if constexpr (K == Kind::dihedral)
     return eval_dihedral(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+  else if constexpr (K == Kind::planarity)
+    return eval_quad_planarity(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+  else if constexpr (K == Kind::plane_offset)
+    return eval_plane_offset(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
   else
     return eval_tet_volume(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
 }
@@ -263,7 +267,8 @@ double deviation(double value, double rest) {
     return value - rest;
 }
 
-/// The generic pass, through constraint_math.hpp (edge angle, tet volume).
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume, quad planarity, plane
+/// offset).
 template <Kind K>
 void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
   constexpr int N = arity_of<K>();
@@ -383,6 +388,59 @@ void World::find_contacts() {
   }
 }
 
+/// Panel faces against sphere colliders: a flat panel touching a sphere with its corners only would
+/// cut into it (a 0.8 panel over a sphere of radius 1 by 0.175), so the triangles of every panel
+/// mesh (both layers) take contacts of their own, at the point closest to the centre.
+void World::find_face_contacts() {
+  face_contacts_.clear();
+  if (panel_layouts_.empty()) return;
+  for (size_t c = 0; c < colliders_.size(); ++c) {
+    const Collider& col = colliders_[c];
+    if (!col.alive || col.desc.shape != ColliderShape::sphere) continue;
+    const double r = col.desc.radius + col.desc.thickness;
+    for (const PanelLayout& l : panel_layouts_)
+      for (int32_t p = 0; p < l.panel_count(); ++p)
+        for (int layer = 0; layer < 2; ++layer)
+          for (int half = 0; half < 2; ++half) {
+            const int32_t o = l.first_particle + 8 * p + 4 * layer;
+            const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
+            if (w_[ids[0]] == 0.0 && w_[ids[1]] == 0.0 && w_[ids[2]] == 0.0) continue;
+            double moved = 0.0;
+            for (int32_t i : ids) moved = std::max(moved, (x_[i] - x_prev_[i]).norm());
+            const Vec3 b = closest_barycentric(col.position, x_[ids[0]], x_[ids[1]], x_[ids[2]]);
+            const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
+            const double move = (col.position - col.position_prev).norm();
+            if ((q - col.position).norm() - r < moved + move)
+              face_contacts_.push_back(FaceContact{{ids[0], ids[1], ids[2]}, static_cast<int32_t>(c), 0.0});
+          }
+  }
+}
+
+void World::project_face_contacts() {
+  for (FaceContact& fc : face_contacts_) {
+    const Collider& col = colliders_[fc.collider];
+    const Vec3& a = x_[fc.ids[0]];
+    const Vec3& b = x_[fc.ids[1]];
+    const Vec3& c = x_[fc.ids[2]];
+    const Vec3 bary = closest_barycentric(col.position, a, b, c);
+    const Vec3 q = bary[0] * a + bary[1] * b + bary[2] * c;
+    const Vec3 d = q - col.position;
+    const double len = d.norm();
+    if (!(len > 1e-12)) continue;
+    const Vec3 n = d / len;
+    const double gap = len - (col.desc.radius + col.desc.thickness);
+    double denom = 0.0;
+    for (int k = 0; k < 3; ++k) denom += w_[fc.ids[k]] * bary[k] * bary[k];
+    if (denom <= 0.0) continue;
+    // Hard, unilateral: C = gap >= 0, grad_k C = b_k n.
+    const double lambda = std::max(fc.lambda - gap / denom, 0.0);
+    const double dl = lambda - fc.lambda;
+    fc.lambda = lambda;
+    if (dl == 0.0) continue;
+    for (int k = 0; k < 3; ++k) x_[fc.ids[k]] += (w_[fc.ids[k]] * bary[k] * dl) * n;
+  }
+}
+
 void World::find_shape_contacts(int32_t index, std::vector<Contact>& out) const {
   const Collider& col = colliders_[index];
   const ColliderGeometry& geo = *col.geometry;
@@ -482,6 +540,8 @@ void World::realign(const std::vector<Vec3>& predicted) {
     add_corrections<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], x_, w_, corr);
     add_corrections<Kind::dihedral>(g.solve[static_cast<int>(Kind::dihedral)], x_, w_, corr);
     add_corrections<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], x_, w_, corr);
+    add_corrections<Kind::planarity>(g.solve[static_cast<int>(Kind::planarity)], x_, w_, corr);
+    add_corrections<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], x_, w_, corr);
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
@@ -497,6 +557,14 @@ void World::realign(const std::vector<Vec3>& predicted) {
     }
   }
   self_collision::add_corrections(self_contacts_, w_, corr);
+  for (const FaceContact& fc : face_contacts_) {
+    if (fc.lambda == 0.0) continue;
+    const Collider& col = colliders_[fc.collider];
+    const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
+    const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
+    const Vec3 n = (q - col.position).normalized();
+    for (int k = 0; k < 3; ++k) corr[fc.ids[k]] += (w_[fc.ids[k]] * bary[k] * fc.lambda) * n;
+  }
   for (size_t i = 0; i < x_.size(); ++i)
     if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
 }
@@ -522,10 +590,13 @@ void World::project_group(Group& g, double h) {
   project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
   k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
+  project_generic<Kind::planarity>(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x_, w_);
+  project_generic<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x_, w_);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
   if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
     self_collision::project(self_contacts_, x_, w_);
   if (!g.contacts.empty()) project_contacts(g, h);
+  if (!face_contacts_.empty() && &g == &groups_[settings_.contact_group.index]) project_face_contacts();
 }
 
 namespace {
@@ -597,6 +668,38 @@ void World::update_velocities(double h) {
       x_[i] -= tangential * std::min(mu_k * ct.lambda / len, 1.0);
   }
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
+  // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
+  // projection shares it (particle k moves w_k b_k / sum_j w_j b_j^2 of it).
+  for (const FaceContact& fc : face_contacts_) {
+    if (fc.lambda <= 0.0) continue;
+    const Collider& c = colliders_[fc.collider];
+    const Vec3 bary = closest_barycentric(c.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
+    Vec3 q = Vec3::Zero(), moved = Vec3::Zero();
+    double denom = 0.0, mu_s = 0.0, mu_k = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t i = fc.ids[k];
+      q += bary[k] * x_[i];
+      moved += bary[k] * (x_[i] - x_prev_[i]);
+      denom += w_[i] * bary[k] * bary[k];
+      mu_s += bary[k] * mu_s_[i];
+      mu_k += bary[k] * mu_k_[i];
+    }
+    if (denom <= 0.0) continue;
+    const Vec3 n = (q - c.position).normalized();
+    const Vec3 slip = moved - (q - collider_point_before(c, q));
+    const Vec3 tangential = slip - slip.dot(n) * n;
+    const double len = tangential.norm();
+    mu_s = std::sqrt(mu_s * c.desc.friction_static);
+    mu_k = std::sqrt(mu_k * c.desc.friction_dynamic);
+    // lambda is the push of the contact point (in length: sum_k w_k b_k^2 lambda moves it by that).
+    const double push = fc.lambda * denom;
+    Vec3 remove = Vec3::Zero();
+    if (len < mu_s * push)
+      remove = tangential;
+    else if (len > 0.0)
+      remove = tangential * std::min(mu_k * push / len, 1.0);
+    for (int k = 0; k < 3; ++k) x_[fc.ids[k]] -= (w_[fc.ids[k]] * bary[k] / denom) * remove;
+  }
   const double inv_h = 1.0 / h;
   for (size_t i = 0; i < x_.size(); ++i) {
     v_[i] = (x_[i] - x_prev_[i]) * inv_h;
@@ -625,6 +728,8 @@ void World::measure() {
     residuals<Kind::dihedral>(g.solve[2], inv_h2, x_, max, sq);
     residuals<Kind::tet_volume>(g.solve[3], inv_h2, x_, max, sq);
     residuals<Kind::tether>(g.solve[5], inv_h2, x_, max, sq);
+    residuals<Kind::planarity>(g.solve[6], inv_h2, x_, max, sq);
+    residuals<Kind::plane_offset>(g.solve[7], inv_h2, x_, max, sq);
     for (const SolverArray& a : g.solve) n += static_cast<int64_t>(a.size());
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
@@ -650,6 +755,16 @@ void World::measure() {
       sq += r * r;
       ++n;
     }
+    if (&g == &groups_[settings_.contact_group.index])
+      for (const FaceContact& fc : face_contacts_) {
+        const Collider& col = colliders_[fc.collider];
+        const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
+        const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
+        const double r = std::max(col.desc.radius + col.desc.thickness - (q - col.position).norm(), 0.0);
+        max = std::max(max, r);
+        sq += r * r;
+        ++n;
+      }
     g.report.count = n;
     g.report.residual_max = max;
     g.report.residual_rms = n > 0 ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
@@ -671,8 +786,8 @@ void World::measure() {
   report_.residual_max = all_max;
   report_.residual_rms = all_n > 0 ? std::sqrt(all_sq / static_cast<double>(all_n)) : 0.0;
   report_.constraint_count = all_n;
-  report_.contact_count =
-      static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size() + self_contacts_.size());
+  report_.contact_count = static_cast<int64_t>(groups_[settings_.contact_group.index].contacts.size() +
+                                               self_contacts_.size() + face_contacts_.size());
   report_.settled = report_.max_speed <= settings_.settle_speed;
 }
 
@@ -696,6 +811,7 @@ void World::step() {
     predict(h, alpha);
     find_contacts();
     find_self_contacts();
+    find_face_contacts();
     reset_multipliers();
     if (settings_.realign_passes > 0) predicted_ = x_;
     for (int pass = 0; pass <= settings_.realign_passes; ++pass) {

@@ -93,6 +93,9 @@ int arity(Kind kind) {
       return 2;
     case Kind::tether:
       return 2;
+    case Kind::planarity:
+    case Kind::plane_offset:
+      return 4;
   }
   return 0;
 }
@@ -111,6 +114,10 @@ const char* kind_name(Kind kind) {
       return "weld";
     case Kind::tether:
       return "tether";
+    case Kind::planarity:
+      return "planarity";
+    case Kind::plane_offset:
+      return "plane_offset";
   }
   return "unknown";
 }
@@ -275,6 +282,16 @@ double measure_rest(Kind kind, const int32_t* p, const std::vector<Vec3>& x, int
     }
     case Kind::weld:
       return 0.0;
+    case Kind::planarity: {
+      const auto e = eval_quad_planarity(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+      if (!e.valid) invalid(name + " is degenerate: the quad's diagonals are parallel");
+      return e.value;
+    }
+    case Kind::plane_offset: {
+      const auto e = eval_plane_offset(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+      if (!e.valid) invalid(name + " is degenerate: the plane's triangle has zero area");
+      return e.value;
+    }
   }
   return 0.0;
 }
@@ -297,6 +314,8 @@ void check_rest(Kind kind, double rest, int64_t i) {
       if (rest != 0.0) invalid(name + ": a weld has no rest value other than 0");
       break;
     case Kind::tet_volume:
+    case Kind::planarity:
+    case Kind::plane_offset:
       break;
   }
 }
@@ -623,6 +642,39 @@ const BodyInfo& World::body(Id id) const {
   if (id.generation != 1 || id.index >= bodies_.size())
     fail(ErrorCode::stale_id, "body id does not name a body of this world");
   return bodies_[id.index];
+}
+
+void World::set_panel_layout(const PanelLayout& layout) {
+  const BodyInfo& b = body(layout.body);
+  if (layout.quads.empty() || layout.quads.size() % 4 != 0) invalid("panel layout quads must be 4 indices per panel");
+  const int64_t panels = static_cast<int64_t>(layout.quads.size() / 4);
+  if (8 * panels != b.particle_count)
+    invalid("panel layout has " + std::to_string(panels) + " panels but the body has " +
+            std::to_string(b.particle_count) + " particles (8 per panel expected)");
+  if (layout.vertex_count < 1) invalid("panel layout vertex_count must be >= 1");
+  for (size_t q = 0; q < layout.quads.size(); q += 4)
+    for (size_t k = 0; k < 4; ++k) {
+      const int32_t v = layout.quads[q + k];
+      if (v < 0 || v >= layout.vertex_count)
+        invalid("panel layout quad " + std::to_string(q / 4) + " vertex " + std::to_string(v) + " is outside [0, " +
+                std::to_string(layout.vertex_count) + ")");
+      for (size_t j = 0; j < k; ++j)
+        if (layout.quads[q + j] == v)
+          invalid("panel layout quad " + std::to_string(q / 4) + " repeats vertex " + std::to_string(v));
+    }
+  check_finite(layout.thickness, "panel thickness");
+  if (!(layout.thickness > 0.0)) invalid("panel thickness must be > 0");
+  for (const PanelLayout& l : panel_layouts_)
+    if (l.body == layout.body) invalid("the body already has a panel layout");
+  PanelLayout copy = layout;
+  copy.first_particle = b.first_particle;
+  panel_layouts_.push_back(std::move(copy));
+}
+
+const PanelLayout* World::panel_layout(Id body_id) const {
+  for (const PanelLayout& l : panel_layouts_)
+    if (l.body == body_id) return &l;
+  return nullptr;
 }
 
 void World::set_clock(int64_t frame, double time) {

@@ -274,6 +274,85 @@ static int write_world_obj(const char* path, embra_world* world) {
   return fclose(f) == 0 ? 0 : -1;
 }
 
+/* Panel meshes: the bodies of the world that are panel meshes (up to 64). */
+#define MAX_PANEL_MESHES 64
+static int find_panel_meshes(embra_world* world, embra_body_id* out) {
+  embra_world_counts counts;
+  int n = 0;
+  if (embra_world_get_counts(world, &counts) != EMBRA_OK) return 0;
+  for (int32_t b = 0; b < counts.bodies && n < MAX_PANEL_MESHES; ++b) {
+    const embra_body_id body = {(uint32_t)b, 1};
+    int32_t panels = 0;
+    if (embra_panel_mesh_get_panel_count(world, body, &panels) == EMBRA_OK) out[n++] = body;
+  }
+  return n;
+}
+
+/* The worst of every panel mesh's metrics (and whether all are within tolerance). */
+typedef struct panel_totals {
+  double planarity, planarity_top, planarity_bottom, corner_distance, thickness, miter, conical, diagonal;
+  int within;
+} panel_totals;
+
+static double max2(double a, double b) {
+  return a > b ? a : b;
+}
+
+static int panel_totals_of(embra_world* world, const embra_body_id* bodies, int n, panel_totals* t) {
+  memset(t, 0, sizeof *t);
+  t->within = 1;
+  for (int i = 0; i < n; ++i) {
+    embra_panel_metrics m;
+    if (embra_panel_mesh_get_metrics(world, bodies[i], NULL, &m) != EMBRA_OK) return -1;
+    t->planarity_top = max2(t->planarity_top, m.planarity_top.max);
+    t->planarity_bottom = max2(t->planarity_bottom, m.planarity_bottom.max);
+    t->planarity = max2(t->planarity_top, t->planarity_bottom);
+    t->corner_distance = max2(t->corner_distance, max2(m.corner_distance_top.max, m.corner_distance_bottom.max));
+    t->diagonal = max2(t->diagonal, max2(m.diagonal_top.max, m.diagonal_bottom.max));
+    t->thickness = max2(t->thickness, m.thickness.max);
+    t->miter = max2(t->miter, m.miter.max);
+    t->conical = max2(t->conical, m.conical.max);
+    t->within = t->within && m.within_tolerance;
+  }
+  return 0;
+}
+
+/* Writes each panel mesh's cut list (JSON and CSV) into DIR. */
+static int write_cuts(embra_world* world, const embra_body_id* bodies, int n, const char* dir) {
+  for (int i = 0; i < n; ++i)
+    for (int format = EMBRA_CUTS_JSON; format <= EMBRA_CUTS_CSV; ++format) {
+      int64_t len = 0;
+      if (embra_panel_mesh_export_cuts(world, bodies[i], format, NULL, 0, &len) != EMBRA_OK) return -1;
+      char* text = malloc((size_t)len);
+      if (!text) return -1;
+      if (embra_panel_mesh_export_cuts(world, bodies[i], format, text, len, &len) != EMBRA_OK) {
+        free(text);
+        return -1;
+      }
+      char path[4200];
+      snprintf(path, sizeof path, "%s/panels_%u.%s", dir, bodies[i].index, format == EMBRA_CUTS_JSON ? "json" : "csv");
+      FILE* f = fopen(path, "w");
+      if (!f) {
+        fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+        free(text);
+        return -1;
+      }
+      fputs(text, f);
+      free(text);
+      if (fclose(f) != 0) return -1;
+    }
+  return 0;
+}
+
+static void print_tolerance_row(const char* name, double value, embra_tolerance tol, double unit_scale, int scaled) {
+  if (scaled)
+    printf("%-22s %12.3e %12.3e %10s %12.4f %12.4f\n", name, value, tol.target, value <= tol.target ? "yes" : "NO",
+           value * unit_scale, tol.target * unit_scale);
+  else
+    printf("%-22s %12.3e %12.3e %10s %12s %12s\n", name, value, tol.target, value <= tol.target ? "yes" : "NO", "-",
+           "-");
+}
+
 static int cmd_validate(int argc, char** argv) {
   if (argc != 1) return usage();
   embra_world* world = NULL;
@@ -341,6 +420,11 @@ static int cmd_run(int argc, char** argv) {
     embra_world_destroy(world);
     return EXIT_INVALID;
   }
+  embra_body_id panel_bodies[MAX_PANEL_MESHES];
+  const int panel_count = find_panel_meshes(world, panel_bodies);
+  panel_totals pt;
+  memset(&pt, 0, sizeof pt);
+  long within_since = -1;
   const int tty = isatty(2);
   const long stride = frames >= 10 ? frames / 10 : 1;
   if (frames > 0)
@@ -369,6 +453,17 @@ static int cmd_run(int argc, char** argv) {
             "\"kinetic_energy\":%.17g,\"max_speed\":%.17g,\"contacts\":%lld,\"settled\":%s}\n",
             (long long)r.frame, r.time, ms, r.residual_max, r.residual_rms, r.kinetic_energy, r.max_speed,
             (long long)r.contact_count, r.settled ? "true" : "false");
+    if (panel_count > 0 && panel_totals_of(world, panel_bodies, panel_count, &pt) == 0) {
+      fseek(metrics, -2, SEEK_CUR); /* reopen the record: drop "}\n" */
+      fprintf(metrics,
+              ",\"planarity_max\":%.17g,\"planarity_top_max\":%.17g,\"planarity_bottom_max\":%.17g,"
+              "\"corner_distance_max\":%.17g,\"diagonal_max\":%.17g,\"thickness_error_max\":%.17g,"
+              "\"miter_error_max\":%.17g,\"conical_defect_max\":%.17g,\"within_tolerance\":%s}\n",
+              pt.planarity, pt.planarity_top, pt.planarity_bottom, pt.corner_distance, pt.diagonal, pt.thickness,
+              pt.miter, pt.conical, pt.within ? "true" : "false");
+      if (pt.within && within_since < 0) within_since = (long)r.frame;
+      if (!pt.within) within_since = -1;
+    }
     if (f % stride == 0 || f == frames) {
       if (tty) fputs("\r\033[K", stderr); /* clear the progress bar's line */
       printf("%7lld %9.3f %13.3e %13.3e %13.3e %13.3e %8s\n", (long long)r.frame, ms, r.residual_max, r.residual_rms,
@@ -408,6 +503,27 @@ static int cmd_run(int argc, char** argv) {
   else
     printf("%-18s no\n", "settled");
   printf("%-18s %s/final.json, %s/metrics.jsonl\n", "wrote", out, out);
+  if (panel_count > 0) {
+    if (write_cuts(world, panel_bodies, panel_count, out) != 0 && rc == 0) rc = EXIT_INVALID;
+    printf("%-18s %s/panels_N.json, %s/panels_N.csv (cut lists), %s/final.obj\n", "", out, out, out);
+    panel_totals_of(world, panel_bodies, panel_count, &pt);
+    embra_tolerances tol;
+    embra_world_get_tolerances(world, &tol);
+    printf("\nfabrication metrics at frame %lld (%d panel mesh%s), unit scale %g mm per metre per unit\n",
+           (long long)r.frame, panel_count, panel_count == 1 ? "" : "es", tol.unit_scale);
+    printf("%-22s %12s %12s %10s %12s %12s\n", "metric", "max", "tolerance", "within", "max mm/m", "tol mm/m");
+    print_tolerance_row("planarity top", pt.planarity_top, tol.planarity, 0.0, 0);
+    print_tolerance_row("planarity bottom", pt.planarity_bottom, tol.planarity, 0.0, 0);
+    print_tolerance_row("corner off plane", pt.corner_distance, tol.planarity_distance, tol.unit_scale, 1);
+    print_tolerance_row("thickness error", pt.thickness, tol.thickness, tol.unit_scale, 1);
+    print_tolerance_row("miter twist", pt.miter, tol.miter, tol.unit_scale, 1);
+    printf("%-22s %12.3e %12s %10s\n", "diagonals / edge", pt.diagonal, "-", "-");
+    printf("%-22s %12.3e %12s %10s\n", "conical defect (rad)", pt.conical, "-", "-");
+    if (within_since >= 0)
+      printf("%-22s since frame %ld\n", "within tolerance", within_since);
+    else
+      printf("%-22s no\n", "within tolerance");
+  }
   embra_world_destroy(world);
   return rc;
 }

@@ -21,7 +21,7 @@ namespace Embra
         public const int Internal = -8;
     }
 
-    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5 }
+    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7 }
 
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
 

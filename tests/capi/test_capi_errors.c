@@ -887,7 +887,7 @@ static void test_constraint_add(void) {
   d = good_constraint(EMBRA_CONSTRAINT_DISTANCE);
   d.kind = -1;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_constraint_add(W, &d));
-  d.kind = 6;
+  d.kind = 8; /* one past EMBRA_CONSTRAINT_PLANE_OFFSET */
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_constraint_add(W, &d));
   d = good_constraint(EMBRA_CONSTRAINT_DISTANCE);
   d.rest_from_current = 2;
@@ -1014,7 +1014,7 @@ static void test_constraints_add(void) {
   d.version = 0;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_constraints_add(W, &d));
   GOOD_BATCH();
-  d.kind = 6;
+  d.kind = 8; /* one past EMBRA_CONSTRAINT_PLANE_OFFSET */
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_constraints_add(W, &d));
   d.kind = INT32_MIN;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_constraints_add(W, &d));

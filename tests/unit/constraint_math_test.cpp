@@ -149,6 +149,61 @@ TEST(ConstraintMath, TetVolumeValueAndGradient) {
   EXPECT_NEAR(eval_tet_volume(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)).value, 1.0 / 6.0, 1e-16);
 }
 
+// Quad (x0, x1, x2, x3), diagonals x0-x2 and x1-x3:   x3 --- x2
+//                                                     |  \/  |   C = distance between the
+//                                                     |  /\  |   diagonal lines, signed
+//                                                     x0 --- x1
+// Expected value from the closest points of the two lines (a 2x2 least-squares solve).
+TEST(ConstraintMath, QuadPlanarityValueAndGradient) {
+  Rng rng(5);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const Vec3 d1 = x[2] - x[0], d2 = x[3] - x[1];
+    if (d1.norm() < 0.4 || d2.norm() < 0.4 || d1.normalized().cross(d2.normalized()).norm() < 0.3) continue;
+    ++checked;
+    // Closest points x0 + s d1 and x1 + t d2: minimise |x0 + s d1 - x1 - t d2|^2.
+    Eigen::Matrix<double, 3, 2> a;
+    a << d1, -d2;
+    const Eigen::Vector2d st = a.colPivHouseholderQr().solve(x[1] - x[0]);
+    const double distance = (x[0] + st[0] * d1 - x[1] - st[1] * d2).norm();
+    const double sign = (x[1] - x[0]).dot(d1.cross(d2)) >= 0 ? 1.0 : -1.0;
+    EXPECT_NEAR(eval_quad_planarity(x[0], x[1], x[2], x[3]).value, sign * distance, 1e-13);
+    check_gradient<4>([](const Points<4>& p) { return eval_quad_planarity(p[0], p[1], p[2], p[3]); }, x, "planarity",
+                      i);
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // A unit square is planar (0); raising one corner by d tilts its diagonal to (1, 1, d), and the
+  // diagonals' common normal n = (1, 1, d) x (-1, 1, 0) = (-d, -d, 2) puts them
+  // |(1, 0, 0) . n| / |n| = d / (2 sqrt(1 + d^2 / 2)) apart (d / 2 for small d).
+  EXPECT_EQ(eval_quad_planarity(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)).value, 0.0);
+  EXPECT_NEAR(std::abs(eval_quad_planarity(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0.2), Vec3(0, 1, 0)).value),
+              0.2 / (2 * std::sqrt(1 + 0.02)), 1e-15);
+  // Parallel diagonals (a collapsed quad): no gradient.
+  EXPECT_FALSE(eval_quad_planarity(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(3, 0, 0)).valid);
+}
+
+// Point x0 and the plane through x1, x2, x3: C = signed distance, positive on the side of
+// (x2 - x1) x (x3 - x1). Expected value from Eigen's Hyperplane.
+TEST(ConstraintMath, PlaneOffsetValueAndGradient) {
+  Rng rng(6);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const Vec3 n = (x[2] - x[1]).cross(x[3] - x[1]);
+    if (n.norm() < 0.3) continue;
+    ++checked;
+    const Eigen::Hyperplane<double, 3> plane(n.normalized(), x[1]);
+    EXPECT_NEAR(eval_plane_offset(x[0], x[1], x[2], x[3]).value, plane.signedDistance(x[0]), 1e-14);
+    check_gradient<4>([](const Points<4>& p) { return eval_plane_offset(p[0], p[1], p[2], p[3]); }, x, "plane_offset",
+                      i);
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // 0.3 above the plane z = 0 (counter-clockwise triangle seen from above: normal +z).
+  EXPECT_NEAR(eval_plane_offset(Vec3(5, -2, 0.3), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)).value, 0.3, 1e-15);
+  EXPECT_FALSE(eval_plane_offset(Vec3(0, 0, 1), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)).valid);
+}
+
 TEST(ConstraintMath, WrapAngle) {
   constexpr double pi = std::numbers::pi;
   EXPECT_NEAR(wrap_angle(0.25), 0.25, 1e-16);

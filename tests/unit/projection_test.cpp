@@ -50,6 +50,16 @@ std::vector<Vec3> random_config(Kind kind, Rng& rng) {
       case Kind::tet_volume:
         if (std::abs(eval_tet_volume(x[0], x[1], x[2], x[3]).value) > 0.03) return x;
         break;
+      case Kind::planarity:  // diagonals far from parallel, and apart
+        if ((x[2] - x[0]).normalized().cross((x[3] - x[1]).normalized()).norm() > 0.5 && (x[2] - x[0]).norm() > 0.5 &&
+            (x[3] - x[1]).norm() > 0.5 && std::abs(eval_quad_planarity(x[0], x[1], x[2], x[3]).value) > 0.05)
+          return x;
+        break;
+      case Kind::plane_offset:  // a well-shaped triangle, the point off its plane
+        if ((x[2] - x[1]).cross(x[3] - x[1]).norm() > 0.5 &&
+            std::abs(eval_plane_offset(x[0], x[1], x[2], x[3]).value) > 0.05)
+          return x;
+        break;
     }
   }
 }
@@ -78,6 +88,10 @@ double rest_of(Kind kind, const std::vector<Vec3>& x) {
       return eval_tet_volume(x[0], x[1], x[2], x[3]).value;
     case Kind::weld:
       return 0.0;
+    case Kind::planarity:
+      return eval_quad_planarity(x[0], x[1], x[2], x[3]).value;
+    case Kind::plane_offset:
+      return eval_plane_offset(x[0], x[1], x[2], x[3]).value;
   }
   return 0.0;
 }
@@ -107,7 +121,8 @@ double residual(const Single& s, Kind kind) {
   return std::abs(test::deviation(kind, s.world.positions(), s.ids.data(), s.rest));
 }
 
-const Kind kKinds[] = {Kind::distance, Kind::edge_angle, Kind::dihedral, Kind::tet_volume, Kind::weld, Kind::tether};
+const Kind kKinds[] = {Kind::distance, Kind::edge_angle, Kind::dihedral,  Kind::tet_volume,
+                       Kind::weld,     Kind::tether,     Kind::planarity, Kind::plane_offset};
 
 // (b) One step with substeps = 1, iterations = 1 is exactly one projection. The residual must drop,
 // both for a hard constraint and for a soft one (compliance alpha with alpha / h^2 = 1, comparable

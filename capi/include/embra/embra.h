@@ -306,15 +306,21 @@ EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_
 
 typedef int32_t embra_constraint_kind;
 enum {
-  EMBRA_CONSTRAINT_DISTANCE = 0,   /* 2 particles: |x0 - x1| = rest (m). Stretch */
-  EMBRA_CONSTRAINT_EDGE_ANGLE = 1, /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 = rest
-                                      (rad, [0, pi]). Shear */
-  EMBRA_CONSTRAINT_DIHEDRAL = 2,   /* 4 particles: angle between triangles (x0,x1,x2) and (x1,x0,x3)
-                                      across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
-  EMBRA_CONSTRAINT_TET_VOLUME = 3, /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
-  EMBRA_CONSTRAINT_WELD = 4,       /* 2 particles: x0 = x1 (rest must be 0) */
-  EMBRA_CONSTRAINT_TETHER = 5      /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
-                                      pulls only when overstretched */
+  EMBRA_CONSTRAINT_DISTANCE = 0,    /* 2 particles: |x0 - x1| = rest (m). Stretch */
+  EMBRA_CONSTRAINT_EDGE_ANGLE = 1,  /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 = rest
+                                       (rad, [0, pi]). Shear */
+  EMBRA_CONSTRAINT_DIHEDRAL = 2,    /* 4 particles: angle between triangles (x0,x1,x2) and (x1,x0,x3)
+                                       across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
+  EMBRA_CONSTRAINT_TET_VOLUME = 3,  /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
+  EMBRA_CONSTRAINT_WELD = 4,        /* 2 particles: x0 = x1 (rest must be 0) */
+  EMBRA_CONSTRAINT_TETHER = 5,      /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
+                                       pulls only when overstretched */
+  EMBRA_CONSTRAINT_PLANARITY = 6,   /* 4 particles, a quad x0 x1 x2 x3 in order round it: signed
+                                       distance between its diagonals x0-x2 and x1-x3 = rest (m; 0 =
+                                       planar). (x1 - x0) . n / |n|, n = (x2 - x0) x (x3 - x1) */
+  EMBRA_CONSTRAINT_PLANE_OFFSET = 7 /* 4 particles: signed distance of x0 from the plane through
+                                      x1, x2, x3 = rest (m; positive on the side of the normal
+                                      (x2 - x1) x (x3 - x1)). x0 may slide along the plane */
 };
 /* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
 EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);
@@ -493,6 +499,150 @@ EMBRA_API embra_status embra_world_set_velocities(embra_world* world, const doub
  * triangles take; with out NULL and capacity 0 only the count is written (EMBRA_OK). */
 EMBRA_API embra_status embra_body_get_triangles(const embra_world* world, embra_body_id body, int32_t* out,
                                                 int64_t capacity, int64_t* out_count);
+
+/* ---------------------------------------------------------------------------------------------
+ * Panel meshes: Planar Offset Quads (the paper's section 4)
+ *
+ * A panel mesh is built from a quad mesh, the top layer, given as vertices and quads or as an
+ * n x m grid of square panels. Each quad becomes a panel of its own, 8 particles in the body (panel
+ * p: top corners first + 8p + 0..3, bottom corners first + 8p + 4..7, corner k on quad vertex k):
+ * the top quad braced rigid (4 edges and 2 diagonals, hard) and held planar (EMBRA_CONSTRAINT_
+ * PLANARITY), the corners of adjacent panels on one mesh vertex welded top and bottom (panels pivot
+ * about their borders), each bottom corner held `thickness` below the plane of its top corner's
+ * triangle (EMBRA_CONSTRAINT_PLANE_OFFSET: it slides along it), every edge's joint (miter face:
+ * the edge's two top and two bottom corners) held planar, and a soft distance from each bottom
+ * corner to its top corner (slide_compliance) for where nothing else decides its place. The
+ * initial bottom corner of a mesh vertex is where the offset planes of its faces meet (least
+ * squares; exact for a conical mesh). The triangles of both layers (bottom ones facing down) take
+ * face contacts against sphere colliders, so a rigid panel never passes into a sphere between its
+ * corners.
+ *
+ * Metrics (section 4.1, computed from positions alone): planarity 1 - n1.n2 of the unit normals of
+ * a quad's two triangles (the larger over both diagonals; dimensionless, quadratic in the fold),
+ * the largest distance of a quad's corner from the plane of the other three (model units), the
+ * distance between its diagonals over its mean edge length, thickness error (the largest
+ * |distance - thickness| of a corner of one layer from the plane of the corresponding corner
+ * triangle of the other), miter twist (distance of a joint's fourth point, bottom corner j, from the
+ * plane through top i, top j and bottom i), and the conical defect |(a1 + a3) - (a2 + a4)| of the
+ * face angles at interior vertices of valence 4 (radians; 0 for a conical mesh, whose face offset
+ * exists, so it explains miter error).
+ * ------------------------------------------------------------------------------------------- */
+
+enum {
+  EMBRA_PANEL_PINS_NONE = 0,
+  EMBRA_PANEL_PINS_TOP_CORNERS = 1,           /* hard pins at the top corners of the mesh's corners */
+  EMBRA_PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2 /* and at their bottom corners */
+};
+
+#define EMBRA_PANEL_MESH_DEF_VERSION 1
+typedef struct embra_panel_mesh_def {
+  int32_t version;         /* EMBRA_PANEL_MESH_DEF_VERSION */
+  int32_t vertex_count;    /* top mesh vertices; 0: build the grid below instead */
+  const double* positions; /* double[3 * vertex_count], model units (m) */
+  const int32_t* quads;    /* int32_t[4 * quad_count], counter-clockwise seen from the top's normal
+                              side (the bottom layer is offset to the other side); consistently
+                              oriented, every edge on at most two quads, each quad planar */
+  int32_t quad_count;
+  int32_t grid_columns;    /* grid (vertex_count 0): panels along +x (>= 1); default 4 */
+  int32_t grid_rows;       /* panels along +y (>= 1); default 4 */
+  int32_t pins;            /* EMBRA_PANEL_PINS_*; default EMBRA_PANEL_PINS_NONE */
+  double panel_size;       /* grid: side of a square panel (m, > 0); default 0.8 */
+  double origin[3];        /* grid: corner of panel 0 (m); the grid lies in z = origin[2]; default 0 */
+  double thickness;        /* panel thickness (m, > 0); default 0.01 */
+  double mass;             /* kg for the whole mesh when > 0; default 0 (use density) */
+  double density;          /* kg per m^2 of top area when mass is 0; default 1 */
+  double damping;          /* 1/s per particle; default 0 */
+  double friction_static;  /* against colliders; default 0.5 */
+  double friction_dynamic; /* default 0.3 */
+  double slide_compliance; /* m/N of the bottom-to-top soft distance (>= 0; 0 = none); default 1e-3 */
+  embra_group_id group;    /* group of every constraint; {0,0} = default group */
+} embra_panel_mesh_def;
+
+EMBRA_API embra_panel_mesh_def embra_default_panel_mesh_def(void);
+/* Builds a panel mesh: a body, its constraints, its pins. *out_body (required) receives the body;
+ * *out_first_particle (nullable) its first particle. Everything is checked first; a refused call
+ * creates nothing. */
+EMBRA_API embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_def* def,
+                                               embra_body_id* out_body, int32_t* out_first_particle);
+/* Number of panels of a panel-mesh body (EMBRA_ERROR_INVALID_ARGUMENT if the body is not one). */
+EMBRA_API embra_status embra_panel_mesh_get_panel_count(const embra_world* world, embra_body_id body,
+                                                        int32_t* out_count);
+
+typedef struct embra_tolerance {
+  double target; /* at or below: within tolerance (drawn grey) */
+  double max;    /* the colour scale's end; above: out of tolerance */
+} embra_tolerance;
+
+#define EMBRA_TOLERANCES_VERSION 1
+/* schemas/tolerances.schema.json as a struct. */
+typedef struct embra_tolerances {
+  int32_t version; /* EMBRA_TOLERANCES_VERSION */
+  int32_t reserved0;
+  double unit_scale;                  /* mm per metre of panel per model unit; default 1000 */
+  embra_tolerance planarity;          /* 1 - n1.n2; default {1e-6, 1e-4} */
+  embra_tolerance planarity_distance; /* corner off the plane of the other three (m); {5e-5, 1e-3} */
+  embra_tolerance thickness;          /* m; default {5e-5, 1e-3} (the paper's) */
+  embra_tolerance miter;              /* m; default {1e-3, 1e-2} (the paper's target) */
+} embra_tolerances;
+
+EMBRA_API embra_tolerances embra_default_tolerances(void);
+/* The world's tolerances: the scene's tolerance document where it has one, else the defaults. */
+EMBRA_API embra_status embra_world_get_tolerances(const embra_world* world, embra_tolerances* out_tolerances);
+/* Sets the world's tolerances (saved with the scene). Every value finite, >= 0, target <= max,
+ * unit_scale > 0. */
+EMBRA_API embra_status embra_world_set_tolerances(embra_world* world, const embra_tolerances* tolerances);
+
+typedef struct embra_metric_summary {
+  double max;
+  double rms;
+  int64_t count;         /* elements measured (panels, joints or vertices) */
+  int64_t within_target; /* <= target */
+  int64_t within_max;    /* > target and <= max */
+  int64_t above_max;     /* > max */
+} embra_metric_summary;
+
+#define EMBRA_PANEL_METRICS_VERSION 1
+typedef struct embra_panel_metrics {
+  int32_t version;          /* set by the library: EMBRA_PANEL_METRICS_VERSION */
+  int32_t within_tolerance; /* 1: planarity (both layers), corner distance, thickness and miter
+                               all at or below their targets */
+  embra_metric_summary planarity_top, planarity_bottom;             /* per panel, 1 - n1.n2 */
+  embra_metric_summary corner_distance_top, corner_distance_bottom; /* per panel, m */
+  embra_metric_summary diagonal_top, diagonal_bottom;               /* per panel, diagonals' distance / mean edge */
+  embra_metric_summary thickness;                                   /* per panel, m */
+  embra_metric_summary miter;                                       /* per joint (edge of the top mesh), m */
+  embra_metric_summary conical;                                     /* per interior valence-4 vertex, rad */
+} embra_panel_metrics;
+
+/* Measures a panel-mesh body at the current positions against `tolerances` (nullable: the world's).
+ * Counts for diagonal and conical are against a target of 0. */
+EMBRA_API embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_id body,
+                                                    const embra_tolerances* tolerances,
+                                                    embra_panel_metrics* out_metrics);
+
+enum {
+  EMBRA_PANEL_METRIC_PLANARITY = 0,       /* 1 - n1.n2 of the particle's layer of its panel */
+  EMBRA_PANEL_METRIC_THICKNESS = 1,       /* m, its panel's thickness error */
+  EMBRA_PANEL_METRIC_MITER = 2,           /* m, the largest twist of the joints it is a corner of */
+  EMBRA_PANEL_METRIC_CORNER_DISTANCE = 3, /* m, its layer's corner distance */
+  EMBRA_PANEL_METRIC_CONICAL = 4          /* rad, the conical defect at its mesh vertex (0 elsewhere) */
+};
+/* Per-vertex error field for colour maps (figures 12 and 13: grey at or below the target, shaded
+ * up to the max): one double per particle of the body (8 per panel, in body order) into out
+ * (capacity in doubles). *out_count (required) receives the count; out NULL and capacity 0 only
+ * ask for it. */
+EMBRA_API embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_body_id body, int32_t metric,
+                                                          double* out, int64_t capacity, int64_t* out_count);
+
+enum { EMBRA_CUTS_JSON = 0, EMBRA_CUTS_CSV = 1 };
+/* The cut list at the current positions: per panel its top and bottom outlines in the panel's own
+ * plane coordinates (origin top corner 0, x along its first edge, y in the top plane, z along the
+ * top normal), its thickness, the bottom plane's z, and the miter angle of each edge k (corner k to
+ * k + 1) in degrees (0 = square cut, positive = the bottom reaches outward), as JSON
+ * ({"format": "embra-panel-cuts", ...}) or CSV (one row per panel, header first). Two-call
+ * pattern as embra_world_save_json: *out_length includes the terminating NUL. */
+EMBRA_API embra_status embra_panel_mesh_export_cuts(const embra_world* world, embra_body_id body, int32_t format,
+                                                    char* out, int64_t capacity, int64_t* out_length);
 
 /* ---------------------------------------------------------------------------------------------
  * JSON scenes (schemas/scene.schema.json): the same world through a second door

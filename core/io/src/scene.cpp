@@ -357,7 +357,8 @@ json material_json(const Material& m) {
 }
 
 const char* const kGenerateNames[] = {"stretch", "shear", "bend", "volume"};
-const char* const kKindNames[] = {"distance", "edge_angle", "dihedral", "tet_volume", "weld", "tether"};
+const char* const kKindNames[] = {"distance", "edge_angle", "dihedral",  "tet_volume",
+                                  "weld",     "tether",     "planarity", "plane_offset"};
 
 /// Builds the world from a validated document, section by section; every error names its place.
 class Builder {
@@ -410,6 +411,7 @@ class Builder {
       meta_.group_names[id.index] = name;
     });
     section("bodies", [&](const json& b, const std::string& at) { body(w, b, at); });
+    section("panel_meshes", [&](const json& p, const std::string& at) { panel_mesh(w, p, at); });
     section("constraints", [&](const json& c, const std::string& at) { constraints(w, c, at); });
     if (doc_.contains("state")) state(w, doc_["state"]);
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
@@ -618,6 +620,106 @@ class Builder {
     });
   }
 
+  /// A panel mesh: generated (grid, inline quads or an OBJ of quads) through build_panel_mesh, as a C
+  /// host would; or, as a saved scene writes it, the layout of a body listed in "bodies" whose
+  /// constraints and pins are listed in their own sections.
+  void panel_mesh(World& w, const json& p, const std::string& at) {
+    if (!p.contains("generator")) {
+      PanelLayout l;
+      l.body = named(bodies_, p, "body", at);
+      l.vertex_count = p["vertex_count"].get<int32_t>();
+      for (const json& q : p["quads"])
+        for (const json& v : q) l.quads.push_back(v.get<int32_t>());
+      l.thickness = p["thickness"].get<double>();
+      guard(at, [&] {
+        w.set_panel_layout(l);
+        return 0;
+      });
+      return;
+    }
+    std::vector<double> positions;
+    std::vector<int32_t> quads;
+    const std::string gen = p["generator"].get<std::string>();
+    if (gen == "grid") {
+      const Vec3 origin = p.contains("origin") ? vec3(p["origin"]) : Vec3::Zero();
+      guard(at, [&] {
+        panel_grid(p["columns"].get<int32_t>(), p["rows"].get<int32_t>(), p["panel_size"].get<double>(), origin,
+                   positions, quads);
+        return 0;
+      });
+    } else if (gen == "mesh") {
+      for (const json& v : p["vertices"])
+        for (const json& c : v) positions.push_back(c.get<double>());
+      for (const json& q : p["quads"])
+        for (const json& v : q) quads.push_back(v.get<int32_t>());
+    } else {  // "obj": a quad mesh file
+      const std::string rel = p["obj"].get<std::string>();
+      const std::string path = !rel.empty() && rel[0] == '/' ? rel : base_dir_ + "/" + rel;
+      std::ifstream in(path);
+      if (!in) fail(at + "/obj", "cannot open " + path);
+      const double scale = value_or(p, "scale", 1.0);
+      std::string line;
+      int64_t line_no = 0;
+      while (std::getline(in, line)) {
+        ++line_no;
+        std::istringstream ls(line);
+        std::string tag;
+        ls >> tag;
+        const std::string where = path + ":" + std::to_string(line_no) + ": ";
+        if (tag == "v") {
+          double x, y, z;
+          if (!(ls >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+            fail(at + "/obj", where + "a vertex needs three finite numbers");
+          positions.insert(positions.end(), {scale * x, scale * y, scale * z});
+        } else if (tag == "f") {
+          std::vector<int32_t> face;
+          std::string token;
+          while (ls >> token) {
+            long v = 0;
+            try {
+              v = std::stol(token.substr(0, token.find('/')));
+            } catch (const std::exception&) {
+              fail(at + "/obj", where + "bad face index '" + token + "'");
+            }
+            const long n = static_cast<long>(positions.size() / 3);
+            if (v < 0) v = n + v + 1;
+            if (v < 1 || v > n) fail(at + "/obj", where + "face index " + token + " out of range");
+            face.push_back(static_cast<int32_t>(v - 1));
+          }
+          if (face.size() != 4) fail(at + "/obj", where + "a panel mesh's faces must be quads (4 vertices)");
+          quads.insert(quads.end(), face.begin(), face.end());
+        }
+      }
+      if (positions.empty() || quads.empty()) fail(at + "/obj", path + " has no quads");
+    }
+    PanelMeshDesc d;
+    d.positions = positions;
+    d.quads = quads;
+    d.thickness = value_or(p, "thickness", d.thickness);
+    d.mass = value_or(p, "mass", d.mass);
+    d.density = value_or(p, "density", d.density);
+    d.damping = value_or(p, "damping", d.damping);
+    d.friction_static = value_or(p, "friction_static", d.friction_static);
+    d.friction_dynamic = value_or(p, "friction_dynamic", d.friction_dynamic);
+    d.slide_compliance = value_or(p, "slide_compliance", d.slide_compliance);
+    const std::string pins = value_or(p, "pins", std::string("none"));
+    d.pins = pins == "top_corners"              ? PanelPins::top_corners
+             : pins == "top_and_bottom_corners" ? PanelPins::top_and_bottom_corners
+                                                : PanelPins::none;
+    d.group = group(p, "group", at);
+    std::vector<bool> had(w.pins().size());
+    for (size_t i = 0; i < w.pins().size(); ++i) had[i] = w.pins()[i].alive;
+    const Id id = guard(at, [&] { return build_panel_mesh(w, d); });
+    name_once(bodies_, meta_.body_names, p["name"], id, at, "body");
+    // The corner pins it made, named <name>.pin0, .pin1, ... in creation order.
+    const std::string base = p["name"].get<std::string>();
+    int k = 0;
+    for (uint32_t i = 0; i < w.pins().size(); ++i)
+      if (w.pins()[i].alive && (i >= had.size() || !had[i]))
+        name_once(pins_, meta_.pin_names, json(base + ".pin" + std::to_string(k++)), Id{i, w.pins()[i].generation}, at,
+                  "pin");
+  }
+
   void pins(World& w, const json& p, const std::string& at) {
     std::vector<int32_t> particles;
     if (p.contains("particle")) {
@@ -824,6 +926,18 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   }
   doc["bodies"] = bodies;
 
+  json panel_meshes = json::array();
+  for (const PanelLayout& l : w.panel_layouts()) {
+    json quads = json::array();
+    for (size_t q = 0; q < l.quads.size(); q += 4)
+      quads.push_back({l.quads[q], l.quads[q + 1], l.quads[q + 2], l.quads[q + 3]});
+    panel_meshes.push_back({{"body", bodies[l.body.index]["name"]},
+                            {"vertex_count", l.vertex_count},
+                            {"quads", quads},
+                            {"thickness", l.thickness}});
+  }
+  if (!panel_meshes.empty()) doc["panel_meshes"] = panel_meshes;
+
   // Added constraints, per group and kind, in projection order; generated ones come from bodies.
   json constraints = json::array();
   for (uint32_t slot : slots) {
@@ -933,6 +1047,35 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   doc["state"] = {
       {"frame", w.report().frame}, {"time", w.report().time}, {"positions", positions}, {"velocities", velocities}};
   return doc.dump(1) + "\n";
+}
+
+Tolerances parse_tolerances(const std::string& text) {
+  Tolerances t;
+  if (text.empty()) return t;
+  const json doc = json::parse(text);
+  t.unit_scale = value_or(doc, "unit_scale", t.unit_scale);
+  auto read = [&](const char* key, Tolerance& out) {
+    if (!doc.contains(key)) return;
+    out.target = doc[key]["target"].get<double>();
+    out.max = doc[key]["max"].get<double>();
+  };
+  read("planarity", t.planarity);
+  read("planarity_distance", t.planarity_distance);
+  read("thickness", t.thickness);
+  read("miter", t.miter);
+  return t;
+}
+
+std::string tolerances_json(const Tolerances& t) {
+  auto one = [](const Tolerance& x) { return json{{"target", x.target}, {"max", x.max}}; };
+  return json{{"format", "embra-tolerances"},
+              {"version", 1},
+              {"unit_scale", t.unit_scale},
+              {"planarity", one(t.planarity)},
+              {"planarity_distance", one(t.planarity_distance)},
+              {"thickness", one(t.thickness)},
+              {"miter", one(t.miter)}}
+      .dump();
 }
 
 void apply_actions(World& w, const SceneMeta& meta, int64_t frame) {

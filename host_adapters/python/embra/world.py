@@ -22,7 +22,8 @@ SHAPES = {"plane": _capi.COLLIDER_PLANE, "sphere": _capi.COLLIDER_SPHERE, "box":
           "capsule": _capi.COLLIDER_CAPSULE, "convex": _capi.COLLIDER_CONVEX, "mesh": _capi.COLLIDER_MESH}
 KINDS = {"distance": _capi.CONSTRAINT_DISTANCE, "edge_angle": _capi.CONSTRAINT_EDGE_ANGLE,
          "dihedral": _capi.CONSTRAINT_DIHEDRAL, "tet_volume": _capi.CONSTRAINT_TET_VOLUME,
-         "weld": _capi.CONSTRAINT_WELD, "tether": _capi.CONSTRAINT_TETHER}
+         "weld": _capi.CONSTRAINT_WELD, "tether": _capi.CONSTRAINT_TETHER,
+         "planarity": _capi.CONSTRAINT_PLANARITY, "plane_offset": _capi.CONSTRAINT_PLANE_OFFSET}
 GENERATE = {"stretch": _capi.GENERATE_STRETCH, "shear": _capi.GENERATE_SHEAR, "bend": _capi.GENERATE_BEND,
             "volume": _capi.GENERATE_VOLUME}
 

@@ -153,4 +153,50 @@ inline ConstraintEval<4> eval_tet_volume(const Vec3& x0, const Vec3& x1, const V
   return e;
 }
 
+/// Signed distance between the diagonals of the quad (x0, x1, x2, x3): the distance from the line
+/// x0-x2 to the line x1-x3 along their common normal n = (x2 - x0) x (x3 - x1), i.e.
+/// C = (x1 - x0) . n / |n|. Zero exactly when the four corners lie in one plane (planarity of a
+/// quad; the field's usual measure of it, in length units). Not valid when the diagonals are
+/// parallel (a collapsed quad).
+inline ConstraintEval<4> eval_quad_planarity(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  ConstraintEval<4> e;
+  const Vec3 d1 = x2 - x0;
+  const Vec3 d2 = x3 - x1;
+  const Vec3 n = d1.cross(d2);
+  const double m = n.norm();
+  if (!(m > 1e-300)) return e;
+  const Vec3 u = n / m;
+  const Vec3 s = x1 - x0;
+  e.value = s.dot(u);
+  // dC = ds . u + (s_perp / m) . dn,  s_perp = s - (s . u) u,  dn = dd1 x d2 + d1 x dd2.
+  const Vec3 q = (s - e.value * u) / m;
+  const Vec3 g_d1 = d2.cross(q);
+  const Vec3 g_d2 = q.cross(d1);
+  e.grad = {-u - g_d1, u - g_d2, g_d1, g_d2};
+  e.valid = true;
+  return e;
+}
+
+/// Signed distance of x0 from the plane through (x1, x2, x3), positive on the side the triangle's
+/// right-hand normal n = (x2 - x1) x (x3 - x1) points to: C = (x0 - x1) . n / |n|. The offset
+/// constraint of a panel's bottom layer: x0 keeps its distance from the plane and may slide along
+/// it. Not valid for a collapsed triangle.
+inline ConstraintEval<4> eval_plane_offset(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  ConstraintEval<4> e;
+  const Vec3 a = x2 - x1;
+  const Vec3 b = x3 - x1;
+  const Vec3 n = a.cross(b);
+  const double m = n.norm();
+  if (!(m > 1e-300)) return e;
+  const Vec3 u = n / m;
+  const Vec3 s = x0 - x1;
+  e.value = s.dot(u);
+  const Vec3 q = (s - e.value * u) / m;
+  const Vec3 g2 = b.cross(q);
+  const Vec3 g3 = q.cross(a);
+  e.grad = {u, -(u + g2 + g3), g2, g3};
+  e.valid = true;
+  return e;
+}
+
 }  // namespace embra

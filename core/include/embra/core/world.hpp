@@ -48,14 +48,16 @@ struct Id {
 
 /// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
 enum class Kind : int32_t {
-  distance = 0,    // |x0 - x1| = rest                          (stretch)
-  edge_angle = 1,  // angle at x0 between x1 - x0 and x2 - x0  (shear)
-  dihedral = 2,    // angle between (x0,x1,x2) and (x1,x0,x3)  (bend)
-  tet_volume = 3,  // signed volume of (x0,x1,x2,x3) = rest
-  weld = 4,        // x0 = x1
-  tether = 5,      // |x0 - x1| <= rest  (long-range attachment, unilateral)
+  distance = 0,      // |x0 - x1| = rest                          (stretch)
+  edge_angle = 1,    // angle at x0 between x1 - x0 and x2 - x0  (shear)
+  dihedral = 2,      // angle between (x0,x1,x2) and (x1,x0,x3)  (bend)
+  tet_volume = 3,    // signed volume of (x0,x1,x2,x3) = rest
+  weld = 4,          // x0 = x1
+  tether = 5,        // |x0 - x1| <= rest  (long-range attachment, unilateral)
+  planarity = 6,     // distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)
+  plane_offset = 7,  // signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)
 };
-constexpr int kKindCount = 6;
+constexpr int kKindCount = 8;
 int arity(Kind kind);
 const char* kind_name(Kind kind);
 
@@ -266,6 +268,16 @@ struct Contact {
   double offset = 0.0;
 };
 
+/// A face contact (panel meshes against sphere colliders): the point of triangle `ids` closest to
+/// the sphere's centre, sum_k b_k x_k with barycentric weights b found again at every projection,
+/// kept `radius` (the sphere's radius plus its thickness) from the centre. Hard and unilateral;
+/// lambda is the accumulated push along the normal.
+struct FaceContact {
+  int32_t ids[3];
+  int32_t collider;
+  double lambda;
+};
+
 struct Group {
   GroupDesc desc;
   uint32_t generation = 0;
@@ -320,6 +332,22 @@ struct Attachment {
 /// distance. Deterministic; cost about that of a Dijkstra search per anchor.
 std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors,
                                                int32_t per_particle);
+
+/// A panel mesh (core/include/embra/core/panels.hpp): a body whose particles are its panels' corners,
+/// 8 per panel in panel order: the top quad's corners 0-3, then the bottom quad's corners 0-3 (the
+/// bottom layer, `thickness` below the top on the side opposite the top's normal). `quads` gives,
+/// per panel, the vertex of the top mesh each corner sits on (counter-clockwise seen from the top's
+/// normal side): corners of different panels on one mesh vertex are welded.
+struct PanelLayout {
+  Id body;
+  int32_t first_particle = 0;
+  int32_t vertex_count = 0;    // vertices of the top mesh
+  std::vector<int32_t> quads;  // 4 mesh vertex indices per panel
+  double thickness = 0.0;      // model units
+  int32_t panel_count() const { return static_cast<int32_t>(quads.size() / 4); }
+  int32_t top(int32_t panel, int corner) const { return first_particle + 8 * panel + corner; }
+  int32_t bottom(int32_t panel, int corner) const { return first_particle + 8 * panel + 4 + corner; }
+};
 
 /// The projection kernels this machine runs: "avx2" (4 constraints at a time), "vec2" (2) or
 /// "scalar". All give the same bits; the environment variable EMBRA_KERNELS forces one.
@@ -376,6 +404,15 @@ class World {
   const Collider& collider(Id id) const;
   size_t collider_count() const;
 
+  // --- panel meshes (panels.hpp builds them) ----------------------------------------------------
+  /// Marks `layout.body` as a panel mesh (layout.first_particle is taken from the body). Refused
+  /// unless the body has exactly 8 particles per panel, the quads index [0, vertex_count) with four
+  /// distinct vertices each, and the thickness is positive and finite; a body has one layout.
+  void set_panel_layout(const PanelLayout& layout);
+  /// The layout of a panel-mesh body, or nullptr if the body is not one.
+  const PanelLayout* panel_layout(Id body) const;
+  const std::vector<PanelLayout>& panel_layouts() const { return panel_layouts_; }
+
   // --- particles -------------------------------------------------------------------------------
   int32_t particle_count() const { return static_cast<int32_t>(x_.size()); }
   const std::vector<Vec3>& positions() const { return x_; }
@@ -409,6 +446,8 @@ class World {
   void move_colliders(double alpha);
   void find_contacts();
   void find_self_contacts();
+  void find_face_contacts();
+  void project_face_contacts();
   void find_shape_contacts(int32_t collider, std::vector<Contact>& out) const;
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
@@ -434,6 +473,7 @@ class World {
   std::vector<int32_t> order_;  // live group slots in projection order
   std::vector<Pin> pins_;
   std::vector<Collider> colliders_;
+  std::vector<PanelLayout> panel_layouts_;
   Id default_group_;
   int64_t serial_ = 0;
   struct TetherCache {  // a body's automatic tethers, kept while its anchors stay the same
@@ -445,6 +485,7 @@ class World {
   bool rest_dirty_ = true;
   bool solver_dirty_ = true;
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
+  std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
                                            // bodies changed: rebuild the solver arrays

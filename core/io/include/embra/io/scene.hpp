@@ -4,6 +4,7 @@
 // actions and the current state) so that loading it again gives the same world, bit for bit.
 #pragma once
 
+#include "embra/core/panels.hpp"
 #include "embra/core/world.hpp"
 
 #include <cstdint>
@@ -54,6 +55,12 @@ std::string save_scene(const World& world, const SceneMeta& meta);
 
 /// Applies the actions' values for `frame` (the frame the next step produces).
 void apply_actions(World& world, const SceneMeta& meta, int64_t frame);
+
+/// Tolerances from a tolerance document's JSON text (valid against tolerances.schema.json; "" or a
+/// missing metric: the defaults of embra::Tolerances).
+Tolerances parse_tolerances(const std::string& text);
+/// A tolerance document (JSON text) holding `t`.
+std::string tolerances_json(const Tolerances& t);
 
 /// The scene schema text compiled into the library.
 std::string_view scene_schema();

@@ -1,0 +1,66 @@
+// POQ panel-mesh drape cost (issue 6): the scene of examples/poq_drape.json (n x n square panels
+// over 3.2 x 3.2, thickness 0.01, top corners pinned and drawn in along x by 10% over 30 frames,
+// a sphere of radius 1 below) built through the core API, with its solver settings (60 substeps x
+// 2 iterations) or the defaults (20 x 1). Times 20 frames of World::step after 40 frames of
+// draping (the mesh folding over the sphere: face contacts active). The 32 x 32 case is the
+// interactive target (under 16 ms per frame is the goal).
+#include "embra/core/panels.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+namespace {
+
+using embra::Vec3;
+
+void drape(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  embra::Settings s;
+  s.substeps = static_cast<int32_t>(state.range(1));
+  s.iterations = static_cast<int32_t>(state.range(2));
+  embra::World w(s);
+  std::vector<double> pos;
+  std::vector<int32_t> quads;
+  embra::panel_grid(n, n, 3.2 / n, Vec3(-1.6, -1.6, 0), pos, quads);
+  embra::PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.thickness = 0.01;
+  d.mass = 16;
+  d.damping = 9;
+  d.pins = embra::PanelPins::top_corners;
+  embra::build_panel_mesh(w, d);
+  embra::ColliderDesc c;
+  c.shape = embra::ColliderShape::sphere;
+  c.radius = 1.0;
+  c.position = Vec3(0.3, 0.2, -1.45);
+  w.create_collider(c);
+  std::vector<embra::Id> pins;
+  std::vector<Vec3> start;
+  for (uint32_t i = 0; i < w.pins().size(); ++i)
+    if (w.pins()[i].alive) {
+      pins.push_back(embra::Id{i, w.pins()[i].generation});
+      start.push_back(w.pins()[i].target);
+    }
+  for (int f = 0; f < 40; ++f) {
+    const double a = f + 1 >= 30 ? 1.0 : (f + 1) / 30.0;
+    for (size_t i = 0; i < pins.size(); ++i)
+      w.set_pin_target(pins[i], Vec3(start[i].x() * (1.0 - 0.1 * a), start[i].y(), start[i].z()));
+    w.step();
+  }
+  for (auto _ : state) w.step();
+  state.counters["particles"] = w.particle_count();
+  state.counters["constraints"] = static_cast<double>(w.constraint_count());
+}
+
+BENCHMARK(drape)
+    ->ArgNames({"n", "substeps", "iterations"})
+    ->Args({4, 60, 2})
+    ->Args({16, 60, 2})
+    ->Args({32, 60, 2})
+    ->Args({32, 20, 1})
+    ->Iterations(20)
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,575 @@
+// Panel meshes (Planar Offset Quads): the builder, the metrics and the cut list. See panels.hpp.
+#include "embra/core/panels.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <utility>
+
+namespace embra {
+
+namespace {
+
+[[noreturn]] void invalid(const std::string& message) {
+  throw Error(ErrorCode::invalid_argument, message);
+}
+
+void check_finite(double v, const char* what) {
+  if (!std::isfinite(v)) invalid(std::string(what) + " must be finite");
+}
+
+void check_non_negative(double v, const char* what) {
+  check_finite(v, what);
+  if (v < 0.0) invalid(std::string(what) + " must be >= 0");
+}
+
+Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 n = (b - a).cross(c - a);
+  const double len = n.norm();
+  return len > 1e-300 ? Vec3(n / len) : Vec3(Vec3::Zero());
+}
+
+/// |distance of p from the plane through a, b, c| (0 for a collapsed triangle).
+double plane_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return std::abs((p - a).dot(unit_normal(a, b, c)));
+}
+
+/// Undirected edge key.
+std::pair<int32_t, int32_t> edge_key(int32_t a, int32_t b) {
+  return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
+}
+
+}  // namespace
+
+// --- metrics -----------------------------------------------------------------------------------------
+
+double quad_planarity(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
+  const double split02 = 1.0 - unit_normal(q0, q1, q2).dot(unit_normal(q0, q2, q3));
+  const double split13 = 1.0 - unit_normal(q1, q2, q3).dot(unit_normal(q1, q3, q0));
+  return std::max({split02, split13, 0.0});
+}
+
+double quad_corner_distance(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
+  return std::max({plane_distance(q3, q0, q1, q2), plane_distance(q0, q1, q2, q3), plane_distance(q1, q2, q3, q0),
+                   plane_distance(q2, q3, q0, q1)});
+}
+
+double quad_diagonal_distance(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
+  const double mean_edge = ((q1 - q0).norm() + (q2 - q1).norm() + (q3 - q2).norm() + (q0 - q3).norm()) / 4.0;
+  const Vec3 n = (q2 - q0).cross(q3 - q1);
+  const double len = n.norm();
+  if (!(len > 1e-300) || !(mean_edge > 0.0)) return 0.0;
+  return std::abs((q1 - q0).dot(n / len)) / mean_edge;
+}
+
+double panel_thickness_error(const Vec3 top[4], const Vec3 bottom[4], double thickness) {
+  double worst = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const int a = (k + 3) % 4, b = (k + 1) % 4;
+    for (int j : {a, k, b}) {
+      worst = std::max(worst, std::abs(plane_distance(bottom[j], top[a], top[k], top[b]) - thickness));
+      worst = std::max(worst, std::abs(plane_distance(top[j], bottom[a], bottom[k], bottom[b]) - thickness));
+    }
+  }
+  return worst;
+}
+
+double miter_twist(const Vec3& top_i, const Vec3& top_j, const Vec3& bottom_i, const Vec3& bottom_j) {
+  return plane_distance(bottom_j, top_i, top_j, bottom_i);
+}
+
+std::vector<PanelJoint> panel_joints(const PanelLayout& layout) {
+  std::map<std::pair<int32_t, int32_t>, size_t> seen;
+  std::vector<PanelJoint> joints;
+  for (int32_t p = 0; p < layout.panel_count(); ++p)
+    for (int k = 0; k < 4; ++k) {
+      const auto key = edge_key(layout.quads[4 * p + k], layout.quads[4 * p + (k + 1) % 4]);
+      auto it = seen.find(key);
+      if (it == seen.end()) {
+        seen.emplace(key, joints.size());
+        joints.push_back(PanelJoint{p, k, -1, -1});
+      } else {
+        joints[it->second].other_panel = p;
+        joints[it->second].other_corner = k;
+      }
+    }
+  return joints;
+}
+
+std::vector<ConicalVertex> conical_vertices(const PanelLayout& layout) {
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> around(layout.vertex_count);
+  for (int32_t p = 0; p < layout.panel_count(); ++p)
+    for (int k = 0; k < 4; ++k) around[layout.quads[4 * p + k]].emplace_back(p, k);
+  std::map<std::pair<int32_t, int32_t>, int> edge_uses;
+  for (int32_t p = 0; p < layout.panel_count(); ++p)
+    for (int k = 0; k < 4; ++k) ++edge_uses[edge_key(layout.quads[4 * p + k], layout.quads[4 * p + (k + 1) % 4])];
+  std::vector<ConicalVertex> out;
+  for (int32_t v = 0; v < layout.vertex_count; ++v) {
+    const auto& faces = around[v];
+    if (faces.size() != 4) continue;
+    bool interior = true;
+    for (const auto& [p, k] : faces) {
+      interior = interior && edge_uses[edge_key(v, layout.quads[4 * p + (k + 1) % 4])] == 2 &&
+                 edge_uses[edge_key(v, layout.quads[4 * p + (k + 3) % 4])] == 2;
+    }
+    if (!interior) continue;
+    // Walk round v: the face after (p, k) is the one in which v's previous corner is p's next corner.
+    ConicalVertex c;
+    c.vertex = v;
+    auto cur = faces[0];
+    bool closed = true;
+    for (int i = 0; i < 4; ++i) {
+      c.panel[i] = cur.first;
+      c.corner[i] = cur.second;
+      const int32_t next = layout.quads[4 * cur.first + (cur.second + 1) % 4];
+      bool found = false;
+      for (const auto& f : faces)
+        if (layout.quads[4 * f.first + (f.second + 3) % 4] == next) {
+          cur = f;
+          found = true;
+          break;
+        }
+      closed = closed && found;
+    }
+    if (closed && cur == faces[0]) out.push_back(c);
+  }
+  return out;
+}
+
+PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
+  PanelErrors e;
+  const int32_t n = layout.panel_count();
+  for (int32_t p = 0; p < n; ++p) {
+    Vec3 t[4], b[4];
+    for (int k = 0; k < 4; ++k) {
+      t[k] = x[layout.top(p, k)];
+      b[k] = x[layout.bottom(p, k)];
+    }
+    e.planarity_top.push_back(quad_planarity(t[0], t[1], t[2], t[3]));
+    e.planarity_bottom.push_back(quad_planarity(b[0], b[1], b[2], b[3]));
+    e.corner_distance_top.push_back(quad_corner_distance(t[0], t[1], t[2], t[3]));
+    e.corner_distance_bottom.push_back(quad_corner_distance(b[0], b[1], b[2], b[3]));
+    e.diagonal_top.push_back(quad_diagonal_distance(t[0], t[1], t[2], t[3]));
+    e.diagonal_bottom.push_back(quad_diagonal_distance(b[0], b[1], b[2], b[3]));
+    e.thickness.push_back(panel_thickness_error(t, b, layout.thickness));
+  }
+  for (const PanelJoint& j : panel_joints(layout)) {
+    const int k = j.corner, k1 = (j.corner + 1) % 4;
+    e.miter.push_back(miter_twist(x[layout.top(j.panel, k)], x[layout.top(j.panel, k1)], x[layout.bottom(j.panel, k)],
+                                  x[layout.bottom(j.panel, k1)]));
+  }
+  for (const ConicalVertex& c : conical_vertices(layout)) {
+    double a[4];
+    for (int i = 0; i < 4; ++i) {
+      const int32_t p = c.panel[i];
+      const int k = c.corner[i];
+      const Vec3 v = x[layout.top(p, k)];
+      const Vec3 u = x[layout.top(p, (k + 1) % 4)] - v, w = x[layout.top(p, (k + 3) % 4)] - v;
+      a[i] = std::atan2(u.cross(w).norm(), u.dot(w));
+    }
+    e.conical.push_back(std::abs((a[0] + a[2]) - (a[1] + a[3])));
+  }
+  return e;
+}
+
+MetricSummary summarize(std::span<const double> values, const Tolerance& tolerance) {
+  MetricSummary s;
+  double sq = 0.0;
+  for (double v : values) {
+    s.max = std::max(s.max, v);
+    sq += v * v;
+    ++s.count;
+    if (v <= tolerance.target)
+      ++s.within_target;
+    else if (v <= tolerance.max)
+      ++s.within_max;
+    else
+      ++s.above_max;
+  }
+  s.rms = s.count > 0 ? std::sqrt(sq / static_cast<double>(s.count)) : 0.0;
+  return s;
+}
+
+PanelReport report_panels(const PanelErrors& e, const Tolerances& t) {
+  PanelReport r;
+  const Tolerance none{0.0, 0.0};
+  r.planarity_top = summarize(e.planarity_top, t.planarity);
+  r.planarity_bottom = summarize(e.planarity_bottom, t.planarity);
+  r.corner_distance_top = summarize(e.corner_distance_top, t.planarity_distance);
+  r.corner_distance_bottom = summarize(e.corner_distance_bottom, t.planarity_distance);
+  r.diagonal_top = summarize(e.diagonal_top, none);
+  r.diagonal_bottom = summarize(e.diagonal_bottom, none);
+  r.thickness = summarize(e.thickness, t.thickness);
+  r.miter = summarize(e.miter, t.miter);
+  r.conical = summarize(e.conical, none);
+  r.within_tolerance = r.planarity_top.max <= t.planarity.target && r.planarity_bottom.max <= t.planarity.target &&
+                       r.corner_distance_top.max <= t.planarity_distance.target &&
+                       r.corner_distance_bottom.max <= t.planarity_distance.target &&
+                       r.thickness.max <= t.thickness.target && r.miter.max <= t.miter.target;
+  return r;
+}
+
+std::vector<double> vertex_errors(const PanelLayout& layout, const PanelErrors& e, PanelMetric metric) {
+  const int32_t n = layout.panel_count();
+  std::vector<double> out(static_cast<size_t>(8) * n, 0.0);
+  auto raise = [&](int32_t particle, double v) {
+    double& slot = out[particle - layout.first_particle];
+    slot = std::max(slot, v);
+  };
+  switch (metric) {
+    case PanelMetric::planarity:
+    case PanelMetric::corner_distance: {
+      const bool pl = metric == PanelMetric::planarity;
+      for (int32_t p = 0; p < n; ++p)
+        for (int k = 0; k < 4; ++k) {
+          raise(layout.top(p, k), pl ? e.planarity_top[p] : e.corner_distance_top[p]);
+          raise(layout.bottom(p, k), pl ? e.planarity_bottom[p] : e.corner_distance_bottom[p]);
+        }
+      break;
+    }
+    case PanelMetric::thickness:
+      for (int32_t p = 0; p < n; ++p)
+        for (int k = 0; k < 4; ++k) {
+          raise(layout.top(p, k), e.thickness[p]);
+          raise(layout.bottom(p, k), e.thickness[p]);
+        }
+      break;
+    case PanelMetric::miter: {
+      const std::vector<PanelJoint> joints = panel_joints(layout);
+      for (size_t j = 0; j < joints.size(); ++j) {
+        const PanelJoint& jt = joints[j];
+        for (int side = 0; side < (jt.other_panel >= 0 ? 2 : 1); ++side) {
+          const int32_t p = side == 0 ? jt.panel : jt.other_panel;
+          const int32_t k = side == 0 ? jt.corner : jt.other_corner;
+          for (int c : {k, (k + 1) % 4}) {
+            raise(layout.top(p, c), e.miter[j]);
+            raise(layout.bottom(p, c), e.miter[j]);
+          }
+        }
+      }
+      break;
+    }
+    case PanelMetric::conical: {
+      const std::vector<ConicalVertex> cv = conical_vertices(layout);
+      for (size_t i = 0; i < cv.size(); ++i)
+        for (int f = 0; f < 4; ++f) {
+          raise(layout.top(cv[i].panel[f], cv[i].corner[f]), e.conical[i]);
+          raise(layout.bottom(cv[i].panel[f], cv[i].corner[f]), e.conical[i]);
+        }
+      break;
+    }
+  }
+  return out;
+}
+
+// --- cut list ------------------------------------------------------------------------------------------
+
+std::vector<PanelCut> panel_cuts(const PanelLayout& layout, std::span<const Vec3> x) {
+  std::vector<PanelCut> cuts;
+  for (int32_t p = 0; p < layout.panel_count(); ++p) {
+    Vec3 t[4], b[4];
+    for (int k = 0; k < 4; ++k) {
+      t[k] = x[layout.top(p, k)];
+      b[k] = x[layout.bottom(p, k)];
+    }
+    const Vec3 ex = (t[1] - t[0]).normalized();
+    const Vec3 ez = (t[2] - t[0]).cross(t[3] - t[1]).normalized();
+    const Vec3 ey = ez.cross(ex);
+    PanelCut c{};
+    double z = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      c.top[k][0] = (t[k] - t[0]).dot(ex);
+      c.top[k][1] = (t[k] - t[0]).dot(ey);
+      c.bottom[k][0] = (b[k] - t[0]).dot(ex);
+      c.bottom[k][1] = (b[k] - t[0]).dot(ey);
+      z += (b[k] - t[0]).dot(ez) / 4.0;
+    }
+    c.bottom_z = z;
+    c.thickness = layout.thickness;
+    for (int k = 0; k < 4; ++k) {
+      const int k1 = (k + 1) % 4;
+      const Vec3 e = (t[k1] - t[k]).normalized();
+      Vec3 u = ((b[k] - t[k]) + (b[k1] - t[k1])) / 2.0;
+      u -= u.dot(e) * e;
+      const Vec3 outward = e.cross(ez);
+      c.miter_deg[k] = std::atan2(u.dot(outward), -u.dot(ez)) * 180.0 / std::numbers::pi;
+    }
+    cuts.push_back(c);
+  }
+  return cuts;
+}
+
+namespace {
+std::string fmt(double v) {
+  char s[40];
+  std::snprintf(s, sizeof s, "%.9g", v);
+  return s;
+}
+}  // namespace
+
+std::string panel_cuts_json(const std::vector<PanelCut>& cuts) {
+  std::string s = "{\"format\": \"embra-panel-cuts\", \"version\": 1, \"panels\": [";
+  for (size_t p = 0; p < cuts.size(); ++p) {
+    const PanelCut& c = cuts[p];
+    s += p ? ",\n  " : "\n  ";
+    s += "{\"panel\": " + std::to_string(p) + ", \"thickness\": " + fmt(c.thickness) +
+         ", \"bottom_z\": " + fmt(c.bottom_z) + ", \"top\": [";
+    for (int k = 0; k < 4; ++k)
+      s += std::string(k ? ", " : "") + "[" + fmt(c.top[k][0]) + ", " + fmt(c.top[k][1]) + "]";
+    s += "], \"bottom\": [";
+    for (int k = 0; k < 4; ++k)
+      s += std::string(k ? ", " : "") + "[" + fmt(c.bottom[k][0]) + ", " + fmt(c.bottom[k][1]) + "]";
+    s += "], \"miter_deg\": [";
+    for (int k = 0; k < 4; ++k) s += std::string(k ? ", " : "") + fmt(c.miter_deg[k]);
+    s += "]}";
+  }
+  s += "\n]}\n";
+  return s;
+}
+
+std::string panel_cuts_csv(const std::vector<PanelCut>& cuts) {
+  std::string s = "panel,thickness,bottom_z";
+  for (const char* layer : {"top", "bottom"})
+    for (int k = 0; k < 4; ++k)
+      s += std::string(",") + layer + std::to_string(k) + "_x," + layer + std::to_string(k) + "_y";
+  for (int k = 0; k < 4; ++k) s += ",miter" + std::to_string(k) + "_deg";
+  s += "\n";
+  for (size_t p = 0; p < cuts.size(); ++p) {
+    const PanelCut& c = cuts[p];
+    s += std::to_string(p) + "," + fmt(c.thickness) + "," + fmt(c.bottom_z);
+    for (int k = 0; k < 4; ++k) s += "," + fmt(c.top[k][0]) + "," + fmt(c.top[k][1]);
+    for (int k = 0; k < 4; ++k) s += "," + fmt(c.bottom[k][0]) + "," + fmt(c.bottom[k][1]);
+    for (int k = 0; k < 4; ++k) s += "," + fmt(c.miter_deg[k]);
+    s += "\n";
+  }
+  return s;
+}
+
+// --- builder -------------------------------------------------------------------------------------------
+
+void panel_grid(int32_t n, int32_t m, double size, const Vec3& origin, std::vector<double>& out_positions,
+                std::vector<int32_t>& out_quads) {
+  if (n < 1 || m < 1 || n > 4096 || m > 4096) invalid("panel grid must have 1 to 4096 panels each way");
+  check_finite(size, "panel size");
+  if (!(size > 0.0)) invalid("panel size must be > 0");
+  for (int c = 0; c < 3; ++c) check_finite(origin[c], "panel grid origin");
+  out_positions.clear();
+  out_quads.clear();
+  for (int32_t j = 0; j <= m; ++j)
+    for (int32_t i = 0; i <= n; ++i)
+      out_positions.insert(out_positions.end(), {origin.x() + i * size, origin.y() + j * size, origin.z()});
+  for (int32_t j = 0; j < m; ++j)
+    for (int32_t i = 0; i < n; ++i) {
+      const int32_t v = j * (n + 1) + i;
+      out_quads.insert(out_quads.end(), {v, v + 1, v + n + 2, v + n + 1});
+    }
+}
+
+Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
+  // --- check everything first ---
+  if (d.positions.empty() || d.positions.size() % 3 != 0)
+    invalid("panel mesh positions must be a non-empty array of 3 numbers per vertex");
+  if (d.quads.empty() || d.quads.size() % 4 != 0)
+    invalid("panel mesh quads must be a non-empty array of 4 indices per quad");
+  const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
+  const int64_t np = static_cast<int64_t>(d.quads.size() / 4);
+  if (8 * np + world.particle_count() > INT32_MAX / 4) invalid("too many panels");
+  for (double c : d.positions) check_finite(c, "panel mesh vertex coordinate");
+  check_finite(d.thickness, "panel thickness");
+  if (!(d.thickness > 0.0)) invalid("panel thickness must be > 0");
+  check_non_negative(d.mass, "panel mesh mass");
+  check_non_negative(d.density, "panel mesh density");
+  if (d.mass == 0.0 && d.density == 0.0) invalid("panel mesh needs a mass or a density > 0");
+  check_non_negative(d.damping, "panel mesh damping");
+  check_non_negative(d.friction_static, "panel mesh friction_static");
+  check_non_negative(d.friction_dynamic, "panel mesh friction_dynamic");
+  check_non_negative(d.slide_compliance, "panel mesh slide_compliance");
+  const int32_t pins = static_cast<int32_t>(d.pins);
+  if (pins < 0 || pins > 2) invalid("panel mesh pins must be 0 (none), 1 (top corners) or 2 (top and bottom corners)");
+  if (!d.group.is_null()) world.group(d.group);  // throws for a stale group
+  auto P = [&](int32_t v) { return Vec3(d.positions[3 * v], d.positions[3 * v + 1], d.positions[3 * v + 2]); };
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  std::map<std::pair<int32_t, int32_t>, int> undirected;
+  for (int64_t q = 0; q < np; ++q) {
+    const int32_t* v = &d.quads[4 * q];
+    const std::string name = "quad " + std::to_string(q);
+    for (int k = 0; k < 4; ++k) {
+      if (v[k] < 0 || v[k] >= nv)
+        invalid(name + " vertex " + std::to_string(v[k]) + " is outside [0, " + std::to_string(nv) + ")");
+      for (int j = 0; j < k; ++j)
+        if (v[j] == v[k]) invalid(name + " is degenerate: vertex " + std::to_string(v[k]) + " appears twice");
+    }
+    for (int k = 0; k < 4; ++k) {
+      const int32_t a = v[k], b = v[(k + 1) % 4];
+      if (++directed[{a, b}] > 1)
+        invalid(name + ": edge " + std::to_string(a) + "-" + std::to_string(b) +
+                " is used twice in the same direction (quads must be oriented consistently)");
+      if (++undirected[edge_key(a, b)] > 2)
+        invalid(name + ": edge " + std::to_string(a) + "-" + std::to_string(b) + " is shared by more than two quads");
+    }
+    const Vec3 q0 = P(v[0]), q1 = P(v[1]), q2 = P(v[2]), q3 = P(v[3]);
+    const double mean_edge = ((q1 - q0).norm() + (q2 - q1).norm() + (q3 - q2).norm() + (q0 - q3).norm()) / 4.0;
+    const Vec3 n = (q2 - q0).cross(q3 - q1);
+    if (!(mean_edge > 0.0) || !(n.norm() > 1e-12 * mean_edge * mean_edge))
+      invalid(name + " is degenerate: its diagonals are parallel (zero area)");
+    for (int k = 0; k < 4; ++k)
+      if (!((P(v[(k + 1) % 4]) - P(v[k])).norm() > 1e-9 * mean_edge))
+        invalid(name + " is degenerate: an edge has zero length");
+    const double apart = quad_diagonal_distance(q0, q1, q2, q3);
+    if (apart > 1e-6)
+      invalid(name + " is not planar (diagonals " + std::to_string(apart * mean_edge) +
+              " apart): a panel starts planar");
+  }
+
+  // --- bottom layer: each vertex offset to where its faces' offset planes meet ---
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> around(nv);
+  std::vector<Vec3> face_normal(np);
+  std::vector<double> area(np);
+  for (int64_t q = 0; q < np; ++q) {
+    const int32_t* v = &d.quads[4 * q];
+    const Vec3 n = (P(v[2]) - P(v[0])).cross(P(v[3]) - P(v[1]));
+    area[q] = 0.5 * n.norm();
+    face_normal[q] = n.normalized();
+    for (int k = 0; k < 4; ++k) around[v[k]].emplace_back(static_cast<int32_t>(q), k);
+  }
+  std::vector<Vec3> offset(nv, Vec3::Zero());  // bottom - top per mesh vertex
+  for (int64_t v = 0; v < nv; ++v) {
+    if (around[v].empty()) continue;
+    // n_f . y = -thickness for every face f, in the least-squares sense; where the faces do not
+    // decide y (a flat vertex, a boundary) the point nearest -thickness * (mean normal) is taken:
+    // y = y0 + N^+ (r - N y0), with the pseudo-inverse of the stacked normals N.
+    const Eigen::Index m = static_cast<Eigen::Index>(around[v].size());
+    Eigen::MatrixXd normals(m, 3);
+    Vec3 mean = Vec3::Zero();
+    for (Eigen::Index f = 0; f < m; ++f) {
+      normals.row(f) = face_normal[around[v][f].first].transpose();
+      mean += face_normal[around[v][f].first];
+    }
+    const Vec3 y0 = -d.thickness * mean.normalized();
+    const Eigen::VectorXd r = Eigen::VectorXd::Constant(m, -d.thickness) - normals * y0;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normals, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    svd.setThreshold(1e-9);
+    offset[v] = y0 + svd.solve(r);
+  }
+
+  // --- particles ---
+  std::vector<double> xyz;
+  xyz.reserve(static_cast<size_t>(24 * np));
+  double total_area = 0.0;
+  for (double s : area) total_area += s;
+  std::vector<double> masses;
+  std::vector<int32_t> triangles;
+  for (int64_t q = 0; q < np; ++q) {
+    const int32_t* v = &d.quads[4 * q];
+    for (int k = 0; k < 4; ++k) xyz.insert(xyz.end(), {P(v[k]).x(), P(v[k]).y(), P(v[k]).z()});
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 b = P(v[k]) + offset[v[k]];
+      xyz.insert(xyz.end(), {b.x(), b.y(), b.z()});
+    }
+    const double m = d.mass > 0.0 ? d.mass * area[q] / total_area : d.density * area[q];
+    for (int k = 0; k < 8; ++k) masses.push_back(m / 8.0);
+    const int32_t o = static_cast<int32_t>(8 * q);
+    triangles.insert(triangles.end(), {o, o + 1, o + 2, o, o + 2, o + 3});
+    triangles.insert(triangles.end(), {o + 4, o + 6, o + 5, o + 4, o + 7, o + 6});
+  }
+  BodyDesc body;
+  body.positions = xyz;
+  body.masses = masses;
+  body.triangles = triangles;
+  body.generate = 0;
+  body.material.damping = d.damping;
+  body.material.friction_static = d.friction_static;
+  body.material.friction_dynamic = d.friction_dynamic;
+  body.material.bend_compliance = 0.0;
+  const Id id = world.create_body(body);
+  const int32_t first = world.body(id).first_particle;
+  PanelLayout layout;
+  layout.body = id;
+  layout.first_particle = first;
+  layout.vertex_count = static_cast<int32_t>(nv);
+  layout.quads.assign(d.quads.begin(), d.quads.end());
+  layout.thickness = d.thickness;
+
+  // --- constraints ---
+  auto add = [&](Kind kind, const std::vector<int32_t>& ids, const std::vector<double>& rest, double compliance) {
+    if (ids.empty()) return;
+    ConstraintDesc c;
+    c.kind = kind;
+    c.group = d.group;
+    c.particles = ids;
+    c.rest = rest;
+    c.uniform_compliance = compliance;
+    world.add_constraints(c);
+  };
+  const std::vector<Vec3>& x = world.positions();
+  std::vector<int32_t> ids;
+  std::vector<double> rest;
+  // (a) the top quad braced: 4 edges and 2 diagonals.
+  for (int32_t p = 0; p < np; ++p)
+    for (auto [i, j] : {std::pair{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}}) {
+      ids.insert(ids.end(), {layout.top(p, i), layout.top(p, j)});
+      rest.push_back((x[layout.top(p, i)] - x[layout.top(p, j)]).norm());
+    }
+  add(Kind::distance, ids, rest, 0.0);
+  // (b) welds at shared vertices, top and bottom.
+  ids.clear();
+  for (int64_t v = 0; v < nv; ++v)
+    for (size_t f = 1; f < around[v].size(); ++f) {
+      const auto [p0, k0] = around[v][0];
+      const auto [p, k] = around[v][f];
+      ids.insert(ids.end(), {layout.top(p0, k0), layout.top(p, k)});
+      ids.insert(ids.end(), {layout.bottom(p0, k0), layout.bottom(p, k)});
+    }
+  add(Kind::weld, ids, std::vector<double>(ids.size() / 2, 0.0), 0.0);
+  // Planarity: the top quad, and every joint (miter face).
+  ids.clear();
+  for (int32_t p = 0; p < np; ++p)
+    ids.insert(ids.end(), {layout.top(p, 0), layout.top(p, 1), layout.top(p, 2), layout.top(p, 3)});
+  for (const PanelJoint& j : panel_joints(layout)) {
+    const int k = j.corner, k1 = (j.corner + 1) % 4;
+    ids.insert(ids.end(), {layout.top(j.panel, k), layout.top(j.panel, k1), layout.bottom(j.panel, k1),
+                           layout.bottom(j.panel, k)});
+  }
+  add(Kind::planarity, ids, std::vector<double>(ids.size() / 4, 0.0), 0.0);
+  // (d) each bottom corner at -thickness from the plane of its top corner's triangle.
+  ids.clear();
+  for (int32_t p = 0; p < np; ++p)
+    for (int k = 0; k < 4; ++k)
+      ids.insert(ids.end(),
+                 {layout.bottom(p, k), layout.top(p, k), layout.top(p, (k + 1) % 4), layout.top(p, (k + 3) % 4)});
+  add(Kind::plane_offset, ids, std::vector<double>(ids.size() / 4, -d.thickness), 0.0);
+  // The soft hold of each bottom corner near its top corner.
+  if (d.slide_compliance > 0.0) {
+    ids.clear();
+    rest.clear();
+    for (int32_t p = 0; p < np; ++p)
+      for (int k = 0; k < 4; ++k) {
+        ids.insert(ids.end(), {layout.bottom(p, k), layout.top(p, k)});
+        rest.push_back((x[layout.bottom(p, k)] - x[layout.top(p, k)]).norm());
+      }
+    add(Kind::distance, ids, rest, d.slide_compliance);
+  }
+  // Pins at the mesh's corners (vertices of one panel).
+  if (d.pins != PanelPins::none)
+    for (int64_t v = 0; v < nv; ++v) {
+      if (around[v].size() != 1) continue;
+      const auto [p, k] = around[v][0];
+      PinDesc pin;
+      pin.particle = layout.top(p, k);
+      pin.target = x[pin.particle];
+      world.create_pin(pin);
+      if (d.pins == PanelPins::top_and_bottom_corners) {
+        pin.particle = layout.bottom(p, k);
+        pin.target = x[pin.particle];
+        world.create_pin(pin);
+      }
+    }
+  world.set_panel_layout(layout);
+  return id;
+}
+
+}  // namespace embra

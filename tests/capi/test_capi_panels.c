@@ -1,0 +1,244 @@
+/* The paper's section 4.1 experiment through the C ABI: examples/poq_drape.json (4 x 4 panels of 0.8,
+ * thickness 0.01, top corners pinned, gravity, a sphere of radius 1 below, moved between frames 120
+ * and 180), with the thresholds the issue sets:
+ *   - settled (no particle faster than 1 mm/s) from frame 100 on until the sphere moves (120), with
+ *     max thickness error <= 0.00005, max planarity <= 1e-6 on top and bottom, max miter twist
+ *     <= 0.001 at frame 100;
+ *   - every metric within tolerance again within 30 frames of the sphere stopping (frame 210) and
+ *     to the end;
+ *   - no panel face inside the sphere at any frame, measured here per triangle from positions alone
+ *     (closest point of each top and bottom triangle to the centre), with a rounding allowance of
+ *     1e-6.
+ * The metrics embra reports are also recomputed here from the positions (planarity of each panel's
+ * top and bottom quads, both diagonal splits) so the numbers do not rest on the library's own code.
+ *
+ * usage: test_capi_panels EXAMPLES_DIR */
+#include "capi_test.h"
+
+#include <stdlib.h>
+
+typedef struct vec {
+  double x, y, z;
+} vec;
+static vec at(const double* p, int32_t i) {
+  vec v = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+  return v;
+}
+static vec sub(vec a, vec b) {
+  vec v = {a.x - b.x, a.y - b.y, a.z - b.z};
+  return v;
+}
+static vec add(vec a, vec b) {
+  vec v = {a.x + b.x, a.y + b.y, a.z + b.z};
+  return v;
+}
+static vec mul(double s, vec a) {
+  vec v = {s * a.x, s * a.y, s * a.z};
+  return v;
+}
+static double dot(vec a, vec b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+static vec cross(vec a, vec b) {
+  vec v = {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  return v;
+}
+static vec unit(vec a) {
+  return mul(1.0 / sqrt(dot(a, a)), a);
+}
+
+/* 1 - n1.n2 over both diagonal splits of quad (a, b, c, d). */
+static double planarity(vec a, vec b, vec c, vec d) {
+  const double s02 = 1.0 - dot(unit(cross(sub(b, a), sub(c, a))), unit(cross(sub(c, a), sub(d, a))));
+  const double s13 = 1.0 - dot(unit(cross(sub(c, b), sub(d, b))), unit(cross(sub(d, b), sub(a, b))));
+  return s02 > s13 ? s02 : s13;
+}
+
+/* Distance from p to triangle (a, b, c): the minimum over the face interior (if the projection falls
+ * inside) and the three edges. */
+static double segment_distance(vec p, vec a, vec b) {
+  const vec ab = sub(b, a);
+  double t = dot(sub(p, a), ab) / dot(ab, ab);
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  const vec d = sub(p, add(a, mul(t, ab)));
+  return sqrt(dot(d, d));
+}
+static double triangle_distance(vec p, vec a, vec b, vec c) {
+  const vec n = unit(cross(sub(b, a), sub(c, a)));
+  const double h = dot(sub(p, a), n);
+  const vec q = sub(p, mul(h, n));
+  const int inside = dot(cross(sub(b, a), sub(q, a)), n) >= 0 && dot(cross(sub(c, b), sub(q, b)), n) >= 0 &&
+                     dot(cross(sub(a, c), sub(q, c)), n) >= 0;
+  double best = inside ? fabs(h) : 1e300;
+  const double e[3] = {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)};
+  for (int k = 0; k < 3; ++k)
+    if (e[k] < best) best = e[k];
+  return best;
+}
+
+static void test_drape(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/poq_drape.json", dir);
+  embra_world* w = NULL;
+  CHECK_OK(embra_world_load_file(&w, path));
+  if (w == NULL) return;
+  const embra_body_id body = {0, 1};
+  int32_t panels = 0, first = 0, count = 0;
+  CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
+  CHECK_INT(panels, 16);
+  CHECK_OK(embra_body_get_particles(w, body, &first, &count));
+  embra_tolerances tol;
+  CHECK_OK(embra_world_get_tolerances(w, &tol));
+  CHECK_NEAR(tol.unit_scale, 1250.0, 0.0);
+  CHECK_NEAR(tol.thickness.target, 5e-5, 0.0);
+  double* x = malloc(sizeof(double) * 3 * (size_t)count);
+  if (!CHECK(x != NULL)) return;
+  const double radius = 1.0;
+  double worst_inside = 0.0;
+  int settled_from = -1, back_from = -1;
+  embra_panel_metrics at100;
+  memset(&at100, 0, sizeof at100);
+  for (int f = 1; f <= 300; ++f) {
+    const embra_status st = embra_world_step(w);
+    CHECK_OK(st);
+    if (st != EMBRA_OK) break;
+    embra_step_report r;
+    embra_panel_metrics m;
+    CHECK_OK(embra_world_get_report(w, &r));
+    CHECK_OK(embra_panel_mesh_get_metrics(w, body, NULL, &m));
+    CHECK_OK(embra_world_get_positions(w, x, 3 * (int64_t)count, first, count));
+    if (f <= 120) {
+      if (r.settled && settled_from < 0) settled_from = f;
+      if (!r.settled) settled_from = -1;
+    }
+    if (f == 100) at100 = m;
+    if (f >= 180) {
+      if (m.within_tolerance && back_from < 0) back_from = f;
+      if (!m.within_tolerance) back_from = -1;
+    }
+    /* The sphere's centre from the scene's path: (0.3, 0.2, -1.45) until frame 120, straight to
+     * (-0.3, 0.2, -1.35) at 180, held after. */
+    const double s = f <= 120 ? 0.0 : f >= 180 ? 1.0 : (f - 120) / 60.0;
+    const vec centre = {0.3 - 0.6 * s, 0.2, -1.45 + 0.1 * s};
+    double own_planarity = 0.0;
+    for (int32_t p = 0; p < panels; ++p) {
+      for (int layer = 0; layer < 2; ++layer) {
+        const int32_t o = 8 * p + 4 * layer;
+        const vec q0 = at(x, o), q1 = at(x, o + 1), q2 = at(x, o + 2), q3 = at(x, o + 3);
+        const double pl = planarity(q0, q1, q2, q3);
+        if (pl > own_planarity) own_planarity = pl;
+        const double d1 = radius - triangle_distance(centre, q0, q1, q2);
+        const double d2 = radius - triangle_distance(centre, q0, q2, q3);
+        if (d1 > worst_inside) worst_inside = d1;
+        if (d2 > worst_inside) worst_inside = d2;
+      }
+    }
+    const double reported = m.planarity_top.max > m.planarity_bottom.max ? m.planarity_top.max : m.planarity_bottom.max;
+    CAPI_CONTEXT("frame %d", f);
+    CHECK_NEAR(own_planarity, reported, 1e-15);
+  }
+  CAPI_CONTEXT("%s", "");
+  printf(
+      "drape: settled from frame %d; at frame 100 thickness %.3e, planarity %.3e / %.3e, miter %.3e; "
+      "within tolerance again from frame %d; deepest face inside the sphere %.3e\n",
+      settled_from, at100.thickness.max, at100.planarity_top.max, at100.planarity_bottom.max, at100.miter.max,
+      back_from, worst_inside);
+  CHECK(settled_from > 0 && settled_from <= 100);
+  CHECK(at100.thickness.max <= 5e-5);
+  CHECK(at100.planarity_top.max <= 1e-6);
+  CHECK(at100.planarity_bottom.max <= 1e-6);
+  CHECK(at100.miter.max <= 1e-3);
+  CHECK(back_from > 0 && back_from <= 210);
+  CHECK(worst_inside <= 1e-6);
+  /* Per-vertex fields: one value per particle, none above the reported max. */
+  double field[128];
+  int64_t n = 0;
+  CHECK_OK(embra_panel_mesh_get_vertex_errors(w, body, EMBRA_PANEL_METRIC_MITER, field, 128, &n));
+  CHECK_INT(n, 128);
+  embra_panel_metrics m;
+  CHECK_OK(embra_panel_mesh_get_metrics(w, body, NULL, &m));
+  double top = 0.0;
+  for (int i = 0; i < 128; ++i)
+    if (field[i] > top) top = field[i];
+  CHECK_NEAR(top, m.miter.max, 0.0);
+  /* Cut list: JSON through the two-call pattern. */
+  int64_t len = 0;
+  CHECK_OK(embra_panel_mesh_export_cuts(w, body, EMBRA_CUTS_JSON, NULL, 0, &len));
+  CHECK(len > 100);
+  char small[8];
+  CHECK_STATUS(embra_panel_mesh_export_cuts(w, body, EMBRA_CUTS_JSON, small, 8, &len), EMBRA_ERROR_BUFFER_TOO_SMALL);
+  CHECK_STATUS(embra_panel_mesh_export_cuts(w, body, 7, NULL, 0, &len), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_panel_mesh_get_vertex_errors(w, body, 9, NULL, 0, &n), EMBRA_ERROR_INVALID_ARGUMENT);
+  free(x);
+  embra_world_destroy(w);
+}
+
+/* The builder through the C ABI: a grid, and refused calls that create nothing. */
+static void test_create(void) {
+  embra_world* w = NULL;
+  CHECK_OK(embra_world_create(&w, NULL));
+  embra_panel_mesh_def d = embra_default_panel_mesh_def();
+  embra_body_id body;
+  int32_t first = -1;
+  embra_world_counts c;
+  d.thickness = -1.0;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
+  d = embra_default_panel_mesh_def();
+  d.version = 99;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_VERSION);
+  d = embra_default_panel_mesh_def();
+  d.panel_size = NAN;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
+  d = embra_default_panel_mesh_def();
+  d.vertex_count = 4;
+  d.quad_count = 1;
+  d.positions = NULL;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_OK(embra_world_get_counts(w, &c));
+  CHECK_INT(c.particles, 0);
+  CHECK_INT(c.bodies, 0);
+  d = embra_default_panel_mesh_def();
+  d.grid_columns = 2;
+  d.grid_rows = 3;
+  d.pins = EMBRA_PANEL_PINS_TOP_AND_BOTTOM_CORNERS;
+  CHECK_OK(embra_panel_mesh_create(w, &d, &body, &first));
+  CHECK_OK(embra_world_get_counts(w, &c));
+  CHECK_INT(c.particles, 48);
+  CHECK_INT(c.pins, 8);
+  embra_panel_metrics m;
+  CHECK_OK(embra_panel_mesh_get_metrics(w, body, NULL, &m));
+  CHECK_INT(m.within_tolerance, 1);
+  CHECK_INT((int)m.miter.count, 2 * 4 + 3 * 3);
+  embra_tolerances t = embra_default_tolerances();
+  t.thickness.target = 2.0;
+  CHECK_STATUS(embra_world_set_tolerances(w, &t), EMBRA_ERROR_INVALID_ARGUMENT); /* target above max */
+  t = embra_default_tolerances();
+  t.miter.target = 0.5;
+  t.miter.max = 1.0;
+  CHECK_OK(embra_world_set_tolerances(w, &t));
+  embra_tolerances back;
+  CHECK_OK(embra_world_get_tolerances(w, &back));
+  CHECK_NEAR(back.miter.target, 0.5, 0.0);
+  embra_body_id not_panels;
+  embra_body_def bd = embra_default_body_def();
+  const double tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const int32_t idx[3] = {0, 1, 2};
+  bd.vertex_count = 3;
+  bd.positions = tri;
+  bd.triangle_count = 1;
+  bd.triangles = idx;
+  CHECK_OK(embra_body_create(w, &bd, &not_panels, NULL));
+  CHECK_STATUS(embra_panel_mesh_get_metrics(w, not_panels, NULL, &m), EMBRA_ERROR_INVALID_ARGUMENT);
+  embra_world_destroy(w);
+}
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    fprintf(stderr, "usage: test_capi_panels EXAMPLES_DIR\n");
+    return 2;
+  }
+  RUN(test_create);
+  capi_test_name = "test_drape";
+  test_drape(argv[1]);
+  return capi_test_finish();
+}

@@ -1,0 +1,227 @@
+// Panel meshes (Planar Offset Quads): the fabrication metrics on hand-checked cases, and the builder
+// on a flat grid and on a known conical mesh.
+//
+// The metrics are checked here against values worked out by hand from the paper's definitions
+// (section 4.1), on positions written out in the test, not produced by the solver.
+#include "embra/core/panels.hpp"
+
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace embra {
+namespace {
+
+// A unit square in z = 0, counter-clockwise seen from +z:   q3 (0,1) --- q2 (1,1)
+//                                                            |              |
+//                                                           q0 (0,0) --- q1 (1,0)
+const Vec3 kSquare[4] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+
+TEST(PanelMetrics, FlatPanelReadsZero) {
+  EXPECT_EQ(quad_planarity(kSquare[0], kSquare[1], kSquare[2], kSquare[3]), 0.0);
+  EXPECT_EQ(quad_corner_distance(kSquare[0], kSquare[1], kSquare[2], kSquare[3]), 0.0);
+  EXPECT_EQ(quad_diagonal_distance(kSquare[0], kSquare[1], kSquare[2], kSquare[3]), 0.0);
+  // Bottom layer exactly 0.01 below: no thickness error; its side faces are vertical: no twist.
+  Vec3 bottom[4];
+  for (int k = 0; k < 4; ++k) bottom[k] = kSquare[k] - Vec3(0, 0, 0.01);
+  EXPECT_NEAR(panel_thickness_error(kSquare, bottom, 0.01), 0.0, 1e-17);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_EQ(miter_twist(kSquare[k], kSquare[(k + 1) % 4], bottom[k], bottom[(k + 1) % 4]), 0.0);
+}
+
+// One corner (q2) raised by d. Split along q0-q2, the triangles' normals are (0, -d, 1) and (-d, 0, 1)
+// (unnormalised), so 1 - n1.n2 = 1 - 1 / (1 + d^2) = d^2 / (1 + d^2). Split along q1-q3, (q1, q3, q0)
+// stays flat (0, 0, 1) and (q1, q2, q3) has normal (-d, -d, 1): 1 - 1 / sqrt(1 + 2 d^2). The metric is
+// the larger. The raised corner is d off the plane of the other three (the largest of the four
+// corner distances). The diagonals are d / (2 sqrt(1 + d^2 / 2)) apart; the edges are 1, 1,
+// sqrt(1 + d^2), sqrt(1 + d^2).
+TEST(PanelMetrics, OneCornerRaisedByD) {
+  for (double d : {1e-4, 1e-3, 0.05}) {
+    const Vec3 q2 = kSquare[2] + Vec3(0, 0, d);
+    const double split02 = d * d / (1 + d * d);
+    const double split13 = 1 - 1 / std::sqrt(1 + 2 * d * d);
+    EXPECT_NEAR(quad_planarity(kSquare[0], kSquare[1], q2, kSquare[3]), std::max(split02, split13), 1e-15) << d;
+    EXPECT_NEAR(quad_corner_distance(kSquare[0], kSquare[1], q2, kSquare[3]), d, 1e-15) << d;
+    const double mean_edge = (2 + 2 * std::sqrt(1 + d * d)) / 4;
+    EXPECT_NEAR(quad_diagonal_distance(kSquare[0], kSquare[1], q2, kSquare[3]),
+                d / (2 * std::sqrt(1 + d * d / 2)) / mean_edge, 1e-15)
+        << d;
+  }
+  // The reading of the paper's number: planarity 6e-6 is a fold of sqrt(2 * 6e-6) = 3.46e-3
+  // rad, about 2.4 mm off-plane per metre of panel, not 0.006 mm.
+  const double d = 0.0024;  // m, one corner of a 1 m panel
+  EXPECT_NEAR(quad_planarity(kSquare[0], kSquare[1], kSquare[2] + Vec3(0, 0, d), kSquare[3]), 5.76e-6, 0.02e-6);
+}
+
+// Thickness: one bottom corner pushed down by e is e further than 0.01 from the top plane; moving a
+// bottom corner along the plane changes nothing.
+TEST(PanelMetrics, ThicknessError) {
+  Vec3 bottom[4];
+  for (int k = 0; k < 4; ++k) bottom[k] = kSquare[k] - Vec3(0, 0, 0.01);
+  bottom[1] += Vec3(0.003, -0.002, 0);
+  EXPECT_NEAR(panel_thickness_error(kSquare, bottom, 0.01), 0.0, 1e-17);
+  bottom[3].z() -= 2e-4;
+  // The top corners measured from the tilted bottom triangles are off by less; the bottom corner
+  // from the flat top plane by exactly 2e-4.
+  EXPECT_NEAR(panel_thickness_error(kSquare, bottom, 0.01), 2e-4, 1e-15);
+}
+
+// Miter: the joint of edge q0-q1 is the vertical face y = 0 when the bottom edge is straight below.
+// Moving bottom corner 1 out of that face by e (along -y) twists the joint by e; moving it within
+// the face (along x or z) does not.
+TEST(PanelMetrics, MiterTwist) {
+  const Vec3 b0 = kSquare[0] - Vec3(0, 0, 0.01);
+  const Vec3 b1 = kSquare[1] - Vec3(0, 0, 0.01);
+  EXPECT_EQ(miter_twist(kSquare[0], kSquare[1], b0, b1 + Vec3(0.004, 0, -0.002)), 0.0);
+  EXPECT_NEAR(miter_twist(kSquare[0], kSquare[1], b0, b1 - Vec3(0, 0.0013, 0)), 0.0013, 1e-16);
+}
+
+// Summary against a tolerance: counts in and out, max and RMS.
+TEST(PanelMetrics, SummaryCountsAgainstTolerance) {
+  const std::vector<double> v = {0.0, 1e-6, 2e-6, 5e-4, 2e-3};
+  const MetricSummary s = summarize(v, Tolerance{1e-6, 1e-3});
+  EXPECT_EQ(s.count, 5);
+  EXPECT_EQ(s.within_target, 2);
+  EXPECT_EQ(s.within_max, 2);
+  EXPECT_EQ(s.above_max, 1);
+  EXPECT_EQ(s.max, 2e-3);
+  EXPECT_NEAR(s.rms, std::sqrt((1e-12 + 4e-12 + 25e-8 + 4e-6) / 5), 1e-18);
+}
+
+// A 3 x 2 grid: 6 panels of 8 particles, 17 joints (edges of the grid: 3*3 + 4*2), 2 interior
+// vertices; everything reads zero as built, the bottom layer 0.01 below the top.
+TEST(PanelMesh, GridBuildsFlatAndExact) {
+  World w(test::settings(10, 1));
+  std::vector<double> pos;
+  std::vector<int32_t> quads;
+  panel_grid(3, 2, 0.8, Vec3(0, 0, 1), pos, quads);
+  PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.thickness = 0.01;
+  d.pins = PanelPins::top_corners;
+  const Id body = build_panel_mesh(w, d);
+  const PanelLayout* l = w.panel_layout(body);
+  ASSERT_NE(l, nullptr);
+  EXPECT_EQ(l->panel_count(), 6);
+  EXPECT_EQ(w.particle_count(), 48);
+  EXPECT_EQ(w.pin_count(), 4u);
+  EXPECT_EQ(panel_joints(*l).size(), 17u);
+  EXPECT_EQ(conical_vertices(*l).size(), 2u);
+  for (int32_t p = 0; p < 6; ++p)
+    for (int k = 0; k < 4; ++k)
+      EXPECT_NEAR((w.positions()[l->top(p, k)] - w.positions()[l->bottom(p, k)] - Vec3(0, 0, 0.01)).norm(), 0.0, 1e-15);
+  const PanelReport r = report_panels(measure_panels(*l, w.positions()), Tolerances{});
+  EXPECT_EQ(r.planarity_top.max, 0.0);
+  EXPECT_LT(r.thickness.max, 1e-15);
+  EXPECT_LT(r.miter.max, 1e-15);
+  EXPECT_LT(r.conical.max, 1e-15);
+  EXPECT_TRUE(r.within_tolerance);
+  // Per-vertex fields: one value per particle.
+  EXPECT_EQ(vertex_errors(*l, measure_panels(*l, w.positions()), PanelMetric::miter).size(), 48u);
+}
+
+// A bad description is refused and changes nothing.
+TEST(PanelMesh, RefusedInputChangesNothing) {
+  World w(test::settings(10, 1));
+  std::vector<double> pos;
+  std::vector<int32_t> quads;
+  panel_grid(2, 2, 1.0, Vec3::Zero(), pos, quads);
+  auto refused = [&](PanelMeshDesc d, const char* what) {
+    EXPECT_THROW(build_panel_mesh(w, d), Error) << what;
+    EXPECT_EQ(w.particle_count(), 0) << what;
+    EXPECT_EQ(w.body_count(), 0u) << what;
+    EXPECT_EQ(w.constraint_count(), 0) << what;
+    EXPECT_EQ(w.pin_count(), 0u) << what;
+  };
+  PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.pins = PanelPins::top_corners;
+  PanelMeshDesc bad = d;
+  bad.thickness = 0.0;
+  refused(bad, "zero thickness");
+  bad = d;
+  bad.thickness = std::nan("");
+  refused(bad, "NaN thickness");
+  std::vector<int32_t> q = quads;
+  q[5] = 99;
+  bad = d;
+  bad.quads = q;
+  refused(bad, "index out of range");
+  q = quads;
+  q[1] = q[0];
+  bad.quads = q;
+  refused(bad, "repeated vertex");
+  q = quads;
+  std::swap(q[4], q[6]);  // second quad turned the other way round: its shared edge runs the same way
+  bad.quads = q;
+  refused(bad, "inconsistent orientation");
+  std::vector<double> p = pos;
+  p[3 * 4 + 2] = 0.3;  // lift the middle vertex: its four quads are no longer planar
+  bad = d;
+  bad.positions = p;
+  refused(bad, "non-planar quad");
+  bad = d;
+  bad.pins = static_cast<PanelPins>(7);
+  refused(bad, "unknown pin mode");
+}
+
+// A known conical mesh: a band of a sphere along its meridians and parallels (a surface of
+// revolution), 24 around and 4 rows, closed round. Each quad is an isosceles trapezoid (planar); at
+// each vertex the mirror symmetry across the meridian plane makes opposite face angles sum equal
+// (a conical vertex), so the face offset exists. Built as the top layer with its face offset, all
+// three metrics read zero, and with gravity off it stays so.
+TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
+  constexpr int around = 24, rows = 4;
+  constexpr double radius = 3.0;
+  std::vector<double> pos;
+  for (int i = 0; i <= rows; ++i) {
+    const double phi = -0.4 + 0.8 * i / rows;
+    for (int j = 0; j < around; ++j) {
+      const double theta = 2 * std::numbers::pi * j / around;
+      pos.insert(pos.end(), {radius * std::cos(phi) * std::cos(theta), radius * std::cos(phi) * std::sin(theta),
+                             radius * std::sin(phi)});
+    }
+  }
+  std::vector<int32_t> quads;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < around; ++j) {
+      const int32_t a = i * around + j, b = i * around + (j + 1) % around;
+      quads.insert(quads.end(), {a, b, b + around, a + around});  // east, then north: outward normal
+    }
+  World w(test::settings(20, 1));
+  PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.thickness = 0.05;
+  const Id body = build_panel_mesh(w, d);
+  const PanelLayout& l = *w.panel_layout(body);
+  EXPECT_EQ(conical_vertices(l).size(), static_cast<size_t>(around * (rows - 1)));
+  const PanelErrors before = measure_panels(l, w.positions());
+  const PanelReport r0 = report_panels(before, Tolerances{});
+  EXPECT_LT(r0.conical.max, 1e-13);
+  EXPECT_LT(r0.planarity_top.max, 1e-14);
+  EXPECT_LT(r0.planarity_bottom.max, 1e-14);
+  EXPECT_LT(r0.thickness.max, 1e-12);
+  EXPECT_LT(r0.miter.max, 1e-12);
+  // The bottom layer lies on the sphere of radius 3 - 0.05 / cos(half the angle between rows):
+  // every bottom corner is below its top corner (inside the sphere).
+  for (int32_t p = 0; p < l.panel_count(); ++p)
+    for (int k = 0; k < 4; ++k) EXPECT_LT(w.positions()[l.bottom(p, k)].norm(), radius - 0.049);
+  for (int f = 0; f < 60; ++f) w.step();
+  const PanelReport r1 = report_panels(measure_panels(l, w.positions()), Tolerances{});
+  EXPECT_LT(r1.planarity_top.max, 1e-12);
+  EXPECT_LT(r1.planarity_bottom.max, 1e-12);
+  EXPECT_LT(r1.thickness.max, 1e-10);
+  EXPECT_LT(r1.miter.max, 1e-10);
+  EXPECT_LT(w.report().max_speed, 1e-9);
+  RecordProperty("conical_after_60_frames_thickness", test::sci(r1.thickness.max));
+  RecordProperty("conical_after_60_frames_miter", test::sci(r1.miter.max));
+}
+
+}  // namespace
+}  // namespace embra
