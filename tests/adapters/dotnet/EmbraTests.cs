@@ -8,6 +8,7 @@ using System.Globalization;
 using System.IO;
 using System.Linq;
 using System.Reflection;
+using System.Runtime.InteropServices;
 using System.Text.RegularExpressions;
 using System.Threading.Tasks;
 using Embra;
@@ -714,7 +715,7 @@ namespace Embra.Tests
             string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
             var declared = new HashSet<string>(Regex.Matches(header, @"EMBRA_API[^;(]*?\b(embra_\w+)\s*\(").Cast<Match>().Select(m => m.Groups[1].Value));
             var bound = new HashSet<string>(typeof(Native).GetMethods(BindingFlags.Public | BindingFlags.Static)
-                .Where(m => m.GetCustomAttributes(typeof(System.Runtime.InteropServices.DllImportAttribute), false).Length > 0)
+                .Where(m => m.GetCustomAttributes(typeof(DllImportAttribute), false).Length > 0)
                 .Select(m => m.Name));
             Assert.Greater(declared.Count, 40);
             CollectionAssert.AreEquivalent(declared, bound);
@@ -758,6 +759,56 @@ namespace Embra.Tests
                 var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value));
                 Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_VERSION");
                 Assert.AreEqual(int.Parse(m.Groups[2].Value), (int)def.GetField("CurrentVersion").GetValue(null));
+            }
+        }
+
+        static string Snake(string pascal)
+        {
+            return Regex.Replace(pascal, "(?<=.)([A-Z])", "_$1").ToLowerInvariant();
+        }
+
+        [Test]
+        public void StructLayoutsMatchTheHeader()
+        {
+            // Every struct of embra.h: the C compiler's sizeof and offsetof against Marshal's, field by field
+            // (C# fields are the C fields in PascalCase).
+            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
+            var structs = Regex.Matches(header, @"typedef struct (embra_(\w+)) \{").Cast<Match>()
+                .ToDictionary(m => m.Groups[1].Value, m => typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[2].Value.ToUpperInvariant())));
+            Assert.GreaterOrEqual(structs.Count, 20);
+            var program = new List<string> { "#include <stddef.h>", "#include <stdio.h>", "#include \"embra/embra.h\"", "int main(void) {" };
+            foreach (var s in structs)
+            {
+                Assert.IsNotNull(s.Value, "no C# struct for " + s.Key);
+                program.Add("  printf(\"" + s.Key + " %zu\\n\", sizeof(" + s.Key + "));");
+                foreach (var f in s.Value.GetFields(BindingFlags.Public | BindingFlags.Instance))
+                    program.Add("  printf(\"" + s.Key + "." + f.Name + " %zu\\n\", offsetof(" + s.Key + ", " + Snake(f.Name) + "));");
+            }
+            program.Add("  return 0;\n}");
+            string dir = Env.TempDir();
+            File.WriteAllLines(Path.Combine(dir, "layout.c"), program);
+            string build = Environment.GetEnvironmentVariable("LD_LIBRARY_PATH").Split(':')[0];  // the build tree
+            Func<string, string, string> run = (file, args) =>
+            {
+                var start = new ProcessStartInfo(file, args) { UseShellExecute = false, RedirectStandardOutput = true };
+                using (var p = Process.Start(start))
+                {
+                    string output = p.StandardOutput.ReadToEnd();
+                    p.WaitForExit();
+                    Assert.AreEqual(0, p.ExitCode, file + " " + args);
+                    return output;
+                }
+            };
+            run("cc", "-I \"" + Path.Combine(Env.Source, "capi", "include") + "\" -I \"" + Path.Combine(build, "generated") +
+                "\" -o \"" + Path.Combine(dir, "layout") + "\" \"" + Path.Combine(dir, "layout.c") + "\"");
+            var c = run(Path.Combine(dir, "layout"), "").Split(new[] { '\n' }, StringSplitOptions.RemoveEmptyEntries)
+                .ToDictionary(line => line.Split(' ')[0], line => int.Parse(line.Split(' ')[1]));
+            Directory.Delete(dir, true);
+            foreach (var s in structs)
+            {
+                Assert.AreEqual(c[s.Key], Marshal.SizeOf(s.Value), "sizeof " + s.Key);
+                foreach (var f in s.Value.GetFields(BindingFlags.Public | BindingFlags.Instance))
+                    Assert.AreEqual(c[s.Key + "." + f.Name], (int)Marshal.OffsetOf(s.Value, f.Name), s.Key + "." + f.Name);
             }
         }
 
