@@ -28,6 +28,15 @@ namespace Embra
     [Flags]
     public enum Generate { None = 0, Stretch = 1, Shear = 2, Bend = 4, Volume = 8 }
 
+    /// <summary>EMBRA_PANEL_PINS_*: which corners of a panel mesh embra_panel_mesh_create pins.</summary>
+    public enum PanelPins { None = 0, TopCorners = 1, TopAndBottomCorners = 2 }
+
+    /// <summary>EMBRA_PANEL_METRIC_*: the per-vertex error fields of embra_panel_mesh_get_vertex_errors.</summary>
+    public enum PanelMetric { Planarity = 0, Thickness = 1, Miter = 2, CornerDistance = 3, Conical = 4 }
+
+    /// <summary>EMBRA_CUTS_*: the formats of embra_panel_mesh_export_cuts.</summary>
+    public enum CutsFormat { Json = 0, Csv = 1 }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct GroupId { public uint Index, Generation; }
     [StructLayout(LayoutKind.Sequential)]
@@ -130,6 +139,53 @@ namespace Embra
         public IntPtr Vertices, Triangles;
     }
 
+    /// <summary>embra_panel_mesh_def (EMBRA_PANEL_MESH_DEF_VERSION 1). Units and defaults: embra.h.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct PanelMeshDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version, VertexCount;
+        public IntPtr Positions, Quads;
+        public int QuadCount, GridColumns, GridRows, Pins;
+        public double PanelSize;
+        public fixed double Origin[3];
+        public double Thickness, Mass, Density, Damping, FrictionStatic, FrictionDynamic, SlideCompliance;
+        public GroupId Group;
+    }
+
+    [StructLayout(LayoutKind.Sequential)]
+    public struct Tolerance
+    {
+        public double Target, Max;
+    }
+
+    /// <summary>embra_tolerances (EMBRA_TOLERANCES_VERSION 1): schemas/tolerances.schema.json as a struct.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct Tolerances
+    {
+        public const int CurrentVersion = 1;
+        public int Version, Reserved0;
+        public double UnitScale;
+        public Tolerance Planarity, PlanarityDistance, Thickness, Miter;
+    }
+
+    [StructLayout(LayoutKind.Sequential)]
+    public struct MetricSummary
+    {
+        public double Max, Rms;
+        public long Count, WithinTarget, WithinMax, AboveMax;
+    }
+
+    /// <summary>embra_panel_metrics (EMBRA_PANEL_METRICS_VERSION 1).</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct PanelMetrics
+    {
+        public const int CurrentVersion = 1;
+        public int Version, WithinTolerance;
+        public MetricSummary PlanarityTop, PlanarityBottom, CornerDistanceTop, CornerDistanceBottom, DiagonalTop,
+            DiagonalBottom, Thickness, Miter, Conical;
+    }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct StepReport
     {
@@ -191,6 +247,16 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_particles(IntPtr world, BodyId body, out int first, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_set_rest_scale(IntPtr world, BodyId body, double scale, double scaleU, double scaleV);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] triangles, long capacity, out long count);
+        // panel meshes (tolerances: one, or null for the world's)
+        [DllImport(Library, CallingConvention = C)] public static extern PanelMeshDef embra_default_panel_mesh_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_create(IntPtr world, ref PanelMeshDef def, out BodyId body, out int firstParticle);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_panel_count(IntPtr world, BodyId body, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern Tolerances embra_default_tolerances();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_tolerances(IntPtr world, out Tolerances tolerances);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_tolerances(IntPtr world, ref Tolerances tolerances);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_metrics(IntPtr world, BodyId body, [In] Tolerances[] tolerances, out PanelMetrics metrics);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_vertex_errors(IntPtr world, BodyId body, int metric, [Out] double[] errors, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_export_cuts(IntPtr world, BodyId body, int format, [Out] byte[] text, long capacity, out long length);
         // constraints
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_arity(int kind);
         [DllImport(Library, CallingConvention = C)] public static extern ConstraintDef embra_default_constraint_def();

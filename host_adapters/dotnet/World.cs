@@ -156,6 +156,8 @@ namespace Embra
         public static Material DefaultMaterial() { return Native.embra_default_material(); }
         public static BodyDef DefaultBodyDef() { return Native.embra_default_body_def(); }
         public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
+        public static PanelMeshDef DefaultPanelMeshDef() { return Native.embra_default_panel_mesh_def(); }
+        public static Tolerances DefaultTolerances() { return Native.embra_default_tolerances(); }
         internal static void Touch() { }
     }
 
@@ -352,6 +354,86 @@ namespace Embra
             var out_ = new int[n];
             Call(w => Native.embra_body_get_triangles(w, body, out_, out_.LongLength, out n));
             return out_;
+        }
+
+        // --- panel meshes ----------------------------------------------------------------------
+        /// <summary>Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create): 8 particles per
+        /// panel. With positions (xyz per top vertex) and quads (4 indices per quad) the mesh is theirs;
+        /// without, a grid of def.GridColumns x def.GridRows square panels. `def` (default:
+        /// embra_default_panel_mesh_def()) supplies the rest; its pointers and counts are set here.</summary>
+        public Body CreatePanelMesh(PanelMeshDef? def = null, double[] positions = null, int[] quads = null)
+        {
+            Need((positions == null) == (quads == null), "positions and quads go together (neither: a grid)");
+            Need(positions == null || positions.Length % 3 == 0, "positions: a whole number of xyz triples is required");
+            Need(quads == null || quads.Length % 4 == 0, "quads: 4 indices per quad");
+            PanelMeshDef d = def ?? Native.embra_default_panel_mesh_def();
+            var body = new Body();
+            fixed (double* p = positions)
+            fixed (int* q = quads)
+            {
+                if (positions != null)
+                {
+                    d.VertexCount = positions.Length / 3;
+                    d.Positions = (IntPtr)p;
+                    d.QuadCount = quads.Length / 4;
+                    d.Quads = (IntPtr)q;
+                }
+                BodyId id = new BodyId();
+                int first = 0;
+                Call(w => Native.embra_panel_mesh_create(w, ref d, out id, out first));
+                body.Id = id;
+                body.First = first;
+                body.Count = 8 * (d.VertexCount != 0 ? d.QuadCount : d.GridColumns * d.GridRows);
+            }
+            return body;
+        }
+
+        public int PanelCount(BodyId body)
+        {
+            int n = 0;
+            Call(w => Native.embra_panel_mesh_get_panel_count(w, body, out n));
+            return n;
+        }
+
+        /// <summary>The fabrication tolerances the metrics are judged against (the scene's, else the defaults).</summary>
+        public Tolerances Tolerances
+        {
+            get { var t = new Tolerances(); Call(w => Native.embra_world_get_tolerances(w, out t)); return t; }
+            set { var t = value; Call(w => Native.embra_world_set_tolerances(w, ref t)); }
+        }
+
+        /// <summary>The section 4.1 metrics of a panel-mesh body at the current positions, judged against
+        /// `tolerances` (default: the world's).</summary>
+        public PanelMetrics PanelMetrics(BodyId body, Tolerances? tolerances = null)
+        {
+            Tolerances[] t = tolerances.HasValue ? new[] { tolerances.Value } : null;
+            var m = new PanelMetrics();
+            Call(w => Native.embra_panel_mesh_get_metrics(w, body, t, out m));
+            return m;
+        }
+
+        /// <summary>One error value per particle of a panel-mesh body (8 per panel, in body order) for a
+        /// colour map, into `into` when given (capacity = its length) or a new array.</summary>
+        public double[] VertexErrors(BodyId body, PanelMetric metric, double[] into = null)
+        {
+            long n = 0;
+            if (into == null)
+            {
+                Call(w => Native.embra_panel_mesh_get_vertex_errors(w, body, (int)metric, null, 0, out n));
+                into = new double[n];
+            }
+            Call(w => Native.embra_panel_mesh_get_vertex_errors(w, body, (int)metric, into, into.LongLength, out n));
+            return into;
+        }
+
+        /// <summary>The cut list of a panel-mesh body at the current positions, as JSON or CSV text.</summary>
+        public string ExportCuts(BodyId body, CutsFormat format = CutsFormat.Json)
+        {
+            long n = 0;
+            Call(w => Native.embra_panel_mesh_export_cuts(w, body, (int)format, null, 0, out n));
+            var text = new byte[n];
+            Call(w => Native.embra_panel_mesh_export_cuts(w, body, (int)format, text, text.LongLength, out n));
+            return Encoding.UTF8.GetString(text, 0, (int)n - 1);
         }
 
         // --- constraints ------------------------------------------------------------------------

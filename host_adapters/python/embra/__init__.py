@@ -13,12 +13,13 @@ is optional: when installed, arrays go to and from C without copies.
 
 from . import _capi
 from ._capi import (ABI_VERSION, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
-                    GroupId, GroupReport, Material, PinDef, PinId, SolverDef, StepReport, WorldCounts, library_path)
+                    GroupId, GroupReport, Material, MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId, SolverDef,
+                    StepReport, Tolerance, Tolerances, WorldCounts, library_path)
 from ._capi import Warning as StepWarning
 from ._buffers import have_numpy
 from .errors import (BufferTooSmallError, EmbraError, InternalError, InvalidArgumentError, LockedError,
                      NumericalError, SchemaError, StaleIdError, VersionError, check)
-from .world import GENERATE, KINDS, SHAPES, Body, World, as_dict
+from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_METRICS, PANEL_PINS, SHAPES, Body, World, as_dict
 
 _lib = _capi.lib
 
@@ -62,14 +63,25 @@ def default_material():
     return _lib.embra_default_material()
 
 
+def default_panel_mesh_def():
+    return _lib.embra_default_panel_mesh_def()
+
+
+def default_tolerances():
+    """The tolerances a world has until a scene or set_tolerances gives it others."""
+    return _lib.embra_default_tolerances()
+
+
 check_abi()  # these bindings and the loaded library must agree before anything else
 
 __version__ = version_string()
 __all__ = [
     "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
-    "last_error_message", "constraint_arity", "default_solver_def", "default_material", "have_numpy",
-    "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError", "StaleIdError", "BufferTooSmallError",
-    "SchemaError", "VersionError", "LockedError", "NumericalError", "InternalError", "SolverDef", "Material",
-    "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef", "ColliderDef", "StepReport", "GroupReport",
-    "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "SHAPES", "KINDS", "GENERATE",
+    "last_error_message", "constraint_arity", "default_solver_def", "default_material", "default_panel_mesh_def",
+    "default_tolerances", "have_numpy", "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError",
+    "StaleIdError", "BufferTooSmallError", "SchemaError", "VersionError", "LockedError", "NumericalError",
+    "InternalError", "SolverDef", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef",
+    "ColliderDef", "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "StepReport",
+    "GroupReport", "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "SHAPES", "KINDS",
+    "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
 ]

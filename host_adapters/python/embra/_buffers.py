@@ -94,13 +94,14 @@ def ints_in(obj, name):
     return ctypes.cast(buf, POINTER(c_int32)), len(a), (buf, a)
 
 
-def doubles_out(count, out, name):
-    """(result object, pointer, capacity in doubles, keep-alive) for `count` xyz triples written by C."""
+def doubles_out(count, out, name, width=3):
+    """(result object, pointer, capacity in doubles, keep-alive) for `count` xyz triples (or, with
+    width 1, `count` single values) written by C."""
     if out is None:
         if np is not None:
-            result = np.empty((count, 3), dtype=np.float64)
-            return result, result.ctypes.data_as(POINTER(c_double)), 3 * count, None
-        result = array("d", bytes(24 * count))
+            result = np.empty((count, 3) if width == 3 else (count * width,), dtype=np.float64)
+            return result, result.ctypes.data_as(POINTER(c_double)), width * count, None
+        result = array("d", bytes(8 * width * count))
     else:
         result = out
     if np is not None and isinstance(result, np.ndarray):

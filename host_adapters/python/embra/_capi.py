@@ -46,6 +46,19 @@ COLLIDER_CAPSULE = 3
 COLLIDER_CONVEX = 4
 COLLIDER_MESH = 5
 
+PANEL_PINS_NONE = 0
+PANEL_PINS_TOP_CORNERS = 1
+PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2
+
+PANEL_METRIC_PLANARITY = 0
+PANEL_METRIC_THICKNESS = 1
+PANEL_METRIC_MITER = 2
+PANEL_METRIC_CORNER_DISTANCE = 3
+PANEL_METRIC_CONICAL = 4
+
+CUTS_JSON = 0
+CUTS_CSV = 1
+
 # --- def versions ----------------------------------------------------------------------------
 SOLVER_DEF_VERSION = 1
 GROUP_DEF_VERSION = 1
@@ -54,6 +67,9 @@ CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
+PANEL_MESH_DEF_VERSION = 1
+TOLERANCES_VERSION = 1
+PANEL_METRICS_VERSION = 1
 
 _d3 = c_double * 3
 _d4 = c_double * 4
@@ -157,6 +173,36 @@ class GroupReport(ctypes.Structure):
     _fields_ = [("count", c_int64), ("residual_max", c_double), ("residual_rms", c_double)]
 
 
+class PanelMeshDef(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("vertex_count", c_int32), ("positions", _pd), ("quads", _pi),
+                ("quad_count", c_int32), ("grid_columns", c_int32), ("grid_rows", c_int32), ("pins", c_int32),
+                ("panel_size", c_double), ("origin", _d3), ("thickness", c_double), ("mass", c_double),
+                ("density", c_double), ("damping", c_double), ("friction_static", c_double),
+                ("friction_dynamic", c_double), ("slide_compliance", c_double), ("group", GroupId)]
+
+
+class Tolerance(ctypes.Structure):
+    _fields_ = [("target", c_double), ("max", c_double)]
+
+
+class Tolerances(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("reserved0", c_int32), ("unit_scale", c_double), ("planarity", Tolerance),
+                ("planarity_distance", Tolerance), ("thickness", Tolerance), ("miter", Tolerance)]
+
+
+class MetricSummary(ctypes.Structure):
+    _fields_ = [("max", c_double), ("rms", c_double), ("count", c_int64), ("within_target", c_int64),
+                ("within_max", c_int64), ("above_max", c_int64)]
+
+
+class PanelMetrics(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("within_tolerance", c_int32), ("planarity_top", MetricSummary),
+                ("planarity_bottom", MetricSummary), ("corner_distance_top", MetricSummary),
+                ("corner_distance_bottom", MetricSummary), ("diagonal_top", MetricSummary),
+                ("diagonal_bottom", MetricSummary), ("thickness", MetricSummary), ("miter", MetricSummary),
+                ("conical", MetricSummary)]
+
+
 class Warning(ctypes.Structure):  # noqa: A001 - the C name (embra_warning)
     _fields_ = [("frame", c_int64), ("particle", c_int32), ("reserved0", c_int32)]
 
@@ -199,6 +245,16 @@ PROTOTYPES = {
     "embra_body_get_particles": (_status, [_world, BodyId, _P(c_int32), _P(c_int32)]),
     "embra_body_set_rest_scale": (_status, [_world, BodyId, c_double, c_double, c_double]),
     "embra_body_get_triangles": (_status, [_world, BodyId, _pi, c_int64, _P(c_int64)]),
+    # panel meshes
+    "embra_default_panel_mesh_def": (PanelMeshDef, []),
+    "embra_panel_mesh_create": (_status, [_world, _P(PanelMeshDef), _P(BodyId), _P(c_int32)]),
+    "embra_panel_mesh_get_panel_count": (_status, [_world, BodyId, _P(c_int32)]),
+    "embra_default_tolerances": (Tolerances, []),
+    "embra_world_get_tolerances": (_status, [_world, _P(Tolerances)]),
+    "embra_world_set_tolerances": (_status, [_world, _P(Tolerances)]),
+    "embra_panel_mesh_get_metrics": (_status, [_world, BodyId, _P(Tolerances), _P(PanelMetrics)]),
+    "embra_panel_mesh_get_vertex_errors": (_status, [_world, BodyId, c_int32, _pd, c_int64, _P(c_int64)]),
+    "embra_panel_mesh_export_cuts": (_status, [_world, BodyId, c_int32, _P(c_char), c_int64, _P(c_int64)]),
     # constraints
     "embra_constraint_arity": (c_int32, [c_int32]),
     "embra_default_constraint_def": (ConstraintDef, []),

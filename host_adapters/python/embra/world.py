@@ -14,8 +14,8 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
-                    GroupId, GroupReport, Material, PinDef, PinId, SolverDef, StepReport, Warning, WorldCounts,
-                    lib)
+                    GroupId, GroupReport, Material, PanelMetrics, PinDef, PinId, SolverDef, StepReport, Tolerances,
+                    Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
 SHAPES = {"plane": _capi.COLLIDER_PLANE, "sphere": _capi.COLLIDER_SPHERE, "box": _capi.COLLIDER_BOX,
@@ -26,6 +26,12 @@ KINDS = {"distance": _capi.CONSTRAINT_DISTANCE, "edge_angle": _capi.CONSTRAINT_E
          "planarity": _capi.CONSTRAINT_PLANARITY, "plane_offset": _capi.CONSTRAINT_PLANE_OFFSET}
 GENERATE = {"stretch": _capi.GENERATE_STRETCH, "shear": _capi.GENERATE_SHEAR, "bend": _capi.GENERATE_BEND,
             "volume": _capi.GENERATE_VOLUME}
+PANEL_PINS = {"none": _capi.PANEL_PINS_NONE, "top_corners": _capi.PANEL_PINS_TOP_CORNERS,
+              "top_and_bottom_corners": _capi.PANEL_PINS_TOP_AND_BOTTOM_CORNERS}
+PANEL_METRICS = {"planarity": _capi.PANEL_METRIC_PLANARITY, "thickness": _capi.PANEL_METRIC_THICKNESS,
+                 "miter": _capi.PANEL_METRIC_MITER, "corner_distance": _capi.PANEL_METRIC_CORNER_DISTANCE,
+                 "conical": _capi.PANEL_METRIC_CONICAL}
+CUTS_FORMATS = {"json": _capi.CUTS_JSON, "csv": _capi.CUTS_CSV}
 
 
 def as_dict(struct):
@@ -322,6 +328,102 @@ class World:
         self._call("embra_body_get_triangles", b, pointer, n.value, byref(n))
         return out
 
+    # --- panel meshes --------------------------------------------------------------------------
+    def create_panel_mesh(self, positions=None, quads=None, *, pins=None, group=None, **fields):
+        """Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create) and returns its Body (id,
+        first particle, 8 particles per panel).
+
+        positions and quads: the top quad mesh (xyz per vertex; 4 vertex indices per quad, flat,
+        nested or numpy); without them, a grid of grid_columns x grid_rows square panels of
+        panel_size at origin. pins: "none", "top_corners", "top_and_bottom_corners" or the number;
+        any other PanelMeshDef field as a keyword (thickness=0.01, mass=16.0, damping=9.0, ...)."""
+        d = lib.embra_default_panel_mesh_def()
+        _fill(d, fields, "PanelMeshDef")
+        keep = []
+        if positions is not None or quads is not None:
+            if positions is None or quads is None:
+                raise ValueError("positions and quads go together (neither: a grid)")
+            p, n, k = buf.doubles_in(positions, "positions")
+            if n % 3:
+                raise ValueError(f"positions: {n} numbers is not a whole number of xyz triples")
+            keep.append(k)
+            d.positions, d.vertex_count = p, buf.int32(n // 3, "vertex count")
+            q, m, k = buf.ints_in(quads, "quads")
+            if m % 4:
+                raise ValueError(f"quads: {m} indices is not a whole number of 4-tuples")
+            keep.append(k)
+            d.quads, d.quad_count = q, buf.int32(m // 4, "quad count")
+        if pins is not None:
+            d.pins = _enum(pins, PANEL_PINS, "pins")
+        d.group = _id(group, GroupId, "group")
+        body, first = BodyId(), c_int32()
+        self._call("embra_panel_mesh_create", byref(d), byref(body), byref(first))
+        panels = d.quad_count if d.vertex_count else d.grid_columns * d.grid_rows
+        return Body(body, first.value, 8 * panels)
+
+    def panel_count(self, body):
+        """The number of panels of a panel-mesh body."""
+        n = c_int32()
+        self._call("embra_panel_mesh_get_panel_count", _id(body, BodyId, "body"), byref(n))
+        return n.value
+
+    @property
+    def tolerances(self):
+        """The fabrication tolerances the metrics are judged against (a Tolerances copy)."""
+        t = Tolerances()
+        self._call("embra_world_get_tolerances", byref(t))
+        return t
+
+    @tolerances.setter
+    def tolerances(self, tolerances):
+        self.set_tolerances(tolerances)
+
+    def set_tolerances(self, tolerances=None, **fields):
+        """Replaces the tolerances: the current ones, then `tolerances` (Tolerances or dict), then
+        keywords (miter={"target": 1e-3, "max": 1e-2}, unit_scale=1000.0, ...)."""
+        t = self.tolerances
+        if tolerances is not None:
+            _fill(t, as_dict(tolerances) if isinstance(tolerances, Tolerances) else dict(tolerances), "Tolerances")
+        _fill(t, fields, "Tolerances")
+        self._call("embra_world_set_tolerances", byref(t))
+
+    def panel_metrics(self, body, tolerances=None):
+        """The section 4.1 metrics of a panel-mesh body at the current positions (a PanelMetrics;
+        as_dict() makes it a dict), judged against `tolerances` (Tolerances or dict over the
+        defaults) or, when None, the world's."""
+        t = None
+        if tolerances is not None:
+            t = lib.embra_default_tolerances()
+            _fill(t, as_dict(tolerances) if isinstance(tolerances, Tolerances) else dict(tolerances), "Tolerances")
+        m = PanelMetrics()
+        self._call("embra_panel_mesh_get_metrics", _id(body, BodyId, "body"), None if t is None else byref(t),
+                   byref(m))
+        return m
+
+    def vertex_errors(self, body, metric, out=None):
+        """One error value per particle of a panel-mesh body (8 per panel, in body order) for a colour
+        map: metric "planarity", "thickness", "miter", "corner_distance", "conical" or its number.
+        A numpy float64 array written in place by C when numpy is installed, else array('d'); or
+        into `out` (a writable double buffer, too small: BufferTooSmallError, nothing written)."""
+        b, m = _id(body, BodyId, "body"), _enum(metric, PANEL_METRICS, "metric")
+        n = c_int64()
+        if out is None:
+            self._call("embra_panel_mesh_get_vertex_errors", b, m, None, 0, byref(n))
+        result, pointer, capacity, keep = buf.doubles_out(n.value, out, "out", width=1)
+        self._call("embra_panel_mesh_get_vertex_errors", b, m, pointer, capacity, byref(n))
+        del keep
+        return result
+
+    def export_cuts(self, body, format="json"):
+        """The cut list of a panel-mesh body at the current positions, as text: format "json" or "csv"
+        (or its number)."""
+        b, f = _id(body, BodyId, "body"), _enum(format, CUTS_FORMATS, "format")
+        n = c_int64()
+        self._call("embra_panel_mesh_export_cuts", b, f, None, 0, byref(n))
+        out = (c_char * n.value)()
+        self._call("embra_panel_mesh_export_cuts", b, f, out, n.value, byref(n))
+        return out.raw[:n.value - 1].decode("utf-8")
+
     # --- constraints ---------------------------------------------------------------------------
     def add_constraint(self, kind, particles, rest=None, compliance=0.0, group=None):
         """One constraint (embra_constraint_add); rest None measures it from current positions."""
@@ -494,4 +596,5 @@ class World:
         return f.value
 
 
-__all__ = ["World", "Body", "as_dict", "SHAPES", "KINDS", "GENERATE", "EmbraError"]
+__all__ = ["World", "Body", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
+           "EmbraError"]

@@ -8,6 +8,7 @@ using System.Globalization;
 using System.IO;
 using System.Linq;
 using System.Reflection;
+using System.Runtime.InteropServices;
 using System.Text.RegularExpressions;
 using System.Threading.Tasks;
 using Embra;
@@ -96,8 +97,8 @@ namespace Embra.Tests
             return d;
         }
 
-        /// <summary>Runs the `embra` command and returns the 'v' lines of DIR/final.obj (%.17g: exact).</summary>
-        public static double[] Cli(params string[] args)
+        /// <summary>Runs the `embra` command with --out into a new folder, which it returns (the caller deletes it).</summary>
+        public static string CliRun(params string[] args)
         {
             string dir = TempDir();
             var start = new ProcessStartInfo(Environment.GetEnvironmentVariable("EMBRA_CLI"),
@@ -109,12 +110,26 @@ namespace Embra.Tests
                 p.WaitForExit();
                 Assert.AreEqual(0, p.ExitCode, "embra " + string.Join(" ", args));
             }
+            return dir;
+        }
+
+        /// <summary>The 'v' lines of an OBJ written by the `embra` command (%.17g: exact).</summary>
+        public static double[] ObjVertices(string path)
+        {
             var values = new List<double>();
-            foreach (var line in File.ReadAllLines(Path.Combine(dir, "final.obj")))
+            foreach (var line in File.ReadAllLines(path))
                 if (line.StartsWith("v "))
                     values.AddRange(line.Split(' ').Skip(1).Take(3).Select(s => double.Parse(s, CultureInfo.InvariantCulture)));
-            Directory.Delete(dir, true);
             return values.ToArray();
+        }
+
+        /// <summary>Runs the `embra` command and returns the 'v' lines of DIR/final.obj.</summary>
+        public static double[] Cli(params string[] args)
+        {
+            string dir = CliRun(args);
+            double[] values = ObjVertices(Path.Combine(dir, "final.obj"));
+            Directory.Delete(dir, true);
+            return values;
         }
 
         public static void AssertBitIdentical(double[] expected, double[] actual)
@@ -307,6 +322,292 @@ namespace Embra.Tests
         }
     }
 
+    /// <summary>examples/poq_drape.json built through World: the paper's 4 x 4 Planar Offset Quad drape
+    /// (panels of 0.8, thickness 0.01, the top corners pinned on posts drawn in by 10% over frames 0-30,
+    /// a sphere of radius 1 below moved between frames 120 and 180), with the scene player's arithmetic.</summary>
+    static class Drape
+    {
+        public const int Frames = 150;
+        public static string Scene { get { return Path.Combine(Env.Source, "examples", "poq_drape.json"); } }
+
+        static readonly double[][] Posts = { new[] { -1.6, -1.6, 0.0 }, new[] { 1.6, -1.6, 0.0 }, new[] { -1.6, 1.6, 0.0 }, new[] { 1.6, 1.6, 0.0 } };
+        static readonly double[][] Drawn = { new[] { -1.44, -1.6, 0.0 }, new[] { 1.44, -1.6, 0.0 }, new[] { -1.44, 1.6, 0.0 }, new[] { 1.44, 1.6, 0.0 } };
+        static readonly double[] BallFrom = { 0.3, 0.2, -1.45 }, BallTo = { -0.3, 0.2, -1.35 };
+
+        /// <summary>A scene action's value: linear between keys at frames f0 and f1, held outside them.</summary>
+        static double[] Keyed(int frame, int f0, double[] a, int f1, double[] b)
+        {
+            if (frame <= f0) return (double[])a.Clone();
+            if (frame > f1) return (double[])b.Clone();
+            double t = (double)(frame - f0) / (double)(f1 - f0);
+            return Enumerable.Range(0, a.Length).Select(k => (1.0 - t) * a[k] + t * b[k]).ToArray();
+        }
+
+        public static World Build(out Body body, out ColliderId ball)
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Dt = 0.016666666666666666;
+            solver.Substeps = 60;
+            solver.Iterations = 2;
+            solver.SettleSpeed = 0.001;
+            var w = new World(solver);
+            var def = Library.DefaultPanelMeshDef();
+            def.GridColumns = 4;
+            def.GridRows = 4;
+            def.PanelSize = 0.8;
+            unsafe
+            {
+                def.Origin[0] = -1.6;
+                def.Origin[1] = -1.6;
+            }
+            def.Thickness = 0.01;
+            def.Mass = 16;
+            def.Damping = 9;
+            def.SlideCompliance = 0.001;
+            def.Pins = (int)PanelPins.TopCorners;
+            body = w.CreatePanelMesh(def);
+            var sphere = Library.DefaultColliderDef();
+            sphere.Shape = (int)ColliderShape.Sphere;
+            unsafe { for (int k = 0; k < 3; ++k) sphere.Position[k] = BallFrom[k]; }
+            sphere.Radius = 1.0;
+            ball = w.CreateCollider(sphere);
+            var t = w.Tolerances;
+            t.UnitScale = 1250;
+            w.Tolerances = t;
+            return w;
+        }
+
+        /// <summary>The corner pins CreatePanelMesh made: the world's first four, ids {k, 1}, in the order
+        /// the scene names them poq.pin0..3.</summary>
+        public static PinId Pin(int k) { return new PinId { Index = (uint)k, Generation = 1 }; }
+
+        public static void Step(World w, ColliderId ball, int frames)
+        {
+            for (int i = 0; i < frames; ++i)
+            {
+                int frame = (int)w.Report.Frame + 1;
+                for (int k = 0; k < 4; ++k) w.SetPinTarget(Pin(k), Keyed(frame, 0, Posts[k], 30, Drawn[k]));
+                w.SetColliderTransform(ball, Keyed(frame, 120, BallFrom, 180, BallTo), new[] { 1.0, 0, 0, 0 });
+                w.Step();
+            }
+        }
+
+        public static void CheckPins(World w)
+        {
+            for (int k = 0; k < 4; ++k) CollectionAssert.AreEqual(Posts[k], w.PinTarget(Pin(k)));
+        }
+    }
+
+    [TestFixture]
+    public class PanelTests
+    {
+        [Test]
+        public void DrapeBuiltInCSharpMatchesTheCHostBitForBit()
+        {
+            string dir = Env.CliRun("run", Drape.Scene, "--frames", Drape.Frames.ToString());
+            try
+            {
+                Body body;
+                ColliderId ball;
+                using (var w = Drape.Build(out body, out ball))
+                {
+                    Assert.AreEqual(128, body.Count);
+                    Assert.AreEqual(16, w.PanelCount(body.Id));
+                    Drape.CheckPins(w);
+                    Drape.Step(w, ball, Drape.Frames);
+                    double[] cs = w.GetPositions(body.First, body.Count);
+                    Env.AssertBitIdentical(Env.ObjVertices(Path.Combine(dir, "final.obj")), cs);
+                    Assert.Less(Enumerable.Range(0, 128).Min(i => cs[3 * i + 2]), -0.5);  // folded over the sphere
+                    Assert.AreEqual(File.ReadAllText(Path.Combine(dir, "panels_0.json")), w.ExportCuts(body.Id));
+                    Assert.AreEqual(File.ReadAllText(Path.Combine(dir, "panels_0.csv")), w.ExportCuts(body.Id, CutsFormat.Csv));
+                    string last = File.ReadAllLines(Path.Combine(dir, "metrics.jsonl")).Last();
+                    var m = w.PanelMetrics(body.Id);
+                    StringAssert.Contains("\"frame\":" + Drape.Frames + ",", last);
+                    Assert.AreEqual(Field(last, "thickness_error_max"), m.Thickness.Max);
+                    Assert.AreEqual(Field(last, "miter_error_max"), m.Miter.Max);
+                    Assert.AreEqual(Field(last, "planarity_top_max"), m.PlanarityTop.Max);
+                    Assert.AreEqual(Field(last, "planarity_bottom_max"), m.PlanarityBottom.Max);
+                    Assert.AreEqual(Field(last, "conical_defect_max"), m.Conical.Max);
+                    StringAssert.Contains("\"within_tolerance\":" + (m.WithinTolerance == 1 ? "true" : "false"), last);
+                }
+            }
+            finally
+            {
+                Directory.Delete(dir, true);
+            }
+        }
+
+        static double Field(string record, string name)
+        {
+            var m = Regex.Match(record, "\"" + name + "\":([^,}]+)");
+            Assert.IsTrue(m.Success, name);
+            return double.Parse(m.Groups[1].Value, CultureInfo.InvariantCulture);
+        }
+
+        [Test]
+        public void DrapeSceneLoadedInCSharpStepsAsTheOneBuilt()
+        {
+            Body body;
+            ColliderId ball;
+            using (var built = Drape.Build(out body, out ball))
+            using (var loaded = World.LoadFile(Drape.Scene))
+            {
+                Assert.AreEqual(built.Tolerances, loaded.Tolerances);
+                Assert.AreEqual(1250.0, loaded.Tolerances.UnitScale);
+                Drape.Step(built, ball, 100);
+                loaded.Step(100);
+                Env.AssertBitIdentical(loaded.GetPositions(), built.GetPositions());
+                var m = loaded.PanelMetrics(body.Id);
+                Assert.AreEqual(m, built.PanelMetrics(body.Id));
+                Assert.AreEqual(PanelMetrics.CurrentVersion, m.Version);
+                Assert.LessOrEqual(m.Thickness.Max, 5e-5);  // the paper's bars at frame 100
+                Assert.LessOrEqual(m.PlanarityTop.Max, 1e-6);
+                Assert.LessOrEqual(m.PlanarityBottom.Max, 1e-6);
+                Assert.LessOrEqual(m.Miter.Max, 1e-3);
+                Assert.AreEqual(16, m.Thickness.Count);
+                Assert.AreEqual(40, m.Miter.Count);
+                Assert.AreEqual(9, m.Conical.Count);
+
+                double[] miter = loaded.VertexErrors(body.Id, PanelMetric.Miter);
+                Assert.AreEqual(128, miter.Length);
+                Assert.AreEqual(m.Miter.Max, miter.Max());
+                Assert.Greater(miter.Max(), 0.0);
+                Assert.AreEqual(Math.Max(m.PlanarityTop.Max, m.PlanarityBottom.Max), loaded.VertexErrors(body.Id, PanelMetric.Planarity).Max());
+                Assert.AreEqual(m.Thickness.Max, loaded.VertexErrors(body.Id, PanelMetric.Thickness).Max());
+                var into = Enumerable.Repeat(7.0, 130).ToArray();
+                Assert.AreSame(into, loaded.VertexErrors(body.Id, PanelMetric.Miter, into));
+                Env.AssertBitIdentical(miter, into.Take(128).ToArray());
+                CollectionAssert.AreEqual(new[] { 7.0, 7.0 }, into.Skip(128));
+            }
+        }
+
+        [Test]
+        public void GridPinsTolerancesAndAMeshOfQuads()
+        {
+            using (var w = new World())
+            {
+                var def = Library.DefaultPanelMeshDef();
+                Assert.AreEqual(PanelMeshDef.CurrentVersion, def.Version);
+                Assert.AreEqual(0.8, def.PanelSize);
+                Assert.AreEqual(1e-3, def.SlideCompliance);
+                Assert.AreEqual(0.3, def.FrictionDynamic);
+                def.GridColumns = 2;
+                def.GridRows = 3;
+                def.Pins = (int)PanelPins.TopAndBottomCorners;
+                var body = w.CreatePanelMesh(def);
+                Assert.AreEqual(0, body.First);
+                Assert.AreEqual(48, body.Count);
+                Assert.AreEqual(48, w.Counts.Particles);
+                Assert.AreEqual(8, w.Counts.Pins);
+                var m = w.PanelMetrics(body.Id);
+                Assert.AreEqual(1, m.WithinTolerance);
+                Assert.AreEqual(2 * 4 + 3 * 3, m.Miter.Count);
+
+                var t = Library.DefaultTolerances();
+                Assert.AreEqual(Tolerances.CurrentVersion, t.Version);
+                Assert.AreEqual(1000.0, t.UnitScale);
+                Assert.AreEqual(5e-5, t.Thickness.Target);
+                Assert.AreEqual(1e-2, t.Miter.Max);
+                Assert.AreEqual(t, w.Tolerances);
+                var custom = t;
+                custom.Miter.Target = 0.5;
+                custom.Miter.Max = 1.0;
+                w.Tolerances = custom;
+                Assert.AreEqual(custom, w.Tolerances);
+
+                // One corner 2 cm off its panel's plane: out of the world's tolerances, within looser ones.
+                var p = w.GetPositions(0, 1);
+                p[2] += 0.02;
+                w.SetPositions(p, 0);
+                var strict = w.PanelMetrics(body.Id);
+                Assert.AreEqual(0, strict.WithinTolerance);
+                Assert.GreaterOrEqual(strict.PlanarityTop.AboveMax, 1);
+                var loose = t;
+                loose.Planarity = loose.PlanarityDistance = loose.Thickness = loose.Miter = new Tolerance { Target = 1.0, Max = 1.0 };
+                var within = w.PanelMetrics(body.Id, loose);
+                Assert.AreEqual(1, within.WithinTolerance);
+                Assert.AreEqual(6, within.PlanarityTop.WithinTarget);
+                Assert.AreEqual(strict.PlanarityTop.Max, within.PlanarityTop.Max);
+
+                var xyz = new double[] { 0, 0, 1, 1, 0, 1, 2, 0, 1, 0, 1, 1, 1, 1, 1, 2, 1, 1 };
+                var quads = new[] { 0, 1, 4, 3, 1, 2, 5, 4 };
+                var thick = Library.DefaultPanelMeshDef();
+                thick.Thickness = 0.05;
+                var two = w.CreatePanelMesh(thick, xyz, quads);
+                Assert.AreEqual(48, two.First);
+                Assert.AreEqual(16, two.Count);
+                Assert.AreEqual(2, w.PanelCount(two.Id));
+                Assert.AreEqual(7, w.PanelMetrics(two.Id).Miter.Count);
+                double[] z = w.GetPositions(two.First, 8).Where((v, i) => i % 3 == 2).ToArray();
+                CollectionAssert.AreEqual(new[] { 1.0, 1.0, 1.0, 1.0 }, z.Take(4));
+                Assert.That(z.Skip(4).All(v => Math.Abs(v - 0.95) < 1e-12));  // the bottom layer 0.05 below
+                Assert.AreEqual(3, w.ExportCuts(two.Id, CutsFormat.Csv).Split(new[] { '\n' }, StringSplitOptions.RemoveEmptyEntries).Length);
+            }
+        }
+
+        static string Snapshot(World w)
+        {
+            var bits = w.GetPositions().Concat(w.GetVelocities()).Select(v => BitConverter.DoubleToInt64Bits(v).ToString("x"));
+            var c = w.Counts;
+            var t = w.Tolerances;
+            return string.Join(",", bits) + "|" + c.Particles + "," + c.Bodies + "," + c.Pins + "," + c.Constraints + "|" +
+                   t.UnitScale.ToString("R") + "," + t.Miter.Target.ToString("R") + "|" + w.SaveJson();
+        }
+
+        [Test]
+        public void RefusedPanelCallsThrowTheCMessageAndChangeNothing()
+        {
+            using (var w = new World())
+            {
+                var body = w.CreatePanelMesh();
+                var plain = w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0 }, new[] { 0, 1, 2 });
+                w.Step(5);
+                string before = Snapshot(w);
+
+                var def = Library.DefaultPanelMeshDef();
+                def.Version = 99;
+                var v = Assert.Throws<EmbraInvalidOperationException>(() => w.CreatePanelMesh(def));
+                Assert.AreEqual(Status.Version, v.Status);
+                StringAssert.StartsWith("embra_panel_mesh_create: ", v.Message);
+                Assert.AreEqual(Errors.LastMessage(), v.Message);
+                def = Library.DefaultPanelMeshDef();
+                def.PanelSize = double.NaN;
+                var nan = Assert.Throws<EmbraArgumentException>(() => w.CreatePanelMesh(def));
+                Assert.That(nan, Is.InstanceOf<ArgumentException>());
+                Assert.AreEqual("embra_panel_mesh_create: panel size must be finite", nan.Message);
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePanelMesh(null, new double[] { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 }, new[] { 0, 1, 2, 9 }));
+                Assert.Throws<ArgumentException>(() => w.CreatePanelMesh(null, new double[] { 0, 0, 0 }, null));  // refused before C
+
+                var missing = new BodyId { Index = 7, Generation = 1 };
+                var stale = Assert.Throws<EmbraInvalidOperationException>(() => w.PanelMetrics(missing));
+                Assert.AreEqual(Status.StaleId, stale.Status);
+                StringAssert.StartsWith("embra_panel_mesh_get_metrics: ", stale.Message);
+                Assert.Throws<EmbraInvalidOperationException>(() => w.PanelCount(missing));
+                Assert.Throws<EmbraInvalidOperationException>(() => w.VertexErrors(missing, PanelMetric.Miter));
+                Assert.Throws<EmbraInvalidOperationException>(() => w.ExportCuts(missing));
+                var notPanels = Assert.Throws<EmbraArgumentException>(() => w.ExportCuts(plain.Id));
+                StringAssert.Contains("not a panel mesh", notPanels.Message);
+                Assert.Throws<EmbraArgumentException>(() => w.VertexErrors(body.Id, (PanelMetric)9));
+                Assert.Throws<EmbraArgumentException>(() => w.ExportCuts(body.Id, (CutsFormat)7));
+
+                var into = Enumerable.Repeat(7.0, 127).ToArray();  // 16 panels: 128 values needed
+                var small = Assert.Throws<EmbraArgumentException>(() => w.VertexErrors(body.Id, PanelMetric.Thickness, into));
+                Assert.AreEqual(Status.BufferTooSmall, small.Status);
+                StringAssert.StartsWith("embra_panel_mesh_get_vertex_errors: buffer holds 127", small.Message);
+                Assert.That(into.All(x => x == 7.0));
+
+                var t = Library.DefaultTolerances();
+                t.Miter.Target = 2.0;  // above its max
+                var bad = Assert.Throws<EmbraArgumentException>(() => w.Tolerances = t);
+                StringAssert.StartsWith("embra_world_set_tolerances: ", bad.Message);
+                t = Library.DefaultTolerances();
+                t.UnitScale = double.NaN;
+                Assert.Throws<EmbraArgumentException>(() => w.PanelMetrics(body.Id, t));
+                Assert.AreEqual(before, Snapshot(w));
+            }
+        }
+    }
+
     [TestFixture]
     public class ThreadTests
     {
@@ -414,7 +715,7 @@ namespace Embra.Tests
             string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
             var declared = new HashSet<string>(Regex.Matches(header, @"EMBRA_API[^;(]*?\b(embra_\w+)\s*\(").Cast<Match>().Select(m => m.Groups[1].Value));
             var bound = new HashSet<string>(typeof(Native).GetMethods(BindingFlags.Public | BindingFlags.Static)
-                .Where(m => m.GetCustomAttributes(typeof(System.Runtime.InteropServices.DllImportAttribute), false).Length > 0)
+                .Where(m => m.GetCustomAttributes(typeof(DllImportAttribute), false).Length > 0)
                 .Select(m => m.Name));
             Assert.Greater(declared.Count, 40);
             CollectionAssert.AreEquivalent(declared, bound);
@@ -436,7 +737,8 @@ namespace Embra.Tests
             var mirrors = new[] {
                 Tuple.Create("ERROR_", typeof(Status)), Tuple.Create("OK", typeof(Status)),
                 Tuple.Create("CONSTRAINT_", typeof(ConstraintKind)), Tuple.Create("COLLIDER_", typeof(ColliderShape)),
-                Tuple.Create("GENERATE_", typeof(Generate)) };
+                Tuple.Create("GENERATE_", typeof(Generate)), Tuple.Create("PANEL_PINS_", typeof(PanelPins)),
+                Tuple.Create("PANEL_METRIC_", typeof(PanelMetric)), Tuple.Create("CUTS_", typeof(CutsFormat)) };
             foreach (var c in constants)
             {
                 var mirror = mirrors.FirstOrDefault(m => c.Key.StartsWith(m.Item1));
@@ -449,11 +751,64 @@ namespace Embra.Tests
                     value = (int)mirror.Item2.GetField(name).GetValue(null);
                 Assert.AreEqual(c.Value, value, "EMBRA_" + c.Key);
             }
-            foreach (Match m in Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_DEF_VERSION\s+(\d+)"))
+            // EMBRA_PANEL_MESH_DEF_VERSION -> PanelMeshDef.CurrentVersion, EMBRA_TOLERANCES_VERSION -> Tolerances...
+            var versions = Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_VERSION\s+(\d+)").Cast<Match>().ToList();
+            Assert.GreaterOrEqual(versions.Count, 10);
+            foreach (Match m in versions)
             {
-                var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value) + "Def");
-                Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_DEF_VERSION");
+                var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value));
+                Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_VERSION");
                 Assert.AreEqual(int.Parse(m.Groups[2].Value), (int)def.GetField("CurrentVersion").GetValue(null));
+            }
+        }
+
+        static string Snake(string pascal)
+        {
+            return Regex.Replace(pascal, "(?<=.)([A-Z])", "_$1").ToLowerInvariant();
+        }
+
+        [Test]
+        public void StructLayoutsMatchTheHeader()
+        {
+            // Every struct of embra.h: the C compiler's sizeof and offsetof against Marshal's, field by field
+            // (C# fields are the C fields in PascalCase).
+            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
+            var structs = Regex.Matches(header, @"typedef struct (embra_(\w+)) \{").Cast<Match>()
+                .ToDictionary(m => m.Groups[1].Value, m => typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[2].Value.ToUpperInvariant())));
+            Assert.GreaterOrEqual(structs.Count, 20);
+            var program = new List<string> { "#include <stddef.h>", "#include <stdio.h>", "#include \"embra/embra.h\"", "int main(void) {" };
+            foreach (var s in structs)
+            {
+                Assert.IsNotNull(s.Value, "no C# struct for " + s.Key);
+                program.Add("  printf(\"" + s.Key + " %zu\\n\", sizeof(" + s.Key + "));");
+                foreach (var f in s.Value.GetFields(BindingFlags.Public | BindingFlags.Instance))
+                    program.Add("  printf(\"" + s.Key + "." + f.Name + " %zu\\n\", offsetof(" + s.Key + ", " + Snake(f.Name) + "));");
+            }
+            program.Add("  return 0;\n}");
+            string dir = Env.TempDir();
+            File.WriteAllLines(Path.Combine(dir, "layout.c"), program);
+            string build = Environment.GetEnvironmentVariable("LD_LIBRARY_PATH").Split(':')[0];  // the build tree
+            Func<string, string, string> run = (file, args) =>
+            {
+                var start = new ProcessStartInfo(file, args) { UseShellExecute = false, RedirectStandardOutput = true };
+                using (var p = Process.Start(start))
+                {
+                    string output = p.StandardOutput.ReadToEnd();
+                    p.WaitForExit();
+                    Assert.AreEqual(0, p.ExitCode, file + " " + args);
+                    return output;
+                }
+            };
+            run("cc", "-I \"" + Path.Combine(Env.Source, "capi", "include") + "\" -I \"" + Path.Combine(build, "generated") +
+                "\" -o \"" + Path.Combine(dir, "layout") + "\" \"" + Path.Combine(dir, "layout.c") + "\"");
+            var c = run(Path.Combine(dir, "layout"), "").Split(new[] { '\n' }, StringSplitOptions.RemoveEmptyEntries)
+                .ToDictionary(line => line.Split(' ')[0], line => int.Parse(line.Split(' ')[1]));
+            Directory.Delete(dir, true);
+            foreach (var s in structs)
+            {
+                Assert.AreEqual(c[s.Key], Marshal.SizeOf(s.Value), "sizeof " + s.Key);
+                foreach (var f in s.Value.GetFields(BindingFlags.Public | BindingFlags.Instance))
+                    Assert.AreEqual(c[s.Key + "." + f.Name], (int)Marshal.OffsetOf(s.Value, f.Name), s.Key + "." + f.Name);
             }
         }
 

@@ -1,5 +1,6 @@
 """The Python adapter covers the whole C ABI, and each part of it does what the header says."""
 
+import ctypes
 import math
 import os
 import re
@@ -237,7 +238,7 @@ def test_every_header_constant_is_mirrored(source_dir):
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         header = f.read()
     constants = dict(re.findall(r"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)", header))
-    constants.update(re.findall(r"#define\s+EMBRA_([A-Z0-9_]+_DEF_VERSION)\s+(\d+)", header))
+    constants.update(re.findall(r"#define\s+EMBRA_([A-Z0-9_]+_VERSION)\s+(\d+)", header))  # defs, tolerances, ...
     assert len(constants) > 30
     for name, value in constants.items():
         assert getattr(_capi, name, None) == int(value), f"EMBRA_{name} = {value} is not mirrored in _capi.py"
@@ -248,3 +249,42 @@ def test_every_header_constant_is_mirrored(source_dir):
     assert sorted(embra.KINDS.values()) == values("CONSTRAINT_")  # the names the World methods accept
     assert sorted(embra.SHAPES.values()) == values("COLLIDER_")
     assert sorted(embra.GENERATE.values()) == values("GENERATE_")
+    assert sorted(embra.PANEL_PINS.values()) == values("PANEL_PINS_")
+    assert sorted(embra.PANEL_METRICS.values()) == values("PANEL_METRIC_")
+    assert sorted(embra.CUTS_FORMATS.values()) == values("CUTS_")
+
+
+def test_struct_layouts_match_the_header(tmp_path, source_dir):
+    """Every ctypes struct has the size and field offsets the C compiler gives its embra.h struct."""
+    import shutil
+    import subprocess
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    structs = {"embra_solver_def": _capi.SolverDef, "embra_world_counts": _capi.WorldCounts,
+               "embra_group_def": _capi.GroupDef, "embra_material": _capi.Material, "embra_body_def": _capi.BodyDef,
+               "embra_constraint_def": _capi.ConstraintDef, "embra_constraint_batch_def": _capi.ConstraintBatchDef,
+               "embra_pin_def": _capi.PinDef, "embra_collider_def": _capi.ColliderDef,
+               "embra_step_report": _capi.StepReport, "embra_group_report": _capi.GroupReport,
+               "embra_warning": _capi.Warning, "embra_panel_mesh_def": _capi.PanelMeshDef,
+               "embra_tolerance": _capi.Tolerance, "embra_tolerances": _capi.Tolerances,
+               "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics}
+    with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
+        declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
+    assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id"} == set(structs)
+    lines = ['#include <stddef.h>', '#include <stdio.h>', '#include "embra/embra.h"', "int main(void) {"]
+    for c_name, cls in structs.items():
+        lines.append(f'  printf("{c_name} %zu\\n", sizeof({c_name}));')
+        for field, _ in cls._fields_:
+            lines.append(f'  printf("{c_name}.{field} %zu\\n", offsetof({c_name}, {field}));')
+    lines += ["  return 0;", "}"]
+    (tmp_path / "layout.c").write_text("\n".join(lines) + "\n")
+    generated = os.path.join(os.path.dirname(_capi.library_path), "generated")  # embra_version.h, in the build tree
+    subprocess.run([cc, "-I", os.path.join(source_dir, "capi", "include"), "-I", generated, "-o",
+                    str(tmp_path / "layout"), str(tmp_path / "layout.c")], check=True)
+    c = dict(line.rsplit(" ", 1) for line in subprocess.run(
+        [str(tmp_path / "layout")], check=True, capture_output=True, text=True).stdout.splitlines())
+    for c_name, cls in structs.items():
+        assert ctypes.sizeof(cls) == int(c[c_name]), c_name
+        for field, _ in cls._fields_:
+            assert getattr(cls, field).offset == int(c[f"{c_name}.{field}"]), f"{c_name}.{field}"
