@@ -78,5 +78,90 @@ TEST(PaperScenes, FlagFlapsPeriodicallyWithBoundedEnergy) {
   EXPECT_LT(*std::max_element(ke.begin(), ke.end()), bound);
 }
 
+// --- Minimal surface ---------------------------------------------------------------------------
+// The catenoid between coaxial rings of radius R at z = +-h/2: r(z) = a cosh(z/a), a cosh(h/2a) = R.
+// For h/R below 1.3255 (where c/a = 1.19968 solves tanh(c/a) = a/c, c = h/2) there are two roots;
+// the wider one is the stable film. Past it there is none, and a soap film's neck collapses.
+
+/// The wider root a of a cosh(h / 2a) = R, or 0 when none exists.
+double catenoid_a(double R, double h) {
+  const double c = 0.5 * h;
+  double lo = c / 1.19967864025773, hi = R;  // f(lo) is the minimum of a cosh(c/a) over a
+  if (lo * std::cosh(c / lo) > R) return 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const double m = 0.5 * (lo + hi);
+    (m * std::cosh(c / m) > R ? hi : lo) = m;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::string with_length(std::string text, const std::string& length) {
+  const std::string key = "\"length\": 0.5";
+  text.replace(text.find(key), key.size(), "\"length\": " + length);
+  return text;
+}
+
+std::string with_mesh(std::string text, const std::string& segments, const std::string& rings) {
+  for (const auto& [key, value] : {std::pair<std::string, std::string>{"\"segments\": 64", "\"segments\": " + segments},
+                                   {"\"rings\": 17", "\"rings\": " + rings}})
+    text.replace(text.find(key), key.size(), value);
+  return text;
+}
+
+// The film settles onto the catenoid: every vertex within 1% of R of a cosh(z/a), and the neck (the
+// smallest radius) within 1% of a; on the scene's mesh (64 segments x 17 rings, near-square
+// triangles) and on a far from conformal one (32 segments x 33 rings, triangles 6:1).
+class SoapFilm : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
+
+TEST_P(SoapFilm, SettlesOntoTheCatenoid) {
+  Scene s;
+  s.world = io::load_scene(with_mesh(read_text(std::string(EMBRA_EXAMPLES_DIR) + "/minimal_surface.json"),
+                                     GetParam().first, GetParam().second),
+                           EMBRA_EXAMPLES_DIR, s.meta);
+  World& w = *s.world;
+  const double R = 0.5, h = 0.5, a = catenoid_a(R, h);
+  int settled_at = -1;
+  for (int f = 0; f < 600 && settled_at < 0; ++f) {
+    s.step();
+    if (w.report().max_speed < 1e-4) settled_at = f + 1;
+  }
+  ASSERT_GT(settled_at, 0) << "did not settle in 600 frames";
+  double worst = 0.0, neck = 1e9;
+  for (const Vec3& x : w.positions()) {
+    const double r = std::hypot(x.x(), x.y());
+    worst = std::max(worst, std::abs(r - a * std::cosh(x.z() / a)));
+    neck = std::min(neck, r);
+  }
+  std::printf(
+      "catenoid h/R = 1, %s x %s: a = %.5f, neck %.5f (%.3f%%), profile max error %.3f%% of R, settled at "
+      "frame %d\n",
+      GetParam().first, GetParam().second, a, neck, 100.0 * (neck - a) / a, 100.0 * worst / R, settled_at);
+  RecordProperty("profile_error_of_R", std::to_string(worst / R));
+  EXPECT_LT(std::abs(neck - a) / a, 0.01);
+  EXPECT_LT(worst / R, 0.01);
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperScenes, SoapFilm,
+                         ::testing::Values(std::pair<const char*, const char*>{"64", "17"},
+                                           std::pair<const char*, const char*>{"32", "33"}));
+
+// Past the critical separation (h/R = 1.4 > 1.3255) no catenoid exists: the neck collapses towards
+// the axis, as a soap film's does, instead of settling.
+TEST(PaperScenes, SoapFilmNeckCollapsesPastTheCriticalSeparation) {
+  ASSERT_EQ(catenoid_a(0.5, 0.7), 0.0);
+  Scene s;
+  s.world = io::load_scene(with_length(read_text(std::string(EMBRA_EXAMPLES_DIR) + "/minimal_surface.json"), "0.7"),
+                           EMBRA_EXAMPLES_DIR, s.meta);
+  double neck = 1e9;
+  int frame = 0;
+  for (; frame < 600 && neck > 0.05; ++frame) {
+    s.step();
+    neck = 1e9;
+    for (const Vec3& x : s.world->positions()) neck = std::min(neck, std::hypot(x.x(), x.y()));
+  }
+  std::printf("catenoid h/R = 1.4: neck %.4f m after %d frames\n", neck, frame);
+  EXPECT_LT(neck, 0.05);  // a tenth of R: collapsed
+}
+
 }  // namespace
 }  // namespace embra::paper
