@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <utility>
 
 namespace embra::paper {
 namespace {
@@ -161,6 +162,89 @@ TEST(PaperScenes, SoapFilmNeckCollapsesPastTheCriticalSeparation) {
   }
   std::printf("catenoid h/R = 1.4: neck %.4f m after %d frames\n", neck, frame);
   EXPECT_LT(neck, 0.05);  // a tenth of R: collapsed
+}
+
+// --- Shrink wrap -------------------------------------------------------------------------------
+
+double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 d = b - a;
+  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * d)).norm();
+}
+
+// The wrap ends on the frame: every vertex is within its half thickness + 2 mm of a column's
+// surface, or spans between the columns (inside the frame's convex hull: the prism through the
+// columns' axes grown by their radius + half thickness + 2 mm); and no vertex is inside a column
+// (nearer its surface than its half thickness - 1 mm). Run as the scene: 360 frames.
+TEST(PaperScenes, ShrinkWrapEndsOnTheFrameAndNeverInsideAMember) {
+  Scene s = load_example("shrink_wrap.json");
+  World& w = *s.world;
+  struct Member {
+    Vec3 a, b;
+    double radius;
+  };
+  std::vector<Member> members;  // capsules and the spheres at the nodes (a = b)
+  double radius = 0.0;          // the capsules' radius
+  for (const Collider& c : w.colliders()) {
+    const Vec3 axis =
+        c.desc.shape == ColliderShape::capsule ? Vec3(c.desc.rotation * Vec3(0, 0, c.desc.half_length)) : Vec3::Zero();
+    members.push_back({c.desc.position - axis, c.desc.position + axis, c.desc.radius});
+    if (c.desc.shape == ColliderShape::capsule) radius = c.desc.radius;
+  }
+  ASSERT_EQ(members.size(), 3u);
+  const double half = 0.5 * w.body(body_named(s, "wrap")).material.thickness, tol = 0.002;
+  // The columns' convex hull: the triangular prism through their axes, grown by their radius.
+  std::vector<std::pair<Vec3, double>> faces;  // outward normal, offset
+  Vec3 centre = Vec3::Zero();
+  for (const Member& m : members) centre += (m.a + m.b) / 6.0;
+  for (size_t k = 0; k < 3; ++k) {
+    const Member &p = members[k], &q = members[(k + 1) % 3];
+    Vec3 n = (q.a - p.a).cross(p.b - p.a).normalized();
+    if (n.dot(p.a - centre) < 0.0) n = -n;
+    faces.push_back({n, n.dot(p.a)});
+  }
+  const Vec3 up = (members[0].b - members[0].a).normalized();
+  faces.push_back({up, up.dot(members[0].b)});
+  faces.push_back({-up, -up.dot(members[0].a)});
+  double volume0 = enclosed_volume(w.positions(), w.body(body_named(s, "wrap")).triangles);
+  for (int f = 0; f < static_cast<int>(s.meta.frames); ++f) s.step();
+  int on_member = 0, spanning = 0, stray = 0;
+  double deepest = 1e9;  // smallest distance to a member's axis minus (radius + half thickness)
+  for (const Vec3& x : w.positions()) {
+    double gap = 1e9;  // to the nearest member's surface
+    for (const Member& m : members) gap = std::min(gap, segment_distance(x, m.a, m.b) - m.radius);
+    deepest = std::min(deepest, gap - half);
+    double outside = -1e9;
+    for (const auto& [n, d] : faces) outside = std::max(outside, n.dot(x) - d);
+    if (gap <= half + tol)
+      ++on_member;
+    else if (outside <= radius + half + tol)
+      ++spanning;
+    else
+      ++stray;
+    if (gap - half < -0.001) {
+      int nearest = 0;
+      double best = 1e9;
+      for (size_t m = 0; m < members.size(); ++m) {
+        const double g = segment_distance(x, members[m].a, members[m].b) - members[m].radius;
+        if (g < best) {
+          best = g;
+          nearest = static_cast<int>(m);
+        }
+      }
+      std::printf("inside a column: x = (%.3f %.3f %.3f) gap %.4f member %d\n", x.x(), x.y(), x.z(), gap, nearest);
+    }
+  }
+  const double volume = enclosed_volume(w.positions(), w.body(body_named(s, "wrap")).triangles);
+  std::printf(
+      "shrink wrap: %d vertices on a member, %d spanning between members, %d elsewhere; deepest %.2e m; "
+      "volume %.4f -> %.4f m^3; speed %.2e m/s\n",
+      on_member, spanning, stray, deepest, volume0, volume, w.report().max_speed);
+  RecordProperty("on_member", on_member);
+  EXPECT_EQ(stray, 0);
+  EXPECT_GT(deepest, -0.001);
+  EXPECT_GT(on_member, 0);
+  EXPECT_TRUE(w.report().settled);
 }
 
 }  // namespace
