@@ -333,5 +333,44 @@ TEST(PaperScenes, DraperySettlesOnTheCubesWithoutInterpenetration) {
   EXPECT_TRUE(w.report().settled);
 }
 
+// --- Bounded growth ----------------------------------------------------------------------------
+
+// The sheet's rest length along u grows to 1.8 times: its area (the sum of its triangles' areas)
+// grows by that factor within 3% although the container is narrower than the grown sheet (it has
+// to fold); after every frame no particle is outside the container (the 0.6 m cube less the half
+// thickness, 0.1 mm tolerance), and at every 60th frame no two triangles intersect. The scene's
+// 420 frames.
+TEST(PaperScenes, BoundedGrowthGainsItsAreaInsideTheContainerWithoutSelfIntersection) {
+  Scene s = load_example("bounded_growth.json");
+  World& w = *s.world;
+  const BodyInfo& sheet = w.body(body_named(s, "sheet"));
+  const double half = 0.5 * sheet.material.thickness;
+  const double area0 = triangle_area_sum(w.positions(), sheet.triangles);
+  double outside = -1e9;  // largest excursion beyond the container's inner faces less the half thickness
+  int64_t crossings = 0;
+  for (int f = 0; f < static_cast<int>(s.meta.frames); ++f) {
+    s.step();
+    for (const Vec3& x : w.positions()) {
+      outside = std::max(
+          {outside, std::abs(x.x()) - 0.3 + half, std::abs(x.y()) - 0.3 + half, half - x.z(), x.z() - 0.6 + half});
+    }
+    if ((f + 1) % 60 == 0) crossings = std::max(crossings, count_self_intersections(w.positions(), sheet.triangles));
+  }
+  const double ratio = triangle_area_sum(w.positions(), sheet.triangles) / area0;
+  double lo = 1e9, hi = -1e9;
+  for (const Vec3& x : w.positions()) {
+    lo = std::min(lo, x.x());
+    hi = std::max(hi, x.x());
+  }
+  std::printf(
+      "bounded growth: area x %.4f (set 1.8), x extent %.3f m of the grown 0.9 m, deepest into the clearance %.2e m, "
+      "%lld intersecting triangle pairs\n",
+      ratio, hi - lo, outside, static_cast<long long>(crossings));
+  EXPECT_NEAR(ratio, 1.8, 0.03 * 1.8);
+  EXPECT_LT(hi - lo, 0.6);   // it cannot lie flat: it folded
+  EXPECT_LT(outside, half);  // inside every wall
+  EXPECT_EQ(crossings, 0);
+}
+
 }  // namespace
 }  // namespace embra::paper
