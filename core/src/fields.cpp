@@ -88,12 +88,18 @@ Id World::create_field(const FieldDesc& desc) {
       check_non_negative(d.pressure.rest_volume, "pressure rest_volume");
       if (!closed_and_oriented(b->triangles))
         invalid("a pressure field needs a closed body: every edge shared by two triangles wound the same way");
-      const double volume = enclosed_volume(x_, b->triangles);
-      if (!(volume > 0.0))
+      // Winding is judged on the body's rest shape (a saved world may be loaded in any state).
+      std::vector<Vec3> rest(x_.size(), Vec3::Zero());
+      for (int32_t i = 0; i < b->particle_count; ++i) rest[b->first_particle + i] = b->rest_positions[i];
+      if (!(enclosed_volume(rest, b->triangles) > 0.0))
         invalid(
             "the body encloses no positive volume (its triangles must wind outwards, counter-clockwise seen "
             "from outside)");
-      if (d.pressure.rest_volume == 0.0) d.pressure.rest_volume = volume;
+      if (d.pressure.rest_volume == 0.0) {
+        const double volume = enclosed_volume(x_, b->triangles);
+        if (!(volume > 0.0)) invalid("rest_volume is 0 and the body encloses no positive volume now");
+        d.pressure.rest_volume = volume;
+      }
       break;
     }
     case FieldKind::surface_tension:
