@@ -113,7 +113,7 @@ std::string with_mesh(std::string text, const std::string& segments, const std::
 // The film settles onto the catenoid: every vertex within 1% of R of a cosh(z/a), and the neck (the
 // smallest radius) within 1% of a; on the scene's mesh (64 segments x 17 rings, near-square
 // triangles) and on a far from conformal one (32 segments x 33 rings, triangles 6:1).
-class SoapFilm : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
+class SoapFilm : public ::testing::TestWithParam<std::pair<std::string, std::string>> {};
 
 TEST_P(SoapFilm, SettlesOntoTheCatenoid) {
   Scene s;
@@ -137,15 +137,19 @@ TEST_P(SoapFilm, SettlesOntoTheCatenoid) {
   std::printf(
       "catenoid h/R = 1, %s x %s: a = %.5f, neck %.5f (%.3f%%), profile max error %.3f%% of R, settled at "
       "frame %d\n",
-      GetParam().first, GetParam().second, a, neck, 100.0 * (neck - a) / a, 100.0 * worst / R, settled_at);
+      GetParam().first.c_str(), GetParam().second.c_str(), a, neck, 100.0 * (neck - a) / a, 100.0 * worst / R,
+      settled_at);
   RecordProperty("profile_error_of_R", std::to_string(worst / R));
   EXPECT_LT(std::abs(neck - a) / a, 0.01);
   EXPECT_LT(worst / R, 0.01);
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperScenes, SoapFilm,
-                         ::testing::Values(std::pair<const char*, const char*>{"64", "17"},
-                                           std::pair<const char*, const char*>{"32", "33"}));
+                         ::testing::Values(std::pair<std::string, std::string>{"64", "17"},
+                                           std::pair<std::string, std::string>{"32", "33"}),
+                         [](const auto& mesh) {
+                           return std::string("segments") + mesh.param.first + "_rings" + mesh.param.second;
+                         });
 
 // Past the critical separation (h/R = 1.4 > 1.3255) no catenoid exists: the neck collapses towards
 // the axis, as a soap film's does, instead of settling.
