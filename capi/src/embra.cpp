@@ -1039,4 +1039,160 @@ embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out
   });
 }
 
+// --- fields ------------------------------------------------------------------------------------
+
+namespace {
+/// The body index a field def names: -1 for {0,0} when `optional`, else a live body (or refused).
+int32_t field_body(const embra_world* world, embra_body_id body, bool optional, const char* def) {
+  const embra::Id id = to_id(body);
+  if (id.is_null()) {
+    if (optional) return -1;
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(def) + ".body is {0,0}: this field needs a body");
+  }
+  world->world.body(id);  // stale: refused
+  return static_cast<int32_t>(id.index);
+}
+
+embra_field_id create_field(embra_world* world, const embra::FieldDesc& d) {
+  return from_id<embra_field_id>(world->world.create_field(d));
+}
+}  // namespace
+
+embra_wind_def embra_default_wind_def(void) {
+  const embra::WindDesc w;
+  embra_wind_def d{};
+  d.version = EMBRA_WIND_DEF_VERSION;
+  for (int k = 0; k < 3; ++k) d.direction[k] = w.direction[k];
+  d.speed = w.speed;
+  d.air_density = w.air_density;
+  d.drag = w.drag;
+  d.lift = w.lift;
+  return d;
+}
+
+embra_status embra_wind_create(embra_world* world, const embra_wind_def* def, embra_field_id* out_field) {
+  return guard("embra_wind_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_field, "out_field");
+    need_version(def->version, EMBRA_WIND_DEF_VERSION, "embra_wind_def");
+    embra::FieldDesc d;
+    d.kind = embra::FieldKind::wind;
+    d.body = field_body(world, def->body, true, "embra_wind_def");
+    d.wind.direction = vec(def->direction);
+    d.wind.speed = def->speed;
+    d.wind.air_density = def->air_density;
+    d.wind.drag = def->drag;
+    d.wind.lift = def->lift;
+    *out_field = create_field(world, d);
+  });
+}
+
+embra_pressure_def embra_default_pressure_def(void) {
+  const embra::PressureDesc p;
+  embra_pressure_def d{};
+  d.version = EMBRA_PRESSURE_DEF_VERSION;
+  d.keep_volume = p.keep_volume;
+  d.inside_pressure = p.inside_pressure;
+  d.outside_pressure = p.outside_pressure;
+  d.volume_compliance = p.volume_compliance;
+  d.rest_volume = p.rest_volume;
+  return d;
+}
+
+embra_status embra_pressure_create(embra_world* world, const embra_pressure_def* def, embra_field_id* out_field) {
+  return guard("embra_pressure_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_field, "out_field");
+    need_version(def->version, EMBRA_PRESSURE_DEF_VERSION, "embra_pressure_def");
+    embra::FieldDesc d;
+    d.kind = embra::FieldKind::pressure;
+    d.body = field_body(world, def->body, false, "embra_pressure_def");
+    d.pressure.keep_volume = def->keep_volume;
+    d.pressure.inside_pressure = def->inside_pressure;
+    d.pressure.outside_pressure = def->outside_pressure;
+    d.pressure.volume_compliance = def->volume_compliance;
+    d.pressure.rest_volume = def->rest_volume;
+    *out_field = create_field(world, d);
+  });
+}
+
+embra_surface_tension_def embra_default_surface_tension_def(void) {
+  const embra::SurfaceTensionDesc t;
+  embra_surface_tension_def d{};
+  d.version = EMBRA_SURFACE_TENSION_DEF_VERSION;
+  d.tension = t.tension;
+  d.regularisation = t.regularisation;
+  return d;
+}
+
+embra_status embra_surface_tension_create(embra_world* world, const embra_surface_tension_def* def,
+                                          embra_field_id* out_field) {
+  return guard("embra_surface_tension_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_field, "out_field");
+    need_version(def->version, EMBRA_SURFACE_TENSION_DEF_VERSION, "embra_surface_tension_def");
+    embra::FieldDesc d;
+    d.kind = embra::FieldKind::surface_tension;
+    d.body = field_body(world, def->body, false, "embra_surface_tension_def");
+    d.surface_tension.tension = def->tension;
+    d.surface_tension.regularisation = def->regularisation;
+    *out_field = create_field(world, d);
+  });
+}
+
+embra_vortex_def embra_default_vortex_def(void) {
+  const embra::VortexDesc v;
+  embra_vortex_def d{};
+  d.version = EMBRA_VORTEX_DEF_VERSION;
+  for (int k = 0; k < 3; ++k) {
+    d.center[k] = v.center[k];
+    d.axis[k] = v.axis[k];
+  }
+  d.strength = v.strength;
+  d.radius = v.radius;
+  d.twist = v.twist;
+  d.decay = v.decay;
+  d.start_time = v.start_time;
+  return d;
+}
+
+embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def, embra_field_id* out_field) {
+  return guard("embra_vortex_create", [&] {
+    need(world, "world");
+    need(def, "def");
+    need(out_field, "out_field");
+    need_version(def->version, EMBRA_VORTEX_DEF_VERSION, "embra_vortex_def");
+    embra::FieldDesc d;
+    d.kind = embra::FieldKind::vortex;
+    d.body = field_body(world, def->body, true, "embra_vortex_def");
+    d.vortex.center = vec(def->center);
+    d.vortex.axis = vec(def->axis);
+    d.vortex.strength = def->strength;
+    d.vortex.radius = def->radius;
+    d.vortex.twist = def->twist;
+    d.vortex.decay = def->decay;
+    d.vortex.start_time = def->start_time;
+    *out_field = create_field(world, d);
+  });
+}
+
+embra_status embra_field_destroy(embra_world* world, embra_field_id field) {
+  return guard("embra_field_destroy", [&] {
+    need(world, "world");
+    world->world.destroy_field(to_id(field));
+    world->meta.field_names.erase(field.index);
+  });
+}
+
+embra_status embra_world_get_field_count(const embra_world* world, int32_t* out_count) {
+  return guard("embra_world_get_field_count", [&] {
+    need(world, "world");
+    need(out_count, "out_count");
+    *out_count = static_cast<int32_t>(world->world.field_count());
+  });
+}
+
 }  // extern "C"

@@ -333,6 +333,7 @@ const char* solver_kernels() {
 }
 
 void World::predict(double h, double alpha) {
+  apply_fields(h, report_.time + alpha * settings_.dt - h);  // fields.cpp
   const Vec3 dv = h * settings_.gravity;
   const size_t n = x_.size();
   for (size_t i = 0; i < n; ++i) {
@@ -816,11 +817,13 @@ void World::step() {
     if (settings_.realign_passes > 0) predicted_ = x_;
     for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
       if (pass > 0) realign(predicted_);
-      for (int it = 0; it < settings_.iterations; ++it)
+      for (int it = 0; it < settings_.iterations; ++it) {
+        project_volumes(h);  // fields.cpp
         for (int32_t slot : order_) {
           Group& g = groups_[slot];
           for (int k = 0; k < g.desc.weight; ++k) project_group(g, h);
         }
+      }
     }
     update_velocities(h);
     const int32_t bad = first_non_finite();

@@ -670,6 +670,121 @@ EMBRA_API embra_status embra_world_save_file(const embra_world* world, const cha
 /* The scene's own frame count ("frames"; 600 for a world not loaded from a scene). */
 EMBRA_API embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out_frames);
 
+/* ---------------------------------------------------------------------------------------------
+ * Fields: forces and whole-body constraints beside gravity (the paper's section 3)
+ *
+ * A field acts in every substep of every step until destroyed. Forces are evaluated at the start of
+ * each substep from the positions and velocities there and change the velocities of movable
+ * particles (as gravity does; hard-pinned and immovable particles are not moved by them). A
+ * pressure field's volume constraint is projected with XPBD before the groups in every pass.
+ * A field's parameters are fixed at creation: destroy it and create another to change them.
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct embra_field_id {
+  uint32_t index;
+  uint32_t generation;
+} embra_field_id;
+
+/* Wind: each triangle of the body (or of every body) feels the air flowing at
+ * `speed` * `direction` relative to the triangle's own velocity u (the mean of its corners'), with
+ * q = 0.5 * air_density * |u|^2 * area and c = cos(angle between u and the triangle's normal n):
+ *   drag = q * drag * |c| * u/|u|              (along the flow, in proportion to the area facing it)
+ *   lift = q * lift * c * (n - c * u/|u|)      (across the flow: a flat plate's normal force, the
+ *                                               part perpendicular to the flow)
+ * a third of each on each corner. Drag and lift against stretch make a flag flap. */
+#define EMBRA_WIND_DEF_VERSION 1
+typedef struct embra_wind_def {
+  int32_t version;     /* EMBRA_WIND_DEF_VERSION */
+  int32_t reserved0;   /* 0 */
+  embra_body_id body;  /* the body whose triangles feel the wind; {0,0} (default) = every body */
+  double direction[3]; /* where the air goes, any length but not zero; default {1, 0, 0} */
+  double speed;        /* m/s, >= 0; default 0 */
+  double air_density;  /* kg/m^3, >= 0; default 1.2 (air at sea level) */
+  double drag;         /* drag coefficient, >= 0; default 1 */
+  double lift;         /* lift coefficient, >= 0; default 1 */
+} embra_wind_def;
+
+EMBRA_API embra_wind_def embra_default_wind_def(void);
+/* Refused for a stale body id, a body without triangles, a zero or non-finite direction, or a
+ * negative or non-finite number. */
+EMBRA_API embra_status embra_wind_create(embra_world* world, const embra_wind_def* def, embra_field_id* out_field);
+
+/* Air pressure on a closed body (every edge shared by two triangles, wound counter-clockwise seen
+ * from outside): each triangle is pushed along its outward normal by
+ * (inside_pressure - outside_pressure) * area, a third on each corner. Inside 0 and a normal
+ * pressure outside sucks a shrink-wrap surface into the concavities of what it wraps. With
+ * keep_volume 1 the enclosed volume V is also held at rest_volume by an XPBD constraint
+ * V - rest_volume + volume_compliance * p = 0 (p the constraint's pressure, Pa). */
+#define EMBRA_PRESSURE_DEF_VERSION 1
+typedef struct embra_pressure_def {
+  int32_t version;          /* EMBRA_PRESSURE_DEF_VERSION */
+  int32_t keep_volume;      /* 0 (default) or 1: hold the enclosed volume at rest_volume */
+  embra_body_id body;       /* required: a closed body */
+  double inside_pressure;   /* Pa (N/m^2), finite; default 0 */
+  double outside_pressure;  /* Pa, finite; default 0 */
+  double volume_compliance; /* m^3/Pa, >= 0; 0 (default) = incompressible */
+  double rest_volume;       /* m^3, >= 0; 0 (default) = the volume the body encloses at creation */
+} embra_pressure_def;
+
+EMBRA_API embra_pressure_def embra_default_pressure_def(void);
+/* Refused for a missing or stale body, a body that is not closed and consistently wound, one that
+ * encloses no positive volume (wound inwards), keep_volume other than 0 or 1, or a negative or
+ * non-finite number. */
+EMBRA_API embra_status embra_pressure_create(embra_world* world, const embra_pressure_def* def,
+                                             embra_field_id* out_field);
+
+/* Surface tension: a soap-film material on a body's triangles. The force on each vertex is
+ * -tension * d(area)/dx, so a settled film between fixed boundaries is a minimal surface whatever
+ * the mesh (edge springs shrunk towards zero minimise the sum of squared edge lengths instead, which
+ * is a minimal surface only on a conformal mesh). Area alone does not care where the vertices sit
+ * on the surface, so a tangential regularisation spaces them: regularisation * tension * (mean of
+ * the neighbours - x), with its component along the vertex normal removed, so it never changes the
+ * shape. Use it without stretch constraints (generate only what else you need) and with damping. */
+#define EMBRA_SURFACE_TENSION_DEF_VERSION 1
+typedef struct embra_surface_tension_def {
+  int32_t version;       /* EMBRA_SURFACE_TENSION_DEF_VERSION */
+  int32_t reserved0;     /* 0 */
+  embra_body_id body;    /* required: a body with triangles */
+  double tension;        /* N/m, >= 0; default 0 */
+  double regularisation; /* dimensionless, >= 0; default 1 */
+} embra_surface_tension_def;
+
+EMBRA_API embra_surface_tension_def embra_default_surface_tension_def(void);
+/* Refused for a missing or stale body, a body without triangles, or a negative or non-finite
+ * number. */
+EMBRA_API embra_status embra_surface_tension_create(embra_world* world, const embra_surface_tension_def* def,
+                                                    embra_field_id* out_field);
+
+/* Vortex: a volumetric torsion field about an axis through `center`. A particle at offset d from
+ * the axis (r = |d|) and height s along it is accelerated (whatever its mass) by
+ *   a = strength * exp(-decay * (t - start_time)) * (1 + twist * s) * exp(-r^2 / radius^2)
+ *       * (axis x d) / radius                      for world time t >= start_time (0 before),
+ * a swirl that fades with distance from the axis, varies along it (twist: torsion) and dies out
+ * over time so the form can settle. */
+#define EMBRA_VORTEX_DEF_VERSION 1
+typedef struct embra_vortex_def {
+  int32_t version;    /* EMBRA_VORTEX_DEF_VERSION */
+  int32_t reserved0;  /* 0 */
+  embra_body_id body; /* the body it acts on; {0,0} (default) = every particle */
+  double center[3];   /* m; default {0, 0, 0} */
+  double axis[3];     /* any length but not zero; right-handed turn; default {0, 0, 1} */
+  double strength;    /* m/s^2, finite (negative turns the other way); default 0 */
+  double radius;      /* m, > 0: radial falloff; default 1 */
+  double twist;       /* 1/m, finite: strength change along the axis; default 0 */
+  double decay;       /* 1/s, >= 0; default 0 (no decay) */
+  double start_time;  /* s of world time, finite; default 0 */
+} embra_vortex_def;
+
+EMBRA_API embra_vortex_def embra_default_vortex_def(void);
+/* Refused for a stale body id, a zero or non-finite axis, radius <= 0, a negative decay or a
+ * non-finite number. */
+EMBRA_API embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def, embra_field_id* out_field);
+
+/* Destroys a field; its id becomes stale. */
+EMBRA_API embra_status embra_field_destroy(embra_world* world, embra_field_id field);
+/* Number of live fields. */
+EMBRA_API embra_status embra_world_get_field_count(const embra_world* world, int32_t* out_count);
+
 #ifdef __cplusplus
 }
 #endif

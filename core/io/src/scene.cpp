@@ -435,6 +435,7 @@ class Builder {
       const Id id = guard(at, [&] { return w.create_collider(d); });
       if (c.contains("name")) name_once(colliders_, meta_.collider_names, c["name"], id, at, "collider");
     });
+    section("fields", [&](const json& f, const std::string& at) { field(w, f, at); });
     section("actions", [&](const json& a, const std::string& at) { action(a, at); });
     if (doc_.contains("tolerances")) meta_.tolerances = doc_["tolerances"].dump();
     return world;
@@ -788,10 +789,47 @@ class Builder {
     meta_.actions.push_back(std::move(act));
   }
 
+  void field(World& w, const json& f, const std::string& at) {
+    const std::string type = f["type"].get<std::string>();
+    FieldDesc d;
+    if (f.contains("body")) d.body = static_cast<int32_t>(named(bodies_, f, "body", at).index);
+    if (type == "wind") {
+      d.kind = FieldKind::wind;
+      if (f.contains("direction")) d.wind.direction = vec3(f["direction"]);
+      d.wind.speed = value_or(f, "speed", d.wind.speed);
+      d.wind.air_density = value_or(f, "air_density", d.wind.air_density);
+      d.wind.drag = value_or(f, "drag", d.wind.drag);
+      d.wind.lift = value_or(f, "lift", d.wind.lift);
+    } else if (type == "pressure") {
+      d.kind = FieldKind::pressure;
+      d.pressure.inside_pressure = value_or(f, "inside_pressure", d.pressure.inside_pressure);
+      d.pressure.outside_pressure = value_or(f, "outside_pressure", d.pressure.outside_pressure);
+      d.pressure.keep_volume = value_or(f, "keep_volume", d.pressure.keep_volume);
+      d.pressure.volume_compliance = value_or(f, "volume_compliance", d.pressure.volume_compliance);
+      d.pressure.rest_volume = value_or(f, "rest_volume", d.pressure.rest_volume);
+    } else if (type == "surface_tension") {
+      d.kind = FieldKind::surface_tension;
+      d.surface_tension.tension = value_or(f, "tension", d.surface_tension.tension);
+      d.surface_tension.regularisation = value_or(f, "regularisation", d.surface_tension.regularisation);
+    } else {
+      d.kind = FieldKind::vortex;
+      if (f.contains("center")) d.vortex.center = vec3(f["center"]);
+      if (f.contains("axis")) d.vortex.axis = vec3(f["axis"]);
+      d.vortex.strength = value_or(f, "strength", d.vortex.strength);
+      d.vortex.radius = value_or(f, "radius", d.vortex.radius);
+      d.vortex.twist = value_or(f, "twist", d.vortex.twist);
+      d.vortex.decay = value_or(f, "decay", d.vortex.decay);
+      d.vortex.start_time = value_or(f, "start_time", d.vortex.start_time);
+    }
+    const Id id = guard(at, [&] { return w.create_field(d); });
+    if (f.contains("name")) name_once(fields_, meta_.field_names, f["name"], id, at, "field");
+  }
+
   const json& doc_;
   std::string base_dir_;
   SceneMeta& meta_;
   std::map<std::string, Id> groups_, bodies_, pins_, colliders_;
+  std::map<std::string, Id> fields_;
   std::set<std::string> seen_groups_;
   std::map<uint32_t, std::map<std::string, std::vector<int32_t>>> sets_;
 };
@@ -1015,6 +1053,49 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     }
   }
   doc["colliders"] = colliders;
+
+  json fields = json::array();
+  for (uint32_t i = 0; i < w.fields().size(); ++i) {
+    const Field& f = w.fields()[i];
+    if (!f.alive) continue;
+    const FieldDesc& d = f.desc;
+    json j;
+    switch (d.kind) {
+      case FieldKind::wind:
+        j = {{"type", "wind"},        {"direction", vec_json(d.wind.direction)},
+             {"speed", d.wind.speed}, {"air_density", d.wind.air_density},
+             {"drag", d.wind.drag},   {"lift", d.wind.lift}};
+        break;
+      case FieldKind::pressure:
+        j = {{"type", "pressure"},
+             {"inside_pressure", d.pressure.inside_pressure},
+             {"outside_pressure", d.pressure.outside_pressure},
+             {"keep_volume", d.pressure.keep_volume},
+             {"volume_compliance", d.pressure.volume_compliance},
+             {"rest_volume", d.pressure.rest_volume}};
+        break;
+      case FieldKind::surface_tension:
+        j = {{"type", "surface_tension"},
+             {"tension", d.surface_tension.tension},
+             {"regularisation", d.surface_tension.regularisation}};
+        break;
+      case FieldKind::vortex:
+        j = {{"type", "vortex"},
+             {"center", vec_json(d.vortex.center)},
+             {"axis", vec_json(d.vortex.axis)},
+             {"strength", d.vortex.strength},
+             {"radius", d.vortex.radius},
+             {"twist", d.vortex.twist},
+             {"decay", d.vortex.decay},
+             {"start_time", d.vortex.start_time}};
+        break;
+    }
+    if (d.body >= 0) j["body"] = bodies[d.body]["name"];
+    const auto named_field = meta.field_names.find(i);
+    if (named_field != meta.field_names.end()) j["name"] = named_field->second;
+    fields.push_back(j);
+  }
+  if (!fields.empty()) doc["fields"] = fields;
 
   json actions = json::array();
   for (const Action& a : meta.actions) {

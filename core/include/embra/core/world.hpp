@@ -8,6 +8,7 @@
 #pragma once
 
 #include "embra/core/constraint_math.hpp"
+#include "embra/core/fields.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -422,10 +423,18 @@ class World {
   const std::vector<Group>& groups() const { return groups_; }
   const std::vector<Pin>& pins() const { return pins_; }
   const std::vector<Collider>& colliders() const { return colliders_; }
+  /// Every field slot, live or not (check `alive`).
+  const std::vector<Field>& fields() const { return fields_; }
   /// Sets the frame counter and simulated time (a saved scene continuing where it stopped).
   void set_clock(int64_t frame, double time);
   void set_positions(int32_t first, std::span<const double> xyz);
   void set_velocities(int32_t first, std::span<const double> xyz);
+
+  // --- fields (fields.hpp) -------------------------------------------------------------------
+  Id create_field(const FieldDesc& desc);
+  void destroy_field(Id id);
+  const Field& field(Id id) const;
+  size_t field_count() const;
 
   // --- stepping --------------------------------------------------------------------------------
   /// Advances one frame of settings().dt. On a non-finite state the world returns to the state it
@@ -456,6 +465,8 @@ class World {
   void update_velocities(double h);
   void measure();
   int32_t first_non_finite() const;
+  void apply_fields(double h, double time);  // fields.cpp: field forces into v_ (movable particles)
+  void project_volumes(double h);            // fields.cpp: the pressure fields' volume constraints
 
   Settings settings_;
   // particle state and per-particle model
@@ -491,6 +502,8 @@ class World {
                                            // bodies changed: rebuild the solver arrays
   StepReport report_;
   Warning warning_;
+  std::vector<Field> fields_;
+  std::vector<Vec3> field_force_;  // scratch: per-particle field force (N)
 };
 
 }  // namespace embra

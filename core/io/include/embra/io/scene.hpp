@@ -43,7 +43,8 @@ struct SceneMeta {
   std::map<uint32_t, std::string> pin_names;
   std::map<uint32_t, std::string> collider_names;
   std::vector<Action> actions;
-  std::string tolerances;  // the tolerance document as JSON text, "" if none
+  std::string tolerances;                       // the tolerance document as JSON text, "" if none
+  std::map<uint32_t, std::string> field_names;  // by field slot (fields without a name are not listed)
 };
 
 /// Parses, validates and builds a scene. `base_dir` resolves relative paths (OBJ meshes).
