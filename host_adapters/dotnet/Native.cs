@@ -45,6 +45,8 @@ namespace Embra
     public struct PinId { public uint Index, Generation; }
     [StructLayout(LayoutKind.Sequential)]
     public struct ColliderId { public uint Index, Generation; }
+    [StructLayout(LayoutKind.Sequential)]
+    public struct FieldId { public uint Index, Generation; }
 
     /// <summary>embra_solver_def (EMBRA_SOLVER_DEF_VERSION 1). Units and defaults: embra.h.</summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -186,6 +188,49 @@ namespace Embra
             DiagonalBottom, Thickness, Miter, Conical;
     }
 
+    /// <summary>embra_wind_def (EMBRA_WIND_DEF_VERSION 1). Units and defaults: embra.h.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct WindDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version, Reserved0;
+        public BodyId Body;
+        public fixed double Direction[3];
+        public double Speed, AirDensity, Drag, Lift;
+    }
+
+    /// <summary>embra_pressure_def (EMBRA_PRESSURE_DEF_VERSION 1). Units and defaults: embra.h.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct PressureDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version, KeepVolume;
+        public BodyId Body;
+        public double InsidePressure, OutsidePressure, VolumeCompliance, RestVolume;
+    }
+
+    /// <summary>embra_surface_tension_def (EMBRA_SURFACE_TENSION_DEF_VERSION 1). Units and defaults: embra.h.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct SurfaceTensionDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version, Reserved0;
+        public BodyId Body;
+        public double Tension, Regularisation;
+    }
+
+    /// <summary>embra_vortex_def (EMBRA_VORTEX_DEF_VERSION 1). Units and defaults: embra.h.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct VortexDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version, Reserved0;
+        public BodyId Body;
+        public fixed double Center[3];
+        public fixed double Axis[3];
+        public double Strength, Radius, Twist, Decay, StartTime;
+    }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct StepReport
     {
@@ -289,5 +334,16 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_save_json(IntPtr world, [Out] byte[] json, long capacity, out long length);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_save_file(IntPtr world, byte[] path);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_scene_frames(IntPtr world, out long frames);
+        // fields
+        [DllImport(Library, CallingConvention = C)] public static extern WindDef embra_default_wind_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_wind_create(IntPtr world, ref WindDef def, out FieldId field);
+        [DllImport(Library, CallingConvention = C)] public static extern PressureDef embra_default_pressure_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_pressure_create(IntPtr world, ref PressureDef def, out FieldId field);
+        [DllImport(Library, CallingConvention = C)] public static extern SurfaceTensionDef embra_default_surface_tension_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_surface_tension_create(IntPtr world, ref SurfaceTensionDef def, out FieldId field);
+        [DllImport(Library, CallingConvention = C)] public static extern VortexDef embra_default_vortex_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_vortex_create(IntPtr world, ref VortexDef def, out FieldId field);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_field_destroy(IntPtr world, FieldId field);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_field_count(IntPtr world, out int count);
     }
 }

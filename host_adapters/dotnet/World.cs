@@ -158,6 +158,10 @@ namespace Embra
         public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
         public static PanelMeshDef DefaultPanelMeshDef() { return Native.embra_default_panel_mesh_def(); }
         public static Tolerances DefaultTolerances() { return Native.embra_default_tolerances(); }
+        public static WindDef DefaultWindDef() { return Native.embra_default_wind_def(); }
+        public static PressureDef DefaultPressureDef() { return Native.embra_default_pressure_def(); }
+        public static SurfaceTensionDef DefaultSurfaceTensionDef() { return Native.embra_default_surface_tension_def(); }
+        public static VortexDef DefaultVortexDef() { return Native.embra_default_vortex_def(); }
         internal static void Touch() { }
     }
 
@@ -549,6 +553,52 @@ namespace Embra
             Three(position, "position");
             Need(rotation != null && rotation.Length == 4, "rotation: a quaternion {w, x, y, z}");
             Call(w => Native.embra_collider_set_transform(w, collider, position, rotation));
+        }
+
+        // --- fields -----------------------------------------------------------------------------
+        /// <summary>A wind field from a def (from Library.DefaultWindDef(), fields set); Body {0,0} =
+        /// every body.</summary>
+        public FieldId CreateWind(WindDef def)
+        {
+            var f = new FieldId();
+            Call(w => Native.embra_wind_create(w, ref def, out f));
+            return f;
+        }
+
+        /// <summary>Air pressure on a closed body and, with KeepVolume 1, its volume held (def from
+        /// Library.DefaultPressureDef(); Body is required).</summary>
+        public FieldId CreatePressure(PressureDef def)
+        {
+            var f = new FieldId();
+            Call(w => Native.embra_pressure_create(w, ref def, out f));
+            return f;
+        }
+
+        /// <summary>A soap-film tension on a body's triangles (def from Library.DefaultSurfaceTensionDef();
+        /// Body is required).</summary>
+        public FieldId CreateSurfaceTension(SurfaceTensionDef def)
+        {
+            var f = new FieldId();
+            Call(w => Native.embra_surface_tension_create(w, ref def, out f));
+            return f;
+        }
+
+        /// <summary>A decaying torsion field about an axis (def from Library.DefaultVortexDef()); Body
+        /// {0,0} = every particle.</summary>
+        public FieldId CreateVortex(VortexDef def)
+        {
+            var f = new FieldId();
+            Call(w => Native.embra_vortex_create(w, ref def, out f));
+            return f;
+        }
+
+        /// <summary>Destroys a field; its id becomes stale.</summary>
+        public void DestroyField(FieldId field) { Call(w => Native.embra_field_destroy(w, field)); }
+
+        /// <summary>The number of live fields.</summary>
+        public int FieldCount
+        {
+            get { int n = 0; Call(w => Native.embra_world_get_field_count(w, out n)); return n; }
         }
 
         // --- stepping and reading back ----------------------------------------------------------

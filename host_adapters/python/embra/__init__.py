@@ -12,9 +12,10 @@ is optional: when installed, arrays go to and from C without copies.
 """
 
 from . import _capi
-from ._capi import (ABI_VERSION, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
-                    GroupId, GroupReport, Material, MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId, SolverDef,
-                    StepReport, Tolerance, Tolerances, WorldCounts, library_path)
+from ._capi import (ABI_VERSION, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
+                    GroupId, GroupReport, Material, MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId,
+                    PressureDef, SolverDef, StepReport, SurfaceTensionDef, Tolerance, Tolerances, VortexDef, WindDef,
+                    WorldCounts, library_path)
 from ._capi import Warning as StepWarning
 from ._buffers import have_numpy
 from .errors import (BufferTooSmallError, EmbraError, InternalError, InvalidArgumentError, LockedError,
@@ -72,16 +73,35 @@ def default_tolerances():
     return _lib.embra_default_tolerances()
 
 
+def default_wind_def():
+    return _lib.embra_default_wind_def()
+
+
+def default_pressure_def():
+    return _lib.embra_default_pressure_def()
+
+
+def default_surface_tension_def():
+    return _lib.embra_default_surface_tension_def()
+
+
+def default_vortex_def():
+    return _lib.embra_default_vortex_def()
+
+
 check_abi()  # these bindings and the loaded library must agree before anything else
 
 __version__ = version_string()
 __all__ = [
     "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
     "last_error_message", "constraint_arity", "default_solver_def", "default_material", "default_panel_mesh_def",
-    "default_tolerances", "have_numpy", "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError",
+    "default_tolerances", "default_wind_def", "default_pressure_def", "default_surface_tension_def",
+    "default_vortex_def", "have_numpy", "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError",
     "StaleIdError", "BufferTooSmallError", "SchemaError", "VersionError", "LockedError", "NumericalError",
     "InternalError", "SolverDef", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef",
-    "ColliderDef", "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "StepReport",
-    "GroupReport", "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "SHAPES", "KINDS",
+    "ColliderDef", "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "WindDef", "PressureDef",
+    "SurfaceTensionDef", "VortexDef", "StepReport",
+    "GroupReport", "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "FieldId",
+    "SHAPES", "KINDS",
     "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
 ]

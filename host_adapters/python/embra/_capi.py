@@ -70,6 +70,10 @@ COLLIDER_DEF_VERSION = 2
 PANEL_MESH_DEF_VERSION = 1
 TOLERANCES_VERSION = 1
 PANEL_METRICS_VERSION = 1
+WIND_DEF_VERSION = 1
+PRESSURE_DEF_VERSION = 1
+SURFACE_TENSION_DEF_VERSION = 1
+VORTEX_DEF_VERSION = 1
 
 _d3 = c_double * 3
 _d4 = c_double * 4
@@ -106,6 +110,10 @@ class PinId(_Id):
 
 class ColliderId(_Id):
     """embra_collider_id."""
+
+
+class FieldId(_Id):
+    """embra_field_id: a wind, pressure, surface tension or vortex field."""
 
 
 class SolverDef(ctypes.Structure):
@@ -203,6 +211,27 @@ class PanelMetrics(ctypes.Structure):
                 ("conical", MetricSummary)]
 
 
+class WindDef(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("reserved0", c_int32), ("body", BodyId), ("direction", _d3),
+                ("speed", c_double), ("air_density", c_double), ("drag", c_double), ("lift", c_double)]
+
+
+class PressureDef(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("keep_volume", c_int32), ("body", BodyId), ("inside_pressure", c_double),
+                ("outside_pressure", c_double), ("volume_compliance", c_double), ("rest_volume", c_double)]
+
+
+class SurfaceTensionDef(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("reserved0", c_int32), ("body", BodyId), ("tension", c_double),
+                ("regularisation", c_double)]
+
+
+class VortexDef(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("reserved0", c_int32), ("body", BodyId), ("center", _d3), ("axis", _d3),
+                ("strength", c_double), ("radius", c_double), ("twist", c_double), ("decay", c_double),
+                ("start_time", c_double)]
+
+
 class Warning(ctypes.Structure):  # noqa: A001 - the C name (embra_warning)
     _fields_ = [("frame", c_int64), ("particle", c_int32), ("reserved0", c_int32)]
 
@@ -287,6 +316,17 @@ PROTOTYPES = {
     "embra_world_save_json": (_status, [_world, _P(c_char), c_int64, _P(c_int64)]),
     "embra_world_save_file": (_status, [_world, c_char_p]),
     "embra_world_get_scene_frames": (_status, [_world, _P(c_int64)]),
+    # fields
+    "embra_default_wind_def": (WindDef, []),
+    "embra_wind_create": (_status, [_world, _P(WindDef), _P(FieldId)]),
+    "embra_default_pressure_def": (PressureDef, []),
+    "embra_pressure_create": (_status, [_world, _P(PressureDef), _P(FieldId)]),
+    "embra_default_surface_tension_def": (SurfaceTensionDef, []),
+    "embra_surface_tension_create": (_status, [_world, _P(SurfaceTensionDef), _P(FieldId)]),
+    "embra_default_vortex_def": (VortexDef, []),
+    "embra_vortex_create": (_status, [_world, _P(VortexDef), _P(FieldId)]),
+    "embra_field_destroy": (_status, [_world, FieldId]),
+    "embra_world_get_field_count": (_status, [_world, _P(c_int32)]),
 }
 
 LIBRARY_ENV = "EMBRA_LIBRARY"

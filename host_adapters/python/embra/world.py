@@ -13,7 +13,7 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 
 from . import _buffers as buf
 from . import _capi
-from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, GroupDef,
+from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
                     GroupId, GroupReport, Material, PanelMetrics, PinDef, PinId, SolverDef, StepReport, Tolerances,
                     Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
@@ -528,6 +528,47 @@ class World:
     def set_collider_transform(self, collider, position, rotation=(1.0, 0.0, 0.0, 0.0)):
         self._call("embra_collider_set_transform", _id(collider, ColliderId, "collider"),
                    buf.d3(position, "position"), buf.d4(rotation, "rotation"))
+
+    # --- fields --------------------------------------------------------------------------------
+    def _create_field(self, default, create, what, fields):
+        d = getattr(lib, default)()
+        _fill(d, fields, what)
+        f = FieldId()
+        self._call(create, byref(d), byref(f))
+        return f
+
+    def create_wind(self, **fields):
+        """A wind field from embra_default_wind_def() and WindDef fields as keywords (body: a Body or
+        BodyId, None = every body; direction, speed, air_density, drag, lift). Returns its FieldId."""
+        return self._create_field("embra_default_wind_def", "embra_wind_create", "WindDef", fields)
+
+    def create_pressure(self, **fields):
+        """Air pressure on a closed body (required: body) and, with keep_volume=1, a held volume:
+        PressureDef fields as keywords (inside_pressure, outside_pressure, volume_compliance,
+        rest_volume). Returns its FieldId."""
+        return self._create_field("embra_default_pressure_def", "embra_pressure_create", "PressureDef", fields)
+
+    def create_surface_tension(self, **fields):
+        """A soap-film tension on a body's triangles (required: body; tension, regularisation).
+        Returns its FieldId."""
+        return self._create_field("embra_default_surface_tension_def", "embra_surface_tension_create",
+                                  "SurfaceTensionDef", fields)
+
+    def create_vortex(self, **fields):
+        """A decaying torsion field about an axis: VortexDef fields as keywords (body, None = every
+        particle; center, axis, strength, radius, twist, decay, start_time). Returns its FieldId."""
+        return self._create_field("embra_default_vortex_def", "embra_vortex_create", "VortexDef", fields)
+
+    def destroy_field(self, field):
+        """Destroys a field; its id becomes stale."""
+        self._call("embra_field_destroy", _id(field, FieldId, "field"))
+
+    @property
+    def field_count(self):
+        """Number of live fields."""
+        n = c_int32()
+        self._call("embra_world_get_field_count", byref(n))
+        return n.value
 
     # --- stepping and reading back -------------------------------------------------------------
     def step(self, frames=1):

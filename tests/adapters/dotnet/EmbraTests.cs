@@ -959,4 +959,288 @@ namespace Embra.Tests
             }
         }
     }
+
+    [TestFixture]
+    public class FieldTests
+    {
+        const int Frames = 40;
+
+        static string Example(string name) { return Path.Combine(Env.Source, "examples", name + ".json"); }
+
+        /// <summary>The scene file's text without its "fields" array (each field an object without braces inside).</summary>
+        static string WithoutFields(string name)
+        {
+            string json = File.ReadAllText(Example(name));
+            string stripped = Regex.Replace(json, @",\s*""fields""\s*:\s*\[\s*\{[^{}]*\}\s*\]", "");
+            Assert.AreNotEqual(json, stripped, name + ": no fields to strip");
+            return stripped;
+        }
+
+        /// <summary>The scene without its fields, loaded here, given its field by `addField` and stepped:
+        /// bit for bit what `embra run` gives for the whole scene; without the field it is not.</summary>
+        static void CheckAgainstCHost(string name, Func<World, FieldId> addField)
+        {
+            StringAssert.DoesNotContain("\"actions\"", File.ReadAllText(Example(name)));  // `embra run` steps as Step does
+            double[] c = Env.Cli("run", Example(name), "--frames", Frames.ToString());
+            using (var w = World.LoadJson(WithoutFields(name)))
+            {
+                Assert.AreEqual(0, w.FieldCount);
+                addField(w);
+                Assert.AreEqual(1, w.FieldCount);
+                w.Step(Frames);
+                Env.AssertBitIdentical(c, w.GetPositions());
+            }
+            using (var w = World.LoadJson(WithoutFields(name)))
+            {
+                w.Step(Frames);
+                double[] still = w.GetPositions();
+                Assert.AreEqual(c.Length, still.Length);
+                Assert.IsFalse(c.Select(BitConverter.DoubleToInt64Bits).SequenceEqual(still.Select(BitConverter.DoubleToInt64Bits)));
+            }
+        }
+
+        [Test]
+        public void FlagInWindMadeInCSharpMatchesTheCHostBitForBit()
+        {
+            CheckAgainstCHost("flag_wind", w =>
+            {
+                var def = Library.DefaultWindDef();
+                unsafe
+                {
+                    def.Direction[0] = 1;
+                    def.Direction[1] = 0.3;
+                    def.Direction[2] = 0;
+                }
+                def.Speed = 6.0;
+                def.AirDensity = 1.2;
+                def.Drag = 1.0;
+                def.Lift = 1.0;
+                return w.CreateWind(def);
+            });
+        }
+
+        [Test]
+        public void SoapFilmMadeInCSharpMatchesTheCHostBitForBit()
+        {
+            CheckAgainstCHost("minimal_surface", w =>
+            {
+                var def = Library.DefaultSurfaceTensionDef();
+                def.Body = new BodyId { Index = 0, Generation = 1 };  // "film", the scene's first body
+                def.Tension = 1.0;
+                def.Regularisation = 1.0;
+                return w.CreateSurfaceTension(def);
+            });
+        }
+
+        [Test]
+        public void TorsionFieldMadeInCSharpMatchesTheCHostBitForBit()
+        {
+            CheckAgainstCHost("interacting_elements", w =>
+            {
+                var def = Library.DefaultVortexDef();
+                unsafe { def.Axis[2] = 1; }
+                def.Strength = 12.0;
+                def.Radius = 0.8;
+                def.Twist = 2.0;
+                def.Decay = 1.5;
+                return w.CreateVortex(def);
+            });
+        }
+
+        static readonly double[] Octahedron = { 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1 };
+        static readonly int[] OctahedronTriangles = { 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5 };
+
+        static World OctahedronWorld(out Body body)
+        {
+            var s = Library.DefaultSolverDef();
+            unsafe { s.Gravity[2] = 0; }
+            s.Substeps = 4;
+            var w = new World(s);
+            var def = Library.DefaultBodyDef();
+            def.Material.Mass = 1.0;
+            def.Material.StretchCompliance = 1e-2;
+            def.Generate = (int)Generate.Stretch;
+            body = w.CreateBody(Octahedron, OctahedronTriangles, def: def);
+            return w;
+        }
+
+        static double Volume(double[] x)
+        {
+            double v = 0;
+            for (int t = 0; t < OctahedronTriangles.Length; t += 3)
+            {
+                int a = 3 * OctahedronTriangles[t], b = 3 * OctahedronTriangles[t + 1], c = 3 * OctahedronTriangles[t + 2];
+                v += (x[a] * (x[b + 1] * x[c + 2] - x[b + 2] * x[c + 1]) - x[a + 1] * (x[b] * x[c + 2] - x[b + 2] * x[c]) +
+                      x[a + 2] * (x[b] * x[c + 1] - x[b + 1] * x[c])) / 6.0;
+            }
+            return v;
+        }
+
+        [Test]
+        public void PressureInflatesAClosedSurfaceAndKeepVolumeHoldsIt()
+        {
+            const double rest = 4.0 / 3.0;  // the unit octahedron
+            Body body;
+            using (var w = OctahedronWorld(out body))
+            {
+                Assert.AreEqual(rest, Volume(w.GetPositions()), 1e-15);
+                var def = Library.DefaultPressureDef();
+                def.Body = body.Id;
+                def.InsidePressure = 50.0;
+                def.OutsidePressure = 10.0;
+                w.CreatePressure(def);
+                w.Step(30);
+                Assert.Greater(Volume(w.GetPositions()), 1.05 * rest);
+            }
+            using (var w = OctahedronWorld(out body))
+            {
+                var def = Library.DefaultPressureDef();
+                def.Body = body.Id;
+                def.InsidePressure = 50.0;
+                def.OutsidePressure = 10.0;
+                def.KeepVolume = 1;
+                w.CreatePressure(def);
+                w.Step(30);
+                Assert.AreEqual(rest, Volume(w.GetPositions()), 1e-4 * rest);  // the free one grew by over 5%
+            }
+        }
+
+        [Test]
+        public void DefaultsAreTheDocumentedOnes()
+        {
+            var wind = Library.DefaultWindDef();
+            Assert.AreEqual(WindDef.CurrentVersion, wind.Version);
+            unsafe { Assert.AreEqual(new[] { 1.0, 0.0, 0.0 }, new[] { wind.Direction[0], wind.Direction[1], wind.Direction[2] }); }
+            Assert.AreEqual(new[] { 0.0, 1.2, 1.0, 1.0 }, new[] { wind.Speed, wind.AirDensity, wind.Drag, wind.Lift });
+            Assert.AreEqual(new BodyId(), wind.Body);
+            var pressure = Library.DefaultPressureDef();
+            Assert.AreEqual(PressureDef.CurrentVersion, pressure.Version);
+            Assert.AreEqual(0, pressure.KeepVolume);
+            Assert.AreEqual(new[] { 0.0, 0.0, 0.0, 0.0 },
+                            new[] { pressure.InsidePressure, pressure.OutsidePressure, pressure.VolumeCompliance, pressure.RestVolume });
+            var tension = Library.DefaultSurfaceTensionDef();
+            Assert.AreEqual(SurfaceTensionDef.CurrentVersion, tension.Version);
+            Assert.AreEqual(new[] { 0.0, 1.0 }, new[] { tension.Tension, tension.Regularisation });
+            var vortex = Library.DefaultVortexDef();
+            Assert.AreEqual(VortexDef.CurrentVersion, vortex.Version);
+            unsafe { Assert.AreEqual(new[] { 0.0, 0.0, 1.0 }, new[] { vortex.Axis[0], vortex.Axis[1], vortex.Axis[2] }); }
+            Assert.AreEqual(new[] { 0.0, 1.0, 0.0, 0.0, 0.0 },
+                            new[] { vortex.Strength, vortex.Radius, vortex.Twist, vortex.Decay, vortex.StartTime });
+        }
+
+        [Test]
+        public void DestroyedFieldStopsActingAndItsIdIsStale()
+        {
+            Body body;
+            using (var w = OctahedronWorld(out body))
+            {
+                var vortex = Library.DefaultVortexDef();
+                vortex.Strength = 3.0;
+                var field = w.CreateVortex(vortex);
+                var wind = Library.DefaultWindDef();
+                wind.Body = body.Id;
+                wind.Speed = 2.0;
+                var other = w.CreateWind(wind);
+                Assert.AreEqual(2, w.FieldCount);
+                Assert.AreNotEqual(field, other);
+                w.DestroyField(field);
+                Assert.AreEqual(1, w.FieldCount);
+                var stale = Assert.Throws<EmbraInvalidOperationException>(() => w.DestroyField(field));
+                Assert.AreEqual(Status.StaleId, stale.Status);
+                StringAssert.StartsWith("embra_field_destroy: ", stale.Message);
+                Assert.AreEqual(Errors.LastMessage(), stale.Message);
+                Assert.AreEqual(1, w.FieldCount);
+                w.DestroyField(other);
+                Assert.AreEqual(0, w.FieldCount);
+                double[] before = w.GetPositions();
+                w.Step(5);  // no field, no gravity, at rest: nothing moves
+                Env.AssertBitIdentical(before, w.GetPositions());
+            }
+        }
+
+        static string Snapshot(World w)
+        {
+            var bits = w.GetPositions().Concat(w.GetVelocities()).Select(v => BitConverter.DoubleToInt64Bits(v).ToString("x"));
+            return string.Join(",", bits) + "|" + w.FieldCount + "|" + w.SaveJson();
+        }
+
+        [Test]
+        public void RefusedFieldCallsThrowTheCMessageAndChangeNothing()
+        {
+            Body body;
+            using (var w = OctahedronWorld(out body))
+            {
+                var breeze = Library.DefaultWindDef();
+                breeze.Body = body.Id;
+                breeze.Speed = 1.0;
+                w.CreateWind(breeze);
+                w.Step(3);
+                string before = Snapshot(w);
+
+                var wind = Library.DefaultWindDef();
+                wind.Version = 99;
+                var v = Assert.Throws<EmbraInvalidOperationException>(() => w.CreateWind(wind));
+                Assert.AreEqual(Status.Version, v.Status);
+                StringAssert.StartsWith("embra_wind_create: ", v.Message);
+                StringAssert.Contains("99", v.Message);
+                Assert.AreEqual(Errors.LastMessage(), v.Message);
+                wind = Library.DefaultWindDef();
+                wind.Speed = double.NaN;
+                var nan = Assert.Throws<EmbraArgumentException>(() => w.CreateWind(wind));
+                Assert.That(nan, Is.InstanceOf<ArgumentException>());
+                StringAssert.StartsWith("embra_wind_create: ", nan.Message);
+                var still = Library.DefaultWindDef();
+                unsafe { still.Direction[0] = 0; }
+                var zero = still;  // a copy the lambda may capture (a fixed buffer's owner may not be)
+                Assert.Throws<EmbraArgumentException>(() => w.CreateWind(zero));
+
+                var pressure = Library.DefaultPressureDef();
+                pressure.Body = body.Id;
+                pressure.InsidePressure = double.NaN;
+                var p = Assert.Throws<EmbraArgumentException>(() => w.CreatePressure(pressure));
+                StringAssert.StartsWith("embra_pressure_create: ", p.Message);
+                pressure.InsidePressure = 0;
+                pressure.KeepVolume = 2;
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePressure(pressure));
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePressure(Library.DefaultPressureDef()));  // no body
+
+                var tension = Library.DefaultSurfaceTensionDef();
+                tension.Body = body.Id;
+                tension.Tension = -1.0;
+                var t = Assert.Throws<EmbraArgumentException>(() => w.CreateSurfaceTension(tension));
+                StringAssert.StartsWith("embra_surface_tension_create: ", t.Message);
+                var vortex = Library.DefaultVortexDef();
+                vortex.Radius = 0.0;
+                var r = Assert.Throws<EmbraArgumentException>(() => w.CreateVortex(vortex));
+                StringAssert.StartsWith("embra_vortex_create: ", r.Message);
+
+                var missing = new BodyId { Index = 7, Generation = 1 };  // out of range: no such body
+                wind = Library.DefaultWindDef();
+                wind.Body = missing;
+                pressure = Library.DefaultPressureDef();
+                pressure.Body = missing;
+                tension = Library.DefaultSurfaceTensionDef();
+                tension.Body = missing;
+                vortex = Library.DefaultVortexDef();
+                vortex.Body = missing;
+                var calls = new Dictionary<string, TestDelegate>
+                {
+                    { "embra_wind_create: ", () => w.CreateWind(wind) },
+                    { "embra_pressure_create: ", () => w.CreatePressure(pressure) },
+                    { "embra_surface_tension_create: ", () => w.CreateSurfaceTension(tension) },
+                    { "embra_vortex_create: ", () => w.CreateVortex(vortex) },
+                    { "embra_field_destroy: ", () => w.DestroyField(new FieldId { Index = 5, Generation = 1 }) },
+                };
+                foreach (var call in calls)
+                {
+                    var stale = Assert.Throws<EmbraInvalidOperationException>(call.Value);
+                    Assert.AreEqual(Status.StaleId, stale.Status, call.Key);
+                    StringAssert.StartsWith(call.Key, stale.Message);
+                }
+                Assert.AreEqual(before, Snapshot(w));
+                w.Dispose();
+                Assert.Throws<EmbraObjectDisposedException>(() => w.FieldCount.ToString());
+            }
+        }
+    }
 }

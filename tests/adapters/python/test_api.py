@@ -268,10 +268,13 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_step_report": _capi.StepReport, "embra_group_report": _capi.GroupReport,
                "embra_warning": _capi.Warning, "embra_panel_mesh_def": _capi.PanelMeshDef,
                "embra_tolerance": _capi.Tolerance, "embra_tolerances": _capi.Tolerances,
-               "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics}
+               "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics,
+               "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
+               "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
-    assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id"} == set(structs)
+    assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",
+                        "embra_field_id"} == set(structs)
     lines = ['#include <stddef.h>', '#include <stdio.h>', '#include "embra/embra.h"', "int main(void) {"]
     for c_name, cls in structs.items():
         lines.append(f'  printf("{c_name} %zu\\n", sizeof({c_name}));')
