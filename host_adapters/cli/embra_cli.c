@@ -505,7 +505,11 @@ static int cmd_run(int argc, char** argv) {
   printf("%-18s %s/final.json, %s/metrics.jsonl\n", "wrote", out, out);
   if (panel_count > 0) {
     if (write_cuts(world, panel_bodies, panel_count, out) != 0 && rc == 0) rc = EXIT_INVALID;
-    printf("%-18s %s/panels_N.json, %s/panels_N.csv (cut lists), %s/final.obj\n", "", out, out, out);
+    if (panel_count == 1)
+      printf("%-18s %s/panels_0.json, %s/panels_0.csv (cut lists), %s/final.obj\n", "", out, out, out);
+    else
+      printf("%-18s %s/panels_0..%d.json and .csv (cut lists, one per panel mesh), %s/final.obj\n", "", out,
+             panel_count - 1, out);
     panel_totals_of(world, panel_bodies, panel_count, &pt);
     embra_tolerances tol;
     embra_world_get_tolerances(world, &tol);
