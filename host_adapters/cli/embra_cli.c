@@ -506,10 +506,10 @@ static int cmd_run(int argc, char** argv) {
   if (panel_count > 0) {
     if (write_cuts(world, panel_bodies, panel_count, out) != 0 && rc == 0) rc = EXIT_INVALID;
     if (panel_count == 1)
-      printf("%-18s %s/panels_0.json, %s/panels_0.csv (cut lists), %s/final.obj\n", "", out, out, out);
+      printf("%-18s %s/panels_%u.json, %s/panels_%u.csv (cut lists), %s/final.obj\n", "", out, panel_bodies[0].index,
+             out, panel_bodies[0].index, out);
     else
-      printf("%-18s %s/panels_0..%d.json and .csv (cut lists, one per panel mesh), %s/final.obj\n", "", out,
-             panel_count - 1, out);
+      printf("%-18s %s/panels_<body>.json and .csv (cut lists, one per panel mesh), %s/final.obj\n", "", out, out);
     panel_totals_of(world, panel_bodies, panel_count, &pt);
     embra_tolerances tol;
     embra_world_get_tolerances(world, &tol);
