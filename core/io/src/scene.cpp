@@ -261,8 +261,13 @@ Mesh closed_mesh(const json& s, const std::string& where) {
   return m;
 }
 
-Mesh obj_mesh(const json& s, const std::string& base_dir, const std::string& where) {
-  Mesh m;
+/// Reads the OBJ file named by s["obj"] (a path relative to base_dir unless absolute; vertices
+/// scaled by s["scale"]): its vertices into `positions`, and every face (0-based vertex indices) to
+/// `on_face(face, at)` with `at` the "file:line: " it came from. Errors name the JSON pointer
+/// `where`/obj and the file's line. Returns the file's path.
+template <class OnFace>
+std::string read_obj(const json& s, const std::string& base_dir, const std::string& where,
+                     std::vector<double>& positions, OnFace&& on_face) {
   const std::string rel = s["obj"].get<std::string>();
   const std::string path = !rel.empty() && rel[0] == '/' ? rel : base_dir + "/" + rel;
   std::ifstream in(path);
@@ -270,37 +275,47 @@ Mesh obj_mesh(const json& s, const std::string& base_dir, const std::string& whe
   const double scale = value_or(s, "scale", 1.0);
   std::string line;
   int64_t line_no = 0;
+  std::vector<int32_t> face;
   while (std::getline(in, line)) {
     ++line_no;
     std::istringstream ls(line);
     std::string tag;
     ls >> tag;
+    const std::string at = path + ":" + std::to_string(line_no) + ": ";
     if (tag == "v") {
       double x, y, z;
       if (!(ls >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
-        fail(where + "/obj", path + ":" + std::to_string(line_no) + ": a vertex needs three finite numbers");
-      m.positions.insert(m.positions.end(), {scale * x, scale * y, scale * z});
+        fail(where + "/obj", at + "a vertex needs three finite numbers");
+      positions.insert(positions.end(), {scale * x, scale * y, scale * z});
     } else if (tag == "f") {
-      std::vector<int32_t> face;
+      face.clear();
       std::string token;
       while (ls >> token) {
         long v = 0;
         try {
           v = std::stol(token.substr(0, token.find('/')));
         } catch (const std::exception&) {
-          fail(where + "/obj", path + ":" + std::to_string(line_no) + ": bad face index '" + token + "'");
+          fail(where + "/obj", at + "bad face index '" + token + "'");
         }
-        const long n = static_cast<long>(m.positions.size() / 3);
+        const long n = static_cast<long>(positions.size() / 3);
         if (v < 0) v = n + v + 1;  // OBJ's relative indices
-        if (v < 1 || v > n)
-          fail(where + "/obj", path + ":" + std::to_string(line_no) + ": face index " + token + " out of range");
+        if (v < 1 || v > n) fail(where + "/obj", at + "face index " + token + " out of range");
         face.push_back(static_cast<int32_t>(v - 1));
       }
-      if (face.size() < 3) fail(where + "/obj", path + ":" + std::to_string(line_no) + ": a face needs 3 vertices");
-      for (size_t k = 1; k + 1 < face.size(); ++k)
-        m.triangles.insert(m.triangles.end(), {face[0], face[k], face[k + 1]});
+      on_face(face, at);
     }
   }
+  return path;
+}
+
+Mesh obj_mesh(const json& s, const std::string& base_dir, const std::string& where) {
+  Mesh m;
+  const std::string path =
+      read_obj(s, base_dir, where, m.positions, [&](const std::vector<int32_t>& face, const std::string& at) {
+        if (face.size() < 3) fail(where + "/obj", at + "a face needs 3 vertices");
+        for (size_t k = 1; k + 1 < face.size(); ++k)
+          m.triangles.insert(m.triangles.end(), {face[0], face[k], face[k + 1]});
+      });
   if (m.positions.empty()) fail(where + "/obj", path + " has no vertices");
   return m;
 }
@@ -654,43 +669,11 @@ class Builder {
       for (const json& q : p["quads"])
         for (const json& v : q) quads.push_back(v.get<int32_t>());
     } else {  // "obj": a quad mesh file
-      const std::string rel = p["obj"].get<std::string>();
-      const std::string path = !rel.empty() && rel[0] == '/' ? rel : base_dir_ + "/" + rel;
-      std::ifstream in(path);
-      if (!in) fail(at + "/obj", "cannot open " + path);
-      const double scale = value_or(p, "scale", 1.0);
-      std::string line;
-      int64_t line_no = 0;
-      while (std::getline(in, line)) {
-        ++line_no;
-        std::istringstream ls(line);
-        std::string tag;
-        ls >> tag;
-        const std::string where = path + ":" + std::to_string(line_no) + ": ";
-        if (tag == "v") {
-          double x, y, z;
-          if (!(ls >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
-            fail(at + "/obj", where + "a vertex needs three finite numbers");
-          positions.insert(positions.end(), {scale * x, scale * y, scale * z});
-        } else if (tag == "f") {
-          std::vector<int32_t> face;
-          std::string token;
-          while (ls >> token) {
-            long v = 0;
-            try {
-              v = std::stol(token.substr(0, token.find('/')));
-            } catch (const std::exception&) {
-              fail(at + "/obj", where + "bad face index '" + token + "'");
-            }
-            const long n = static_cast<long>(positions.size() / 3);
-            if (v < 0) v = n + v + 1;
-            if (v < 1 || v > n) fail(at + "/obj", where + "face index " + token + " out of range");
-            face.push_back(static_cast<int32_t>(v - 1));
-          }
-          if (face.size() != 4) fail(at + "/obj", where + "a panel mesh's faces must be quads (4 vertices)");
-          quads.insert(quads.end(), face.begin(), face.end());
-        }
-      }
+      const std::string path =
+          read_obj(p, base_dir_, at, positions, [&](const std::vector<int32_t>& face, const std::string& line) {
+            if (face.size() != 4) fail(at + "/obj", line + "a panel mesh's faces must be quads (4 vertices)");
+            quads.insert(quads.end(), face.begin(), face.end());
+          });
       if (positions.empty() || quads.empty()) fail(at + "/obj", path + " has no quads");
     }
     PanelMeshDesc d;
