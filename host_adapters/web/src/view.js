@@ -1,0 +1,387 @@
+// The 3D view: every body's triangles over one shared position / colour buffer (updated in place
+// each frame), the colliders moved with each frame's poses, pins as small markers; z is up.
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { ConvexGeometry } from 'three/examples/jsm/geometries/ConvexGeometry.js';
+
+const BACKGROUND = 0xf3f4f6;
+const COLLIDER_COLOR = 0x7f93a8;
+const PIN_COLOR = 0x1f2933;
+const DRAG_COLOR = 0xe8590c;
+const VIEW_DIRECTION = new THREE.Vector3(0.95, -1.35, 0.85).normalize();
+
+/**
+ * The colour attribute holds the page's colours as given (errorColor's sRGB values, exactly);
+ * the fragment shader reads them as sRGB, so a lit face shows the colour function's colour.
+ */
+function srgbVertexColors(material) {
+  material.onBeforeCompile = (shader) => {
+    shader.fragmentShader = shader.fragmentShader.replace(
+      '#include <color_fragment>',
+      '#if defined( USE_COLOR ) || defined( USE_COLOR_ALPHA )\n\tdiffuseColor *= sRGBTransferEOTF( vColor );\n#endif',
+    );
+  };
+  return material;
+}
+
+function colliderGeometry(c, planeSize) {
+  switch (c.shape) {
+    case 'sphere':
+      return new THREE.SphereGeometry(c.radius, 64, 40);
+    case 'box': {
+      const [x, y, z] = c.half_extents;
+      return new THREE.BoxGeometry(2 * x, 2 * y, 2 * z);
+    }
+    case 'capsule': // three's capsule runs along y, embra's along local z
+      return new THREE.CapsuleGeometry(c.radius, 2 * c.half_length, 12, 40).rotateX(Math.PI / 2);
+    case 'plane':
+      return new THREE.PlaneGeometry(planeSize, planeSize, 1, 1);
+    case 'convex': {
+      const points = [];
+      for (let k = 0; k + 2 < c.vertices.length; k += 3) points.push(new THREE.Vector3(c.vertices[k], c.vertices[k + 1], c.vertices[k + 2]));
+      return new ConvexGeometry(points);
+    }
+    case 'mesh': {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.Float32BufferAttribute(c.vertices, 3));
+      g.setIndex(c.triangles);
+      g.computeVertexNormals();
+      return g;
+    }
+    default:
+      return null;
+  }
+}
+
+export class View {
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+    this.renderer.setClearColor(BACKGROUND);
+    this.canvas = this.renderer.domElement;
+    container.appendChild(this.canvas);
+
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(35, 1, 0.01, 1000);
+    this.camera.up.set(0, 0, 1);
+    this.camera.position.set(4, -6, 4);
+    this.controls = new OrbitControls(this.camera, this.canvas);
+    this.controls.enableDamping = true;
+    this.controls.dampingFactor = 0.15;
+    this.controls.addEventListener('change', () => { this.dirty = true; });
+
+    // Light that shows folds: a soft sky / ground fill, a key light from the front left and above,
+    // a weaker rim light from behind on the right.
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x9a948a, 1.25));
+    this.key = new THREE.DirectionalLight(0xffffff, 2.1);
+    this.key.position.set(-1.2, -2.0, 3.0);
+    this.scene.add(this.key);
+    this.rim = new THREE.DirectionalLight(0xffffff, 0.7);
+    this.rim.position.set(2.0, 2.5, 1.2);
+    this.scene.add(this.rim);
+
+    this.grid = null;
+    this.bodyGroup = new THREE.Group();
+    this.colliderGroup = new THREE.Group();
+    this.pinGroup = new THREE.Group();
+    this.scene.add(this.bodyGroup, this.colliderGroup, this.pinGroup);
+
+    this.dragMarker = new THREE.Mesh(new THREE.SphereGeometry(1, 20, 14), new THREE.MeshBasicMaterial({ color: DRAG_COLOR }));
+    this.dragLine = new THREE.Line(new THREE.BufferGeometry().setAttribute('position', new THREE.Float32BufferAttribute(6, 3)),
+      new THREE.LineBasicMaterial({ color: DRAG_COLOR }));
+    this.hoverMarker = new THREE.Mesh(new THREE.SphereGeometry(1, 16, 10), new THREE.MeshBasicMaterial({ color: 0x111111 }));
+    this.dragMarker.visible = this.dragLine.visible = this.hoverMarker.visible = false;
+    this.scene.add(this.dragMarker, this.dragLine, this.hoverMarker);
+
+    this.raycaster = new THREE.Raycaster();
+    this.particles = 0;
+    this.meshes = [];
+    this.colliders = [];
+    this.pins = [];
+    this.markerSize = 0.02;
+    this.framed = false;
+    this.heldCollider = -1;
+    this.drag = null;
+    this.dirty = true;
+
+    this.resize();
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  resize() {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    if (w === 0 || h === 0) return;
+    this.renderer.setSize(w, h, false);
+    this.canvas.style.width = `${w}px`;
+    this.canvas.style.height = `${h}px`;
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.dirty = true;
+  }
+
+  /** Builds the bodies, colliders and pins of a scene message (replacing any previous scene). */
+  setScene(scene) {
+    for (const group of [this.bodyGroup, this.colliderGroup, this.pinGroup]) {
+      for (const child of [...group.children]) {
+        group.remove(child);
+        child.traverse((o) => { o.geometry?.dispose(); o.material?.dispose(); });
+      }
+    }
+    const n = scene.particles;
+    this.particles = n;
+    this.position = new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
+    this.color = new THREE.BufferAttribute(new Float32Array(3 * n).fill(0.8), 3).setUsage(THREE.DynamicDrawUsage);
+    this.meshes = scene.bodies.map((body) => {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', this.position);
+      geometry.setAttribute('color', this.color);
+      geometry.setIndex(new (n > 65535 ? THREE.Uint32BufferAttribute : THREE.Uint16BufferAttribute)(body.triangles, 1));
+      // Panels are planar: flat shading shows every fold between them; cloth is shaded smooth.
+      const material = srgbVertexColors(new THREE.MeshStandardMaterial({
+        vertexColors: true, side: THREE.DoubleSide, flatShading: !!body.panel_mesh,
+        roughness: 0.62, metalness: 0.0,
+        polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+      }));
+      const mesh = new THREE.Mesh(geometry, material);
+      mesh.userData.body = body.index;
+      mesh.userData.smooth = !body.panel_mesh;
+      this.bodyGroup.add(mesh);
+      return mesh;
+    });
+
+    this.colliders = scene.colliders.map((c) => {
+      const geometry = colliderGeometry(c, 1);
+      const plane = c.shape === 'plane';
+      const material = new THREE.MeshStandardMaterial({
+        color: COLLIDER_COLOR, roughness: 0.85, metalness: 0,
+        transparent: true, opacity: plane ? 0.16 : 0.42, depthWrite: false,
+        side: plane || c.shape === 'mesh' ? THREE.DoubleSide : THREE.FrontSide,
+      });
+      const object = new THREE.Mesh(geometry || new THREE.BufferGeometry(), material);
+      object.renderOrder = 1; // after the opaque bodies
+      object.userData.collider = c.index;
+      object.userData.plane = plane;
+      if (!plane && geometry) {
+        const edges = new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 30),
+          new THREE.LineBasicMaterial({ color: 0x5b6b7c, transparent: true, opacity: 0.5 }));
+        if (c.shape !== 'sphere' && c.shape !== 'capsule') object.add(edges);
+      }
+      this.setPose(object, c.position, c.rotation);
+      this.colliderGroup.add(object);
+      return object;
+    });
+
+    this.pins = scene.pins.map((pin) => {
+      const marker = new THREE.Mesh(new THREE.SphereGeometry(1, 16, 10), new THREE.MeshBasicMaterial({ color: PIN_COLOR }));
+      marker.userData.particle = pin.particle;
+      this.pinGroup.add(marker);
+      return marker;
+    });
+    this.dirty = true;
+  }
+
+  setPose(object, p, q) {
+    object.position.set(p[0], p[1], p[2]);
+    object.quaternion.set(q[1], q[2], q[3], q[0]).normalize(); // embra: w x y z
+    object.updateMatrixWorld(true);
+  }
+
+  /** One frame: positions (3N floats) and collider poses (7C floats: x y z, w qx qy qz). */
+  setFrame(positions, poses) {
+    if (!this.position || positions.length !== 3 * this.particles) return;
+    this.position.array.set(positions);
+    this.position.needsUpdate = true;
+    for (const mesh of this.meshes) {
+      if (mesh.userData.smooth) mesh.geometry.computeVertexNormals();
+      mesh.geometry.boundingSphere = null; // recomputed for culling and picking
+      mesh.geometry.boundingBox = null;
+    }
+    if (poses) {
+      this.colliders.forEach((object, c) => {
+        if (c === this.heldCollider || poses.length < 7 * (c + 1)) return;
+        const o = 7 * c;
+        this.setPose(object, [poses[o], poses[o + 1], poses[o + 2]], [poses[o + 3], poses[o + 4], poses[o + 5], poses[o + 6]]);
+      });
+    }
+    for (const marker of this.pins) marker.position.fromArray(positions, 3 * marker.userData.particle);
+    this.updateDragLine();
+    this.dirty = true;
+  }
+
+  /** Vertex colours: a function from particle index to [r, g, b] (errorColor's values, sRGB). */
+  setColors(colorOf) {
+    if (!this.color) return;
+    const a = this.color.array;
+    for (let i = 0; i < this.particles; i++) {
+      const c = colorOf(i);
+      a[3 * i] = c[0];
+      a[3 * i + 1] = c[1];
+      a[3 * i + 2] = c[2];
+    }
+    this.color.needsUpdate = true;
+    this.dirty = true;
+  }
+
+  setPinsVisible(on) {
+    this.pinGroup.visible = on;
+    this.dirty = true;
+  }
+
+  particle(i, out = new THREE.Vector3()) {
+    return out.fromArray(this.position.array, 3 * i);
+  }
+
+  /** Frames the camera on the bodies and colliders (planes excepted), looking down from the south east. */
+  frameAll() {
+    const box = new THREE.Box3();
+    const p = new THREE.Vector3();
+    for (let i = 0; i < this.particles; i++) {
+      if (Number.isFinite(this.position.array[3 * i])) box.expandByPoint(this.particle(i, p));
+    }
+    for (const object of this.colliders) {
+      if (!object.userData.plane) box.expandByObject(object);
+    }
+    if (box.isEmpty()) return;
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const radius = Math.max(sphere.radius, 1e-3);
+    const vfov = THREE.MathUtils.degToRad(this.camera.fov);
+    const hfov = 2 * Math.atan(Math.tan(vfov / 2) * this.camera.aspect);
+    const distance = (radius / Math.sin(Math.min(vfov, hfov) / 2)) * 0.92;
+    this.controls.target.copy(sphere.center);
+    this.camera.position.copy(sphere.center).addScaledVector(VIEW_DIRECTION, distance);
+    this.camera.near = distance / 200;
+    this.camera.far = distance * 50;
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+
+    this.markerSize = radius * 0.018;
+    for (const marker of [...this.pins, this.dragMarker]) marker.scale.setScalar(this.markerSize);
+    this.hoverMarker.scale.setScalar(this.markerSize * 0.7);
+    this.colliders.forEach((object) => {
+      if (object.userData.plane) object.scale.setScalar(radius * 8);
+    });
+
+    if (this.grid) {
+      this.scene.remove(this.grid);
+      this.grid.geometry.dispose();
+      this.grid.material.dispose();
+    }
+    const step = 10 ** Math.floor(Math.log10(radius / 2));
+    const divisions = Math.min(200, Math.ceil((radius * 6) / step));
+    this.grid = new THREE.GridHelper(divisions * step, divisions, 0xc3c8cf, 0xdde0e4);
+    this.grid.rotation.x = Math.PI / 2; // into the xy plane
+    this.grid.position.set(sphere.center.x, sphere.center.y, box.min.z - radius * 0.01);
+    this.grid.material.transparent = true;
+    this.grid.material.opacity = 0.8;
+    this.scene.add(this.grid);
+    this.framed = true;
+    this.dirty = true;
+  }
+
+  ndc(clientX, clientY) {
+    const rect = this.canvas.getBoundingClientRect();
+    return new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+  }
+
+  ray(clientX, clientY) {
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    return this.raycaster.ray;
+  }
+
+  /** The particle nearest the hit point of the body triangle under the cursor, or null. */
+  pickParticle(clientX, clientY) {
+    this.ray(clientX, clientY);
+    const hit = this.raycaster.intersectObjects(this.meshes, false)[0];
+    if (!hit || !hit.face) return null;
+    let best = null;
+    let bestDistance = Infinity;
+    const p = new THREE.Vector3();
+    for (const i of [hit.face.a, hit.face.b, hit.face.c]) {
+      const d = this.particle(i, p).distanceToSquared(hit.point);
+      if (d < bestDistance) {
+        bestDistance = d;
+        best = i;
+      }
+    }
+    return { particle: best, point: hit.point.clone() };
+  }
+
+  /** The collider under the cursor: its index and the hit point, or null. */
+  pickCollider(clientX, clientY) {
+    this.ray(clientX, clientY);
+    const hit = this.raycaster.intersectObjects(this.colliders, false)[0];
+    return hit ? { index: hit.object.userData.collider, point: hit.point.clone() } : null;
+  }
+
+  /** The plane through `point` facing the camera. */
+  cameraPlane(point) {
+    const normal = this.camera.getWorldDirection(new THREE.Vector3()).negate();
+    return new THREE.Plane().setFromNormalAndCoplanarPoint(normal, point);
+  }
+
+  /** Where the cursor's ray meets `plane`, or null. */
+  onPlane(clientX, clientY, plane) {
+    return this.ray(clientX, clientY).intersectPlane(plane, new THREE.Vector3());
+  }
+
+  moveCollider(index, position) {
+    const object = this.colliders[index];
+    if (!object) return;
+    object.position.copy(position);
+    object.updateMatrixWorld(true);
+    this.dirty = true;
+  }
+
+  colliderPosition(index) {
+    return this.colliders[index]?.position.clone();
+  }
+
+  colliderRotation(index) {
+    const q = this.colliders[index]?.quaternion;
+    return q ? [q.w, q.x, q.y, q.z] : [1, 0, 0, 0];
+  }
+
+  /** The drag feedback: a marker at the target and a line from the particle; null hides it. */
+  showDrag(particle, target) {
+    const on = particle !== null && target !== null;
+    this.drag = on ? { particle, target: target.clone() } : null;
+    this.dragMarker.visible = this.dragLine.visible = on;
+    if (on) this.dragMarker.position.copy(target);
+    this.updateDragLine();
+    this.dirty = true;
+  }
+
+  updateDragLine() {
+    if (!this.drag) return;
+    const line = this.dragLine.geometry.attributes.position;
+    const p = this.particle(this.drag.particle);
+    const t = this.drag.target;
+    line.setXYZ(0, p.x, p.y, p.z);
+    line.setXYZ(1, t.x, t.y, t.z);
+    line.needsUpdate = true;
+    this.dragLine.geometry.computeBoundingSphere();
+  }
+
+  showHover(particle) {
+    this.hoverMarker.visible = particle !== null;
+    if (particle !== null) this.particle(particle, this.hoverMarker.position);
+    this.dirty = true;
+  }
+
+  /** A particle's page pixel coordinates. */
+  screenOf(i) {
+    const p = this.particle(i).project(this.camera);
+    const rect = this.canvas.getBoundingClientRect();
+    return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
+  }
+
+  /** Called every animation frame: renders when something changed. */
+  tick() {
+    if (this.controls.update()) this.dirty = true;
+    if (!this.dirty) return;
+    this.renderer.render(this.scene, this.camera);
+    this.dirty = false;
+  }
+}
