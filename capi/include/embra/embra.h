@@ -202,6 +202,21 @@ typedef struct embra_world_counts {
 
 EMBRA_API embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts);
 
+/* The ids of the live objects of one kind, in creation order: for a world loaded from a scene, the
+ * order of the scene's arrays (groups: "default" and "contacts" first, then the scene's; a panel
+ * mesh's body and pins after the scene's bodies and pins, as saved), so a host that reads the scene
+ * JSON (embra_world_save_json) pairs its entries with these ids. Two-call pattern: out NULL and
+ * capacity 0 only write *out_count; too small a buffer is EMBRA_ERROR_BUFFER_TOO_SMALL, nothing
+ * written. Capacity and *out_count are in ids. */
+EMBRA_API embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out, int32_t capacity,
+                                              int32_t* out_count);
+EMBRA_API embra_status embra_world_get_groups(const embra_world* world, embra_group_id* out, int32_t capacity,
+                                              int32_t* out_count);
+EMBRA_API embra_status embra_world_get_pins(const embra_world* world, embra_pin_id* out, int32_t capacity,
+                                            int32_t* out_count);
+EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra_collider_id* out, int32_t capacity,
+                                                 int32_t* out_count);
+
 /* ---------------------------------------------------------------------------------------------
  * Groups: the paper's "preferred order of evaluation" and "importance weight"
  *
@@ -380,6 +395,8 @@ EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. */
 EMBRA_API embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]);
 EMBRA_API embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]);
+/* The particle a pin holds. */
+EMBRA_API embra_status embra_pin_get_particle(const embra_world* world, embra_pin_id pin, int32_t* out_particle);
 
 /* ---------------------------------------------------------------------------------------------
  * Colliders: rigid shapes the host places and moves between steps
@@ -435,6 +452,11 @@ EMBRA_API embra_status embra_collider_destroy(embra_world* world, embra_collider
  * over the substeps, and particles it drags take its velocity through friction. */
 EMBRA_API embra_status embra_collider_set_transform(embra_world* world, embra_collider_id collider,
                                                     const double position[3], const double rotation[4]);
+/* Where the collider is now: the pose it reached at the end of the last step (before any step, or
+ * after embra_collider_set_transform, the pose it will reach at the end of the next one). The
+ * rotation is a unit quaternion {w, x, y, z}. Scene actions that move a collider show here. */
+EMBRA_API embra_status embra_collider_get_transform(const embra_world* world, embra_collider_id collider,
+                                                    double out_position[3], double out_rotation[4]);
 
 /* ---------------------------------------------------------------------------------------------
  * Stepping and reading back
