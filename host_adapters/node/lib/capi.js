@@ -240,6 +240,15 @@ const PROTOTYPES = {
   embra_world_set_solver: `embra_status embra_world_set_solver(${W}, const embra_solver_def *def)`,
   embra_world_set_gravity: `embra_status embra_world_set_gravity(${W}, const double *gravity)`,
   embra_world_get_counts: `embra_status embra_world_get_counts(${CW}, _Out_ embra_world_counts *out_counts)`,
+  // ids of live objects: `out` is a Uint32Array of 2 * capacity values (index, generation per id)
+  embra_world_get_bodies: `embra_status embra_world_get_bodies(${CW}, embra_body_id *out, int32_t capacity,
+    _Out_ int32_t *out_count)`,
+  embra_world_get_groups: `embra_status embra_world_get_groups(${CW}, embra_group_id *out, int32_t capacity,
+    _Out_ int32_t *out_count)`,
+  embra_world_get_pins: `embra_status embra_world_get_pins(${CW}, embra_pin_id *out, int32_t capacity,
+    _Out_ int32_t *out_count)`,
+  embra_world_get_colliders: `embra_status embra_world_get_colliders(${CW}, embra_collider_id *out,
+    int32_t capacity, _Out_ int32_t *out_count)`,
   // groups
   embra_default_group_def: 'embra_group_def embra_default_group_def(void)',
   embra_group_create:
@@ -272,6 +281,8 @@ const PROTOTYPES = {
   embra_pin_destroy: `embra_status embra_pin_destroy(${W}, embra_pin_id pin)`,
   embra_pin_set_target: `embra_status embra_pin_set_target(${W}, embra_pin_id pin, const double *target)`,
   embra_pin_get_target: `embra_status embra_pin_get_target(${CW}, embra_pin_id pin, double *out_target)`,
+  embra_pin_get_particle:
+    `embra_status embra_pin_get_particle(${CW}, embra_pin_id pin, _Out_ int32_t *out_particle)`,
   // colliders
   embra_default_collider_def: 'embra_collider_def embra_default_collider_def(void)',
   embra_collider_create: `embra_status embra_collider_create(${W}, const embra_collider_def *def,
@@ -279,6 +290,8 @@ const PROTOTYPES = {
   embra_collider_destroy: `embra_status embra_collider_destroy(${W}, embra_collider_id collider)`,
   embra_collider_set_transform: `embra_status embra_collider_set_transform(${W}, embra_collider_id collider,
     const double *position, const double *rotation)`,
+  embra_collider_get_transform: `embra_status embra_collider_get_transform(${CW}, embra_collider_id collider,
+    double *out_position, double *out_rotation)`,
   // stepping and reading back
   embra_world_step: `embra_status embra_world_step(${W})`,
   embra_world_get_report: `embra_status embra_world_get_report(${CW}, _Out_ embra_step_report *out_report)`,

@@ -291,6 +291,37 @@ class World {
     return this.counts().particles;
   }
 
+  /** Ids of the live objects of one kind, in creation order (two calls: count, then ids). */
+  #ids(name, cls) {
+    const n = [0];
+    this.#call(name, null, 0, n);
+    const out = new Uint32Array(2 * n[0]);
+    this.#call(name, out, n[0], n);
+    const ids = [];
+    for (let k = 0; k < n[0]; k++) ids.push(new cls(out[2 * k], out[2 * k + 1]));
+    return ids;
+  }
+
+  /** The BodyIds of the live bodies, in creation order (a loaded scene's: in the scene's order). */
+  bodies() {
+    return this.#ids('embra_world_get_bodies', BodyId);
+  }
+
+  /** The GroupIds of the live groups, the default and contact groups first. */
+  groups() {
+    return this.#ids('embra_world_get_groups', GroupId);
+  }
+
+  /** The PinIds of the live pins, in creation order. */
+  pins() {
+    return this.#ids('embra_world_get_pins', PinId);
+  }
+
+  /** The ColliderIds of the live colliders, in creation order. */
+  colliders() {
+    return this.#ids('embra_world_get_colliders', ColliderId);
+  }
+
   // --- groups -------------------------------------------------------------------------------------
 
   /** A constraint group: {order (lower first; default 0), weight (projections per pass; default 1)}. */
@@ -604,6 +635,13 @@ class World {
     return Array.from(out);
   }
 
+  /** The particle a pin holds. */
+  pinParticle(pin) {
+    const p = [0];
+    this.#call('embra_pin_get_particle', toId(pin, PinId, 'pin'), p);
+    return p[0];
+  }
+
   // --- colliders ----------------------------------------------------------------------------------
 
   /**
@@ -642,6 +680,14 @@ class World {
   setColliderTransform(collider, position, rotation = [1.0, 0.0, 0.0, 0.0]) {
     this.#call('embra_collider_set_transform', toId(collider, ColliderId, 'collider'),
       Float64Array.from(buf.fixed(position, 3, 'position')), Float64Array.from(buf.fixed(rotation, 4, 'rotation')));
+  }
+
+  /** Where the collider is now: {position: [x, y, z] (m), rotation: [w, x, y, z]}. */
+  colliderTransform(collider) {
+    const position = new Float64Array(3);
+    const rotation = new Float64Array(4);
+    this.#call('embra_collider_get_transform', toId(collider, ColliderId, 'collider'), position, rotation);
+    return { position: Array.from(position), rotation: Array.from(rotation) };
   }
 
   // --- fields -------------------------------------------------------------------------------------

@@ -136,6 +136,37 @@ test('colliders hold a falling particle and carry it when moved', () => {
   w.close();
 });
 
+test('live ids in creation order, a pin\'s particle, a collider\'s pose', () => {
+  const w = new embra.World({ gravity: [0, 0, 0] });
+  const ids = (list) => list.map(String);
+  assert.deepEqual(ids(w.groups()), ids([w.defaultGroup(), w.contactGroup()]));
+  assert.deepEqual(w.bodies(), []);
+  const a = w.createBody([[0, 0, 0], [1, 0, 0]], { edges: [[0, 1]], mass: 1.0 });
+  const b = w.createBody([[0, 0, 1]], { mass: 1.0 });
+  const g = w.createGroup({ order: 3 });
+  assert.deepEqual(ids(w.bodies()), ids([a.id, b.id]));
+  assert.ok(w.bodies()[1] instanceof embra.BodyId);
+  assert.deepEqual(ids(w.groups()), ids([w.defaultGroup(), w.contactGroup(), g]));
+  const pins = [w.createPin(1, [1, 0, 0]), w.createPin(2, [0, 0, 1]), w.createPin(0, [0, 0, 0])];
+  assert.deepEqual(pins.map((p) => w.pinParticle(p)), [1, 2, 0]);
+  w.destroyPin(pins[1]);
+  assert.deepEqual(ids(w.pins()), ids([pins[0], pins[2]]));
+  const ball = w.createCollider('sphere', { position: [0, 0, -3], radius: 0.5 });
+  const box = w.createCollider('box', { position: [4, 0, 0], rotation: [0, 0, 0, 1] });
+  assert.deepEqual(ids(w.colliders()), ids([ball, box]));
+  assert.deepEqual(w.colliderTransform(ball), { position: [0, 0, -3], rotation: [1, 0, 0, 0] });
+  assert.deepEqual(w.colliderTransform(box), { position: [4, 0, 0], rotation: [0, 0, 0, 1] });
+  w.setColliderTransform(ball, [0, 1, -3]); // the pose it reaches at the end of the next step
+  assert.deepEqual(w.colliderTransform(ball).position, [0, 1, -3]);
+  w.step();
+  assert.deepEqual(w.colliderTransform(ball), { position: [0, 1, -3], rotation: [1, 0, 0, 0] });
+  w.destroyCollider(ball);
+  assert.deepEqual(ids(w.colliders()), ids([box]));
+  w.destroyGroup(g);
+  assert.equal(w.groups().length, 2);
+  w.close();
+});
+
 test('rest scale shrinks edges', () => {
   const w = new embra.World({ gravity: [0, 0, 0], iterations: 10 });
   const body = w.createBody([[0, 0, 0], [1, 0, 0]], { edges: [[0, 1]], mass: 1.0 });

@@ -98,6 +98,8 @@ test('stale ids: a destroyed pin, group, collider, field', () => {
   refusedByC(() => w.setColliderTransform(sphere, [0, 0, -3]), embra.StaleIdError, 'embra_collider_set_transform');
   refusedByC(() => w.destroyField(wind), embra.StaleIdError, 'embra_field_destroy');
   refusedByC(() => w.bodyParticles(new embra.BodyId(5, 1)), embra.StaleIdError, 'embra_body_get_particles');
+  refusedByC(() => w.pinParticle(pin), embra.StaleIdError, 'embra_pin_get_particle');
+  refusedByC(() => w.colliderTransform(sphere), embra.StaleIdError, 'embra_collider_get_transform');
   // an id of the wrong kind is refused before C
   refused(() => w.setPinTarget(group, [1, 0, 0]), TypeError, /pin: expected a PinId, got GroupId/);
   assert.deepEqual(snapshot(w), before);
@@ -113,7 +115,7 @@ test('use of a closed world', () => {
   w.close(); // idempotent
   assert.ok(w.closed);
   for (const call of [() => w.step(), () => w.counts(), () => w.saveJson(), () => w.positions(0, 1),
-    () => w.createBody([[0, 0, 0]]), () => w.solver, () => w.tolerances]) {
+    () => w.createBody([[0, 0, 0]]), () => w.solver, () => w.tolerances, () => w.bodies(), () => w.pins()]) {
     const e = refused(call, embra.InvalidArgumentError, /world is NULL.*\(this World was closed\)/);
     assert.equal(e.status, embra.capi.ERROR_INVALID_ARGUMENT);
   }

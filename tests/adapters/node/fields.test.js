@@ -167,9 +167,11 @@ test('refused field calls raise the C message and change nothing', () => {
       (e) => e instanceof embra.StaleIdError && /^embra_\w+_create: /.test(e.message));
   }
   byC(() => w.destroyField(new embra.FieldId(5, 1)), embra.StaleIdError, 'embra_field_destroy: ');
-  assert.throws(() => w.createWind({ velocity: 3.0 }), { name: 'TypeError', message: /WindDef has no field 'velocity'/ });
+  assert.throws(() => w.createWind({ velocity: 3.0 }),
+    { name: 'TypeError', message: /WindDef has no field 'velocity'/ });
   assert.throws(() => w.destroyField(body), { name: 'TypeError', message: /expected a FieldId/ });
   assert.deepEqual([w.fieldCount, snapshot(w)], before);
   w.close();
-  assert.throws(() => w.fieldCount, (e) => e instanceof embra.InvalidArgumentError && /world is NULL.*closed/.test(e.message));
+  assert.throws(() => w.fieldCount,
+    (e) => e instanceof embra.InvalidArgumentError && /world is NULL.*closed/.test(e.message));
 });

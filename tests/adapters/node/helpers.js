@@ -66,4 +66,6 @@ function snapshot(world) {
   };
 }
 
-module.exports = { embra, sourceDir, cli, packageDir, tempDir, readObjVertices, runCli, bytes, assertSameBits, snapshot };
+module.exports = {
+  embra, sourceDir, cli, packageDir, tempDir, readObjVertices, runCli, bytes, assertSameBits, snapshot,
+};

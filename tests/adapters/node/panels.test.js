@@ -48,6 +48,9 @@ class Drape {
     // The corner pins createPanelMesh made are the world's first four: ids {k, 1} in creation order,
     // the order the scene names them poq.pin0..3 (checked against the actions' first keys).
     this.pins = new Map([0, 1, 2, 3].map((k) => [`${p.name}.pin${k}`, new embra.PinId(k, 1)]));
+    assert.deepEqual(this.world.pins().map(String), [...this.pins.values()].map(String));
+    assert.deepEqual([0, 1, 2, 3].map((k) => this.world.pinParticle(this.pins.get(`${p.name}.pin${k}`))),
+      [0, 8 * (p.columns - 1) + 1, 8 * p.columns * (p.rows - 1) + 3, 8 * (p.columns * p.rows - 1) + 2]);
     for (const a of scene.actions) {
       if (a.type === 'pin_target') assert.deepEqual(this.world.pinTarget(this.pins.get(a.pin)), keyed(a.keys, 0));
     }
@@ -110,6 +113,8 @@ test('the drape built in Node matches the C host bit for bit: positions, metrics
     assert.equal(w.exportCuts(drape.body), fs.readFileSync(path.join(out, 'panels_0.json'), 'utf8'));
     assert.equal(w.exportCuts(drape.body, 'csv'), fs.readFileSync(path.join(out, 'panels_0.csv'), 'utf8'));
     assert.equal(JSON.parse(w.exportCuts(drape.body, embra.CUTS_FORMATS.json)).format, 'embra-panel-cuts');
+    const pose = scene.actions.find((a) => a.type === 'collider_pose');
+    assert.deepEqual(w.colliderTransform(drape.ball).position, keyed(pose.keys, FRAMES)); // on its way
   } finally {
     w.close();
   }
@@ -125,6 +130,9 @@ test('the drape scene loaded in Node steps as the one built, and meets the paper
     assert.deepEqual(loaded.bodyParticles(body), { first: 0, count: 128 });
     assert.deepEqual(loaded.tolerances, built.tolerances);
     assert.equal(loaded.tolerances.unit_scale, 1250.0);
+    assert.deepEqual(loaded.pins().map(String), built.pins().map(String));
+    assert.deepEqual(loaded.colliders().map((c) => loaded.colliderTransform(c)),
+      built.colliders().map((c) => built.colliderTransform(c)));
     drape.step(100);
     loaded.step(100);
     const p = loaded.positions();
@@ -141,7 +149,8 @@ test('the drape scene loaded in Node steps as the one built, and meets the paper
     let own = 0;
     for (let k = 0; k < 16; k++) {
       for (let layer = 0; layer < 2; layer++) {
-        const q = [0, 1, 2, 3].map((c) => Array.from(p.subarray(3 * (8 * k + 4 * layer + c), 3 * (8 * k + 4 * layer + c) + 3)));
+        const at = (c) => 3 * (8 * k + 4 * layer + c);
+        const q = [0, 1, 2, 3].map((c) => Array.from(p.subarray(at(c), at(c) + 3)));
         own = Math.max(own, planarity(q));
       }
     }
