@@ -301,6 +301,7 @@ embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]
     need(world, "world");
     need(gravity, "gravity");
     world->world.set_gravity(vec(gravity));
+    drop_actions(world->meta, embra::io::Action::Type::gravity, embra::Id{});
   });
 }
 
@@ -497,6 +498,7 @@ embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, d
   return guard("embra_body_set_rest_scale", [&] {
     need(world, "world");
     world->world.set_rest_scale(to_id(body), scale, scale_u, scale_v);
+    drop_actions(world->meta, embra::io::Action::Type::rest_scale, to_id(body));
   });
 }
 
@@ -596,6 +598,7 @@ embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const do
     need(world, "world");
     need(target, "target");
     world->world.set_pin_target(to_id(pin), vec(target));
+    drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
   });
 }
 
@@ -692,6 +695,7 @@ embra_status embra_collider_set_transform(embra_world* world, embra_collider_id 
     need(position, "position");
     need(rotation, "rotation");
     world->world.set_collider_transform(to_id(collider), vec(position), quat(rotation));
+    drop_actions(world->meta, embra::io::Action::Type::collider_pose, to_id(collider));
   });
 }
 

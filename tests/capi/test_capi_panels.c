@@ -264,6 +264,38 @@ static void test_create(void) {
   embra_world_destroy(w);
 }
 
+/* A host that sets what a scene action drives takes over: the sphere set by hand while its path is
+ * under way stays where the host put it, a pin target set by hand is not pulled back along the
+ * scene's path, and gravity set by hand holds. Without the host's calls the scene moves them. */
+static void test_host_takes_over(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/poq_drape.json", dir);
+  embra_world* w = NULL;
+  CHECK_OK(embra_world_load_file(&w, path));
+  if (w == NULL) return;
+  embra_pin_id pins[4];
+  embra_collider_id ball;
+  int32_t n = 0;
+  CHECK_OK(embra_world_get_pins(w, pins, 4, &n));
+  CHECK_OK(embra_world_get_colliders(w, &ball, 1, &n));
+  const double held[3] = {-1.5, -1.6, 0.05}, at[3] = {0.2, 0.1, -1.5}, rot[4] = {1, 0, 0, 0};
+  double got[3], q[4];
+  for (int f = 1; f <= 5; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_pin_set_target(w, pins[0], held)); /* the scene draws it to (-1.44, -1.6, 0) by frame 30 */
+  for (int f = 6; f <= 130; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_pin_get_target(w, pins[0], got));
+  CHECK(got[0] == held[0] && got[1] == held[1] && got[2] == held[2]);
+  CHECK_OK(embra_pin_get_target(w, pins[1], got)); /* untouched: where its path ends */
+  CHECK(got[0] == 1.44 && got[1] == -1.6 && got[2] == 0.0);
+  CHECK_OK(embra_collider_get_transform(w, ball, got, q)); /* on its path: 10 of 60 frames along */
+  CHECK_NEAR(got[0], 0.3 - 0.6 * 10.0 / 60.0, 1e-12);
+  CHECK_OK(embra_collider_set_transform(w, ball, at, rot));
+  for (int f = 131; f <= 200; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_collider_get_transform(w, ball, got, q));
+  CHECK(got[0] == at[0] && got[1] == at[1] && got[2] == at[2]);
+  embra_world_destroy(w);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: test_capi_panels EXAMPLES_DIR\n");
@@ -272,5 +304,7 @@ int main(int argc, char** argv) {
   RUN(test_create);
   capi_test_name = "test_drape";
   test_drape(argv[1]);
+  capi_test_name = "test_host_takes_over";
+  test_host_takes_over(argv[1]);
   return capi_test_finish();
 }
