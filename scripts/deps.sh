@@ -12,7 +12,12 @@ packages=(
   python3-pytest python3-numpy
   mono-mcs nunit-console libnunit-cil-dev
   abigail-tools
+  chromium
 )
+# Node.js and npm: the Node adapter, embra-live and the page. Any Node >= 18 will do; Debian 12's
+# nodejs is 18. A machine with Node from elsewhere (nodesource ships npm inside its nodejs) keeps it.
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -21,17 +26,28 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "embra: installing ${missing[*]}" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+  else
+    echo "embra: missing Debian packages: ${missing[*]}" >&2
+    echo "embra: install them with: sudo apt-get install ${missing[*]}" >&2
+    exit 1
+  fi
 fi
 
-if [ "$(id -u)" -eq 0 ]; then
-  echo "embra: installing ${missing[*]}" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
-else
-  echo "embra: missing Debian packages: ${missing[*]}" >&2
-  echo "embra: install them with: sudo apt-get install ${missing[*]}" >&2
-  exit 1
-fi
+# npm packages, exactly as locked (package-lock.json), into each package's node_modules; skipped
+# when node_modules was installed from the same lock (a stamp of its sha256).
+root="$(cd "$(dirname "$0")/.." && pwd)"
+for dir in host_adapters/node host_adapters/web; do
+  sum=$(sha256sum "$root/$dir/package-lock.json" | cut -d' ' -f1)
+  stamp="$root/$dir/node_modules/.embra-lock-sha256"
+  if [ "$(cat "$stamp" 2>/dev/null)" != "$sum" ]; then
+    echo "embra: npm ci in $dir" >&2
+    (cd "$root/$dir" && npm ci --no-audit --no-fund --loglevel=error >&2)
+    echo "$sum" >"$stamp"
+  fi
+done

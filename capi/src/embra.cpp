@@ -180,6 +180,33 @@ void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t 
            "buffer holds " + num(capacity) + " doubles, " + num(3 * static_cast<int64_t>(count)) + " needed");
 }
 
+/// The two-call id listing of embra_world_get_bodies/groups/pins/colliders: of `slots` slots, the
+/// live ones (`generation(i)` nonzero) as {slot index, generation}, in slot order (creation order).
+template <class IdT, class Generation>
+void list_ids(size_t slots, Generation generation, IdT* out, int32_t capacity, int32_t* out_count) {
+  need(out_count, "out_count");
+  if (capacity < 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "capacity is negative");
+  int32_t n = 0;
+  for (size_t i = 0; i < slots; ++i) n += generation(i) != 0 ? 1 : 0;
+  if (out == nullptr && capacity == 0) {
+    *out_count = n;
+    return;
+  }
+  need(out, "out");
+  if (capacity < n)
+    refuse(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer holds " + num(capacity) + " ids, " + num(n) + " needed");
+  int32_t k = 0;
+  for (size_t i = 0; i < slots; ++i)
+    if (const uint32_t g = generation(i); g != 0) out[k++] = IdT{static_cast<uint32_t>(i), g};
+  *out_count = n;
+}
+
+/// A slot's generation if it is alive, else 0.
+template <class T>
+auto live_generation(const std::vector<T>& slots) {
+  return [&slots](size_t i) { return slots[i].alive ? slots[i].generation : 0u; };
+}
+
 }  // namespace
 
 extern "C" {
@@ -274,6 +301,7 @@ embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]
     need(world, "world");
     need(gravity, "gravity");
     world->world.set_gravity(vec(gravity));
+    drop_actions(world->meta, embra::io::Action::Type::gravity, embra::Id{});
   });
 }
 
@@ -290,6 +318,39 @@ embra_status embra_world_get_counts(const embra_world* world, embra_world_counts
     c.colliders = static_cast<int32_t>(w.collider_count());
     c.constraints = w.constraint_count();
     *out_counts = c;
+  });
+}
+
+embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out, int32_t capacity,
+                                    int32_t* out_count) {
+  return guard("embra_world_get_bodies", [&] {
+    need(world, "world");
+    // Bodies are never destroyed: each keeps generation 1.
+    list_ids(
+        world->world.body_count(), [](size_t) { return 1u; }, out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_groups(const embra_world* world, embra_group_id* out, int32_t capacity,
+                                    int32_t* out_count) {
+  return guard("embra_world_get_groups", [&] {
+    need(world, "world");
+    list_ids(world->world.groups().size(), live_generation(world->world.groups()), out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_pins(const embra_world* world, embra_pin_id* out, int32_t capacity, int32_t* out_count) {
+  return guard("embra_world_get_pins", [&] {
+    need(world, "world");
+    list_ids(world->world.pins().size(), live_generation(world->world.pins()), out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_colliders(const embra_world* world, embra_collider_id* out, int32_t capacity,
+                                       int32_t* out_count) {
+  return guard("embra_world_get_colliders", [&] {
+    need(world, "world");
+    list_ids(world->world.colliders().size(), live_generation(world->world.colliders()), out, capacity, out_count);
   });
 }
 
@@ -437,6 +498,7 @@ embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, d
   return guard("embra_body_set_rest_scale", [&] {
     need(world, "world");
     world->world.set_rest_scale(to_id(body), scale, scale_u, scale_v);
+    drop_actions(world->meta, embra::io::Action::Type::rest_scale, to_id(body));
   });
 }
 
@@ -536,6 +598,7 @@ embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const do
     need(world, "world");
     need(target, "target");
     world->world.set_pin_target(to_id(pin), vec(target));
+    drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
   });
 }
 
@@ -545,6 +608,14 @@ embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, do
     need(out_target, "out_target");
     const embra::Vec3& t = world->world.pin(to_id(pin)).target;
     for (int k = 0; k < 3; ++k) out_target[k] = t[k];
+  });
+}
+
+embra_status embra_pin_get_particle(const embra_world* world, embra_pin_id pin, int32_t* out_particle) {
+  return guard("embra_pin_get_particle", [&] {
+    need(world, "world");
+    need(out_particle, "out_particle");
+    *out_particle = world->world.pin(to_id(pin)).particle;
   });
 }
 
@@ -624,6 +695,22 @@ embra_status embra_collider_set_transform(embra_world* world, embra_collider_id 
     need(position, "position");
     need(rotation, "rotation");
     world->world.set_collider_transform(to_id(collider), vec(position), quat(rotation));
+    drop_actions(world->meta, embra::io::Action::Type::collider_pose, to_id(collider));
+  });
+}
+
+embra_status embra_collider_get_transform(const embra_world* world, embra_collider_id collider, double out_position[3],
+                                          double out_rotation[4]) {
+  return guard("embra_collider_get_transform", [&] {
+    need(world, "world");
+    need(out_position, "out_position");
+    need(out_rotation, "out_rotation");
+    const embra::ColliderDesc& d = world->world.collider(to_id(collider)).desc;
+    for (int k = 0; k < 3; ++k) out_position[k] = d.position[k];
+    out_rotation[0] = d.rotation.w();
+    out_rotation[1] = d.rotation.x();
+    out_rotation[2] = d.rotation.y();
+    out_rotation[3] = d.rotation.z();
   });
 }
 

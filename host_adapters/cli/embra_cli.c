@@ -7,7 +7,9 @@
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
- * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames.
+ * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames; with
+ * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
+ * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by.
  *
  * `demo tent` is the paper's Gaudi paradigm (section 3.2, figure 6): a triangular cloth pinned at
  * its three corners under reversed gravity. The membrane is elastic, so reversed gravity stretches
@@ -317,6 +319,67 @@ static int panel_totals_of(embra_world* world, const embra_body_id* bodies, int 
   return 0;
 }
 
+/* Writes the per-vertex error fields beside an OBJ of the world (docs/live-protocol.md, "The replay
+ * folder"): planarity, thickness and miter per world particle, null for particles of no panel mesh,
+ * with the tolerances that colour them. */
+static int write_error_fields(const char* path, embra_world* world, const embra_body_id* bodies, int n, long frame) {
+  static const struct {
+    const char* name;
+    int32_t metric;
+  } fields[3] = {{"planarity", EMBRA_PANEL_METRIC_PLANARITY},
+                 {"thickness", EMBRA_PANEL_METRIC_THICKNESS},
+                 {"miter", EMBRA_PANEL_METRIC_MITER}};
+  embra_world_counts counts;
+  embra_tolerances tol;
+  if (embra_world_get_counts(world, &counts) != EMBRA_OK || embra_world_get_tolerances(world, &tol) != EMBRA_OK)
+    return -1;
+  const size_t np = (size_t)(counts.particles > 0 ? counts.particles : 1);
+  double* value = malloc(sizeof(double) * np);
+  unsigned char* measured = calloc(np, 1);
+  FILE* f = value && measured ? fopen(path, "w") : NULL;
+  int rc = f ? 0 : -1;
+  if (!f && value && measured) fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+  if (f) {
+    fprintf(f,
+            "{\"format\":\"embra-vertex-errors\",\"version\":1,\"frame\":%ld,\"particles\":%d,"
+            "\"tolerances\":{\"unit_scale\":%.17g,\"planarity\":{\"target\":%.17g,\"max\":%.17g},"
+            "\"thickness\":{\"target\":%.17g,\"max\":%.17g},\"miter\":{\"target\":%.17g,\"max\":%.17g}},"
+            "\"fields\":{",
+            frame, counts.particles, tol.unit_scale, tol.planarity.target, tol.planarity.max, tol.thickness.target,
+            tol.thickness.max, tol.miter.target, tol.miter.max);
+  }
+  for (int k = 0; k < 3 && rc == 0; ++k) {
+    memset(measured, 0, np);
+    for (int i = 0; i < n && rc == 0; ++i) {
+      int32_t first = 0, count = 0;
+      int64_t got = 0;
+      if (embra_body_get_particles(world, bodies[i], &first, &count) != EMBRA_OK ||
+          embra_panel_mesh_get_vertex_errors(world, bodies[i], fields[k].metric, value + first, count, &got) !=
+              EMBRA_OK) {
+        rc = -1;
+        break;
+      }
+      memset(measured + first, 1, (size_t)count);
+    }
+    fprintf(f, "%s\"%s\":[", k > 0 ? "," : "", fields[k].name);
+    for (int32_t p = 0; p < counts.particles && rc == 0; ++p) {
+      if (p > 0) fputc(',', f);
+      if (measured[p])
+        fprintf(f, "%.9g", value[p]);
+      else
+        fputs("null", f);
+    }
+    fputc(']', f);
+  }
+  if (f) {
+    fputs("}}\n", f);
+    if (fclose(f) != 0) rc = -1;
+  }
+  free(value);
+  free(measured);
+  return rc;
+}
+
 /* Writes each panel mesh's cut list (JSON and CSV) into DIR. */
 static int write_cuts(embra_world* world, const embra_body_id* bodies, int n, const char* dir) {
   for (int i = 0; i < n; ++i)
@@ -476,6 +539,11 @@ static int cmd_run(int argc, char** argv) {
         rc = EXIT_INVALID;
         break;
       }
+      snprintf(path, sizeof path, "%s/frame_%05ld.errors.json", out, f);
+      if (panel_count > 0 && write_error_fields(path, world, panel_bodies, panel_count, f) != 0) {
+        rc = EXIT_INVALID;
+        break;
+      }
     }
     if (tty && (f % 10 == 0 || f == frames)) progress(f, frames, total_ms);
   }
@@ -489,6 +557,9 @@ static int cmd_run(int argc, char** argv) {
   }
   snprintf(path, sizeof path, "%s/final.obj", out);
   if (write_world_obj(path, world) != 0 && rc == 0) rc = EXIT_INVALID;
+  snprintf(path, sizeof path, "%s/final.errors.json", out);
+  if (panel_count > 0 && write_error_fields(path, world, panel_bodies, panel_count, (long)r.frame) != 0 && rc == 0)
+    rc = EXIT_INVALID;
   embra_world_counts c;
   embra_world_get_counts(world, &c);
   printf("%-18s %s\n", "scene", scene);

@@ -277,6 +277,10 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_solver(IntPtr world, ref SolverDef def);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_gravity(IntPtr world, double[] gravity);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_counts(IntPtr world, out WorldCounts counts);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_bodies(IntPtr world, [Out] BodyId[] ids, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_groups(IntPtr world, [Out] GroupId[] ids, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_pins(IntPtr world, [Out] PinId[] ids, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_colliders(IntPtr world, [Out] ColliderId[] ids, int capacity, out int count);
         // groups
         [DllImport(Library, CallingConvention = C)] public static extern GroupDef embra_default_group_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_create(IntPtr world, ref GroupDef def, out GroupId group);
@@ -314,11 +318,13 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_particle(IntPtr world, PinId pin, out int particle);
         // colliders
         [DllImport(Library, CallingConvention = C)] public static extern ColliderDef embra_default_collider_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_collider_create(IntPtr world, ref ColliderDef def, out ColliderId collider);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_collider_destroy(IntPtr world, ColliderId collider);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_collider_set_transform(IntPtr world, ColliderId collider, double[] position, double[] rotation);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_collider_get_transform(IntPtr world, ColliderId collider, [Out] double[] position, [Out] double[] rotation);
         // stepping and reading back
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_step(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_report(IntPtr world, out StepReport report);

@@ -266,6 +266,27 @@ namespace Embra
             get { var c = new WorldCounts(); Call(w => Native.embra_world_get_counts(w, out c)); return c; }
         }
 
+        /// <summary>Ids of every body, in creation order (a loaded scene's order, as saved).</summary>
+        public BodyId[] Bodies() { return Ids<BodyId>(Native.embra_world_get_bodies); }
+        /// <summary>Ids of the live groups in creation order: the default and contact groups first.</summary>
+        public GroupId[] Groups() { return Ids<GroupId>(Native.embra_world_get_groups); }
+        /// <summary>Ids of the live pins, in creation order (a loaded scene's order, as saved).</summary>
+        public PinId[] Pins() { return Ids<PinId>(Native.embra_world_get_pins); }
+        /// <summary>Ids of the live colliders, in creation order (a loaded scene's order, as saved).</summary>
+        public ColliderId[] Colliders() { return Ids<ColliderId>(Native.embra_world_get_colliders); }
+
+        delegate int IdList<T>(IntPtr world, T[] ids, int capacity, out int count);
+
+        // The two-call id listing: the count first, then the ids.
+        T[] Ids<T>(IdList<T> list)
+        {
+            int count = 0;
+            Call(w => list(w, null, 0, out count));
+            var ids = new T[count];
+            Call(w => list(w, ids, ids.Length, out count));
+            return ids;
+        }
+
         // --- groups -----------------------------------------------------------------------------
         public GroupId CreateGroup(int order = 0, int weight = 1)
         {
@@ -520,6 +541,13 @@ namespace Embra
             return t;
         }
 
+        public int PinParticle(PinId pin)
+        {
+            int p = -1;
+            Call(w => Native.embra_pin_get_particle(w, pin, out p));
+            return p;
+        }
+
         // --- colliders --------------------------------------------------------------------------
         /// <summary>A collider from a def (from Native.embra_default_collider_def(), fields set), with
         /// the local vertices (and triangles) of a convex or mesh shape.</summary>
@@ -553,6 +581,16 @@ namespace Embra
             Three(position, "position");
             Need(rotation != null && rotation.Length == 4, "rotation: a quaternion {w, x, y, z}");
             Call(w => Native.embra_collider_set_transform(w, collider, position, rotation));
+        }
+
+        /// <summary>Where the collider is now (scene actions included): position and rotation {w, x, y, z}.</summary>
+        public void ColliderTransform(ColliderId collider, out double[] position, out double[] rotation)
+        {
+            var p = new double[3];
+            var q = new double[4];
+            Call(w => Native.embra_collider_get_transform(w, collider, p, q));
+            position = p;
+            rotation = q;
         }
 
         // --- fields -----------------------------------------------------------------------------

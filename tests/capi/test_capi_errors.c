@@ -446,6 +446,12 @@ static void test_null_world(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_velocities(NULL, xyz, 3, 0, 1));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_set_positions(NULL, xyz, 0, 1));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_set_velocities(NULL, xyz, 0, 1));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_bodies(NULL, NULL, 0, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_groups(NULL, NULL, 0, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_pins(NULL, NULL, 0, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_colliders(NULL, NULL, 0, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_pin_get_particle(NULL, p, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_collider_get_transform(NULL, k, xyz, q));
 }
 
 /* embra_world_create: every refusal leaves *out_world NULL. */
@@ -1085,6 +1091,7 @@ static void test_pins(void) {
   embra_pin_def d;
   embra_pin_id out;
   double t[3];
+  int32_t particle = 0;
   const embra_pin_id zero = {0, 0};
   const embra_pin_id stale[4] = {g_ref.pin_dead, g_ref.pin_wrong_gen, g_ref.pin_never, zero};
   int i, k;
@@ -1153,10 +1160,12 @@ static void test_pins(void) {
     REFUSED(EMBRA_ERROR_STALE_ID, "pin", embra_pin_destroy(W, stale[i]));
     REFUSED(EMBRA_ERROR_STALE_ID, "pin", embra_pin_set_target(W, stale[i], t));
     REFUSED(EMBRA_ERROR_STALE_ID, "pin", embra_pin_get_target(W, stale[i], t));
+    REFUSED(EMBRA_ERROR_STALE_ID, "pin", embra_pin_get_particle(W, stale[i], &particle));
   }
   CAPI_CONTEXT("NULL");
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "target", embra_pin_set_target(W, S->pin_hard, NULL));
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_target", embra_pin_get_target(W, S->pin_hard, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_particle", embra_pin_get_particle(W, S->pin_hard, NULL));
 #undef GOOD_PIN
 }
 
@@ -1304,11 +1313,14 @@ static void test_colliders(void) {
     GOOD_TRANSFORM();
     REFUSED(EMBRA_ERROR_STALE_ID, "collider", embra_collider_destroy(W, stale[i]));
     REFUSED(EMBRA_ERROR_STALE_ID, "collider", embra_collider_set_transform(W, stale[i], p, q));
+    REFUSED(EMBRA_ERROR_STALE_ID, "collider", embra_collider_get_transform(W, stale[i], p, q));
   }
   CAPI_CONTEXT("set_transform");
   GOOD_TRANSFORM();
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "position", embra_collider_set_transform(W, S->col_sphere, NULL, q));
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rotation", embra_collider_set_transform(W, S->col_sphere, p, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_position", embra_collider_get_transform(W, S->col_sphere, NULL, q));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_rotation", embra_collider_get_transform(W, S->col_sphere, p, NULL));
   for (i = 0; i < 3; ++i) {
     CAPI_CONTEXT("set_transform %s", bad_name(i));
     for (k = 0; k < 3; ++k) {
@@ -1330,6 +1342,58 @@ static void test_colliders(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "unit quaternion", embra_collider_set_transform(W, S->col_sphere, p, q));
 #undef GOOD_COLLIDER
 #undef GOOD_TRANSFORM
+}
+
+/* The id lists: every live object once, in creation order, none destroyed; the two-call pattern's
+ * refusals write nothing. */
+static void test_id_lists(void) {
+  embra_world_counts c;
+  embra_pin_id pins[16];
+  embra_collider_id cols[16];
+  embra_group_id groups[16];
+  embra_body_id bodies[16];
+  int32_t n = -1, i, particle = -1;
+  double pos[3], rot[4];
+  if (!CHECK(scene_build(&g_a))) return;
+  CHECK_OK(embra_world_get_counts(g_a.w, &c));
+  CHECK_OK(embra_world_get_bodies(g_a.w, NULL, 0, &n));
+  CHECK_INT(n, c.bodies);
+  CHECK_OK(embra_world_get_bodies(g_a.w, bodies, 16, &n));
+  CHECK(memcmp(&bodies[0], &g_a.b_cloth, sizeof bodies[0]) == 0);
+  CHECK(memcmp(&bodies[n - 1], &g_a.b_fixture, sizeof bodies[0]) == 0);
+  CHECK_OK(embra_world_get_groups(g_a.w, groups, 16, &n));
+  CHECK_INT(n, c.groups);
+  CHECK(memcmp(&groups[0], &g_a.g_default, sizeof groups[0]) == 0);
+  CHECK(memcmp(&groups[1], &g_a.g_contact, sizeof groups[0]) == 0);
+  for (i = 0; i < n; ++i) CHECK(memcmp(&groups[i], &g_a.g_dead, sizeof groups[0]) != 0);
+  CHECK_OK(embra_world_get_pins(g_a.w, pins, 16, &n));
+  CHECK_INT(n, c.pins);
+  for (i = 0; i < n; ++i) {
+    CHECK(memcmp(&pins[i], &g_a.pin_dead, sizeof pins[0]) != 0);
+    CHECK_OK(embra_pin_get_particle(g_a.w, pins[i], &particle));
+    CHECK(particle >= 0 && particle < g_a.n);
+  }
+  CHECK_OK(embra_pin_get_particle(g_a.w, g_a.pin_hard, &particle));
+  CHECK_INT(particle, g_a.cloth);
+  CHECK_OK(embra_world_get_colliders(g_a.w, cols, 16, &n));
+  CHECK_INT(n, c.colliders);
+  for (i = 0; i < n; ++i) CHECK(memcmp(&cols[i], &g_a.col_dead, sizeof cols[0]) != 0);
+  /* A collider reads back the pose it was last sent to. */
+  pos[0] = 0.5, pos[1] = -0.25, pos[2] = 2.0;
+  rot[0] = 0.0, rot[1] = 0.0, rot[2] = 0.0, rot[3] = 1.0; /* half a turn about z */
+  CHECK_OK(embra_collider_set_transform(g_a.w, g_a.col_sphere, pos, rot));
+  memset(pos, 0, sizeof pos);
+  CHECK_OK(embra_collider_get_transform(g_a.w, g_a.col_sphere, pos, rot));
+  CHECK(pos[0] == 0.5 && pos[1] == -0.25 && pos[2] == 2.0);
+  CHECK(rot[0] == 0.0 && rot[1] == 0.0 && rot[2] == 0.0 && rot[3] == 1.0);
+  embra_world_destroy(g_a.w);
+
+  memset(pins, 0x5A, sizeof pins);
+  REFUSED(EMBRA_ERROR_BUFFER_TOO_SMALL, "needed", embra_world_get_pins(W, pins, 1, &n));
+  CHECK(pins[0].index == 0x5A5A5A5Au); /* nothing written */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", embra_world_get_colliders(W, cols, -1, &n));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", embra_world_get_groups(W, groups, 16, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out", embra_world_get_bodies(W, NULL, 4, &n));
 }
 
 static void test_particles(void) {
@@ -1451,6 +1515,7 @@ int main(void) {
   RUN(test_constraints_add);
   RUN(test_pins);
   RUN(test_colliders);
+  RUN(test_id_lists);
   RUN(test_particles);
   RUN(test_step);
   return capi_test_finish();

@@ -87,6 +87,32 @@ static void test_drape(const char* dir) {
   CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
   CHECK_INT(panels, 16);
   CHECK_OK(embra_body_get_particles(w, body, &first, &count));
+  /* The scene's objects through the id lists: one body, its four corner pins (each on a particle
+   * sitting at its target before any step) and the sphere where the scene puts it. */
+  embra_body_id bodies[2];
+  embra_pin_id pins[8];
+  embra_collider_id ball[2];
+  int32_t n_ids = 0;
+  CHECK_OK(embra_world_get_bodies(w, bodies, 2, &n_ids));
+  CHECK_INT(n_ids, 1);
+  CHECK(bodies[0].index == body.index && bodies[0].generation == body.generation);
+  CHECK_OK(embra_world_get_pins(w, pins, 8, &n_ids));
+  CHECK_INT(n_ids, 4);
+  for (int i = 0; i < n_ids; ++i) {
+    int32_t particle = -1;
+    double target[3], xp[3];
+    CHECK_OK(embra_pin_get_particle(w, pins[i], &particle));
+    CHECK_OK(embra_pin_get_target(w, pins[i], target));
+    CHECK_OK(embra_world_get_positions(w, xp, 3, particle, 1));
+    CHECK(xp[0] == target[0] && xp[1] == target[1] && xp[2] == target[2]);
+  }
+  CHECK_OK(embra_world_get_colliders(w, ball, 2, &n_ids));
+  CHECK_INT(n_ids, 1);
+  double ball_at[3], ball_rot[4];
+  CHECK_OK(embra_collider_get_transform(w, ball[0], ball_at, ball_rot));
+  CHECK(ball_at[0] == 0.3 && ball_at[1] == 0.2 && ball_at[2] == -1.45);
+  CHECK(ball_rot[0] == 1.0 && ball_rot[1] == 0.0 && ball_rot[2] == 0.0 && ball_rot[3] == 0.0);
+  double ball_off = 0.0; /* the largest distance of the read-back sphere from its scripted path */
   embra_tolerances tol;
   CHECK_OK(embra_world_get_tolerances(w, &tol));
   CHECK_NEAR(tol.unit_scale, 1250.0, 0.0);
@@ -120,6 +146,11 @@ static void test_drape(const char* dir) {
      * (-0.3, 0.2, -1.35) at 180, held after. */
     const double s = f <= 120 ? 0.0 : f >= 180 ? 1.0 : (f - 120) / 60.0;
     const vec centre = {0.3 - 0.6 * s, 0.2, -1.45 + 0.1 * s};
+    CHECK_OK(embra_collider_get_transform(w, ball[0], ball_at, ball_rot));
+    for (int k = 0; k < 3; ++k) {
+      const double off = fabs(ball_at[k] - (k == 0 ? centre.x : k == 1 ? centre.y : centre.z));
+      if (off > ball_off) ball_off = off;
+    }
     double own_planarity = 0.0;
     for (int32_t p = 0; p < panels; ++p) {
       for (int layer = 0; layer < 2; ++layer) {
@@ -150,6 +181,7 @@ static void test_drape(const char* dir) {
   CHECK(at100.miter.max <= 1e-3);
   CHECK(back_from > 0 && back_from <= 210);
   CHECK(worst_inside <= 1e-6);
+  CHECK(ball_off <= 1e-12);
   /* Per-vertex fields: one value per particle, none above the reported max. */
   double field[128];
   int64_t n = 0;
@@ -232,6 +264,38 @@ static void test_create(void) {
   embra_world_destroy(w);
 }
 
+/* A host that sets what a scene action drives takes over: the sphere set by hand while its path is
+ * under way stays where the host put it, a pin target set by hand is not pulled back along the
+ * scene's path, and gravity set by hand holds. Without the host's calls the scene moves them. */
+static void test_host_takes_over(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/poq_drape.json", dir);
+  embra_world* w = NULL;
+  CHECK_OK(embra_world_load_file(&w, path));
+  if (w == NULL) return;
+  embra_pin_id pins[4];
+  embra_collider_id ball;
+  int32_t n = 0;
+  CHECK_OK(embra_world_get_pins(w, pins, 4, &n));
+  CHECK_OK(embra_world_get_colliders(w, &ball, 1, &n));
+  const double held[3] = {-1.5, -1.6, 0.05}, at[3] = {0.2, 0.1, -1.5}, rot[4] = {1, 0, 0, 0};
+  double got[3], q[4];
+  for (int f = 1; f <= 5; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_pin_set_target(w, pins[0], held)); /* the scene draws it to (-1.44, -1.6, 0) by frame 30 */
+  for (int f = 6; f <= 130; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_pin_get_target(w, pins[0], got));
+  CHECK(got[0] == held[0] && got[1] == held[1] && got[2] == held[2]);
+  CHECK_OK(embra_pin_get_target(w, pins[1], got)); /* untouched: where its path ends */
+  CHECK(got[0] == 1.44 && got[1] == -1.6 && got[2] == 0.0);
+  CHECK_OK(embra_collider_get_transform(w, ball, got, q)); /* on its path: 10 of 60 frames along */
+  CHECK_NEAR(got[0], 0.3 - 0.6 * 10.0 / 60.0, 1e-12);
+  CHECK_OK(embra_collider_set_transform(w, ball, at, rot));
+  for (int f = 131; f <= 200; ++f) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_collider_get_transform(w, ball, got, q));
+  CHECK(got[0] == at[0] && got[1] == at[1] && got[2] == at[2]);
+  embra_world_destroy(w);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: test_capi_panels EXAMPLES_DIR\n");
@@ -240,5 +304,7 @@ int main(int argc, char** argv) {
   RUN(test_create);
   capi_test_name = "test_drape";
   test_drape(argv[1]);
+  capi_test_name = "test_host_takes_over";
+  test_host_takes_over(argv[1]);
   return capi_test_finish();
 }

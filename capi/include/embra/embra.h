@@ -187,7 +187,8 @@ EMBRA_API void embra_world_destroy(embra_world* world);
 /* Reads or replaces the solver settings (between steps). */
 EMBRA_API embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* out_def);
 EMBRA_API embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* def);
-/* Sets gravity (m/s^2) between steps; reversing it is the Gaudi paradigm. */
+/* Sets gravity (m/s^2) between steps; reversing it is the Gaudi paradigm. The host takes over: a
+ * scene's gravity changes (actions) stop. */
 EMBRA_API embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]);
 
 typedef struct embra_world_counts {
@@ -201,6 +202,21 @@ typedef struct embra_world_counts {
 } embra_world_counts;
 
 EMBRA_API embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts);
+
+/* The ids of the live objects of one kind, in creation order: for a world loaded from a scene, the
+ * order of the scene's arrays (groups: "default" and "contacts" first, then the scene's; a panel
+ * mesh's body and pins after the scene's bodies and pins, as saved), so a host that reads the scene
+ * JSON (embra_world_save_json) pairs its entries with these ids. Two-call pattern: out NULL and
+ * capacity 0 only write *out_count; too small a buffer is EMBRA_ERROR_BUFFER_TOO_SMALL, nothing
+ * written. Capacity and *out_count are in ids. */
+EMBRA_API embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out, int32_t capacity,
+                                              int32_t* out_count);
+EMBRA_API embra_status embra_world_get_groups(const embra_world* world, embra_group_id* out, int32_t capacity,
+                                              int32_t* out_count);
+EMBRA_API embra_status embra_world_get_pins(const embra_world* world, embra_pin_id* out, int32_t capacity,
+                                            int32_t* out_count);
+EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra_collider_id* out, int32_t capacity,
+                                                 int32_t* out_count);
 
 /* ---------------------------------------------------------------------------------------------
  * Groups: the paper's "preferred order of evaluation" and "importance weight"
@@ -296,7 +312,8 @@ EMBRA_API embra_status embra_body_get_particles(const embra_world* world, embra_
  * from the next step on: rest = scale * |(scale_u * rest_u, scale_v * rest_v, rest_other)|, where
  * rest_u and rest_v are the parts of each edge along the body's uv directions (all of it is
  * "other" for a body without uvs). 1, 1, 1 is the rest shape; < 1 shrinks (shrink wrap, minimal
- * surfaces), > 1 grows (bounded growth). All >= 0 and finite. */
+ * surfaces), > 1 grows (bounded growth). All >= 0 and finite. The host takes over: a scene's
+ * rest-scale ramp for this body stops. */
 EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, double scale, double scale_u,
                                                  double scale_v);
 
@@ -377,9 +394,12 @@ EMBRA_API embra_pin_def embra_default_pin_def(void);
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
-/* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. */
+/* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The
+ * host takes over: a scene's path for this pin stops (a dragged pin is not pulled back). */
 EMBRA_API embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]);
 EMBRA_API embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]);
+/* The particle a pin holds. */
+EMBRA_API embra_status embra_pin_get_particle(const embra_world* world, embra_pin_id pin, int32_t* out_particle);
 
 /* ---------------------------------------------------------------------------------------------
  * Colliders: rigid shapes the host places and moves between steps
@@ -432,9 +452,15 @@ EMBRA_API embra_status embra_collider_create(embra_world* world, const embra_col
 /* Destroys a collider (and a scene action that moves it). */
 EMBRA_API embra_status embra_collider_destroy(embra_world* world, embra_collider_id collider);
 /* Sets where the collider is at the end of the next step; it moves there along a straight path
- * over the substeps, and particles it drags take its velocity through friction. */
+ * over the substeps, and particles it drags take its velocity through friction. The host takes
+ * over: a scene's path for this collider stops. */
 EMBRA_API embra_status embra_collider_set_transform(embra_world* world, embra_collider_id collider,
                                                     const double position[3], const double rotation[4]);
+/* Where the collider is now: the pose it reached at the end of the last step (before any step, or
+ * after embra_collider_set_transform, the pose it will reach at the end of the next one). The
+ * rotation is a unit quaternion {w, x, y, z}. Scene actions that move a collider show here. */
+EMBRA_API embra_status embra_collider_get_transform(const embra_world* world, embra_collider_id collider,
+                                                    double out_position[3], double out_rotation[4]);
 
 /* ---------------------------------------------------------------------------------------------
  * Stepping and reading back
@@ -651,7 +677,9 @@ EMBRA_API embra_status embra_panel_mesh_export_cuts(const embra_world* world, em
  * EMBRA_ERROR_SCHEMA with a message starting with the JSON pointer of the offending value, and
  * creates nothing. A saved scene holds the complete world and its state: loading it gives a world
  * that steps bit-identically to the one saved. Scene actions (rest-scale ramps, pin paths,
- * collider paths, gravity changes) are applied by embra_world_step before each frame.
+ * collider paths, gravity changes) are applied by embra_world_step before each frame, until the
+ * host sets the same thing itself (embra_pin_set_target, embra_collider_set_transform,
+ * embra_world_set_gravity, embra_body_set_rest_scale): then the host's value holds.
  * ------------------------------------------------------------------------------------------- */
 
 /* Builds a world from scene JSON text of `length` bytes. `base_dir` (nullable: ".") resolves

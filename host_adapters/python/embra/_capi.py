@@ -259,6 +259,10 @@ PROTOTYPES = {
     "embra_world_set_solver": (_status, [_world, _P(SolverDef)]),
     "embra_world_set_gravity": (_status, [_world, _pd]),
     "embra_world_get_counts": (_status, [_world, _P(WorldCounts)]),
+    "embra_world_get_bodies": (_status, [_world, _P(BodyId), c_int32, _pi]),
+    "embra_world_get_groups": (_status, [_world, _P(GroupId), c_int32, _pi]),
+    "embra_world_get_pins": (_status, [_world, _P(PinId), c_int32, _pi]),
+    "embra_world_get_colliders": (_status, [_world, _P(ColliderId), c_int32, _pi]),
     # groups
     "embra_default_group_def": (GroupDef, []),
     "embra_group_create": (_status, [_world, _P(GroupDef), _P(GroupId)]),
@@ -296,11 +300,13 @@ PROTOTYPES = {
     "embra_pin_destroy": (_status, [_world, PinId]),
     "embra_pin_set_target": (_status, [_world, PinId, _pd]),
     "embra_pin_get_target": (_status, [_world, PinId, _pd]),
+    "embra_pin_get_particle": (_status, [_world, PinId, _pi]),
     # colliders
     "embra_default_collider_def": (ColliderDef, []),
     "embra_collider_create": (_status, [_world, _P(ColliderDef), _P(ColliderId)]),
     "embra_collider_destroy": (_status, [_world, ColliderId]),
     "embra_collider_set_transform": (_status, [_world, ColliderId, _pd, _pd]),
+    "embra_collider_get_transform": (_status, [_world, ColliderId, _pd, _pd]),
     # stepping and reading back
     "embra_world_step": (_status, [_world]),
     "embra_world_get_report": (_status, [_world, _P(StepReport)]),

@@ -209,6 +209,29 @@ class World:
     def particle_count(self):
         return self.counts().particles
 
+    def _ids(self, name, cls):
+        n = c_int32()
+        self._call(name, None, 0, byref(n))
+        out = (cls * max(n.value, 1))()
+        self._call(name, out, n.value, byref(n))
+        return [cls(out[i].index, out[i].generation) for i in range(n.value)]
+
+    def bodies(self):
+        """Ids of every body, in creation order (a loaded scene's order, as saved)."""
+        return self._ids("embra_world_get_bodies", BodyId)
+
+    def groups(self):
+        """Ids of the live groups in creation order: the default and contact groups first."""
+        return self._ids("embra_world_get_groups", GroupId)
+
+    def pins(self):
+        """Ids of the live pins, in creation order (a loaded scene's order, as saved)."""
+        return self._ids("embra_world_get_pins", PinId)
+
+    def colliders(self):
+        """Ids of the live colliders, in creation order (a loaded scene's order, as saved)."""
+        return self._ids("embra_world_get_colliders", ColliderId)
+
     # --- groups --------------------------------------------------------------------------------
     def create_group(self, order=0, weight=1):
         d = lib.embra_default_group_def()
@@ -497,6 +520,11 @@ class World:
         self._call("embra_pin_get_target", _id(pin, PinId, "pin"), out)
         return tuple(out)
 
+    def pin_particle(self, pin):
+        out = c_int32()
+        self._call("embra_pin_get_particle", _id(pin, PinId, "pin"), byref(out))
+        return out.value
+
     # --- colliders -----------------------------------------------------------------------------
     def create_collider(self, shape, *, vertices=None, triangles=None, **fields):
         """A collider: shape ("plane", "sphere", "box", "capsule", "convex", "mesh" or its number),
@@ -528,6 +556,12 @@ class World:
     def set_collider_transform(self, collider, position, rotation=(1.0, 0.0, 0.0, 0.0)):
         self._call("embra_collider_set_transform", _id(collider, ColliderId, "collider"),
                    buf.d3(position, "position"), buf.d4(rotation, "rotation"))
+
+    def collider_transform(self, collider):
+        """(position, rotation {w, x, y, z}) where the collider is now (scene actions included)."""
+        p, q = (c_double * 3)(), (c_double * 4)()
+        self._call("embra_collider_get_transform", _id(collider, ColliderId, "collider"), p, q)
+        return tuple(p), tuple(q)
 
     # --- fields --------------------------------------------------------------------------------
     def _create_field(self, default, create, what, fields):

@@ -482,6 +482,30 @@ namespace Embra.Tests
         }
 
         [Test]
+        public void ALoadedSceneNamesItsObjectsThroughTheIdLists()
+        {
+            using (var w = World.LoadFile(Drape.Scene))
+            {
+                // The scene's pins, in its order: the four top corners of the 4 x 4 panel mesh.
+                CollectionAssert.AreEqual(new[] { 0, 25, 99, 122 }, w.Pins().Select(p => w.PinParticle(p)).ToArray());
+                Assert.AreEqual(1, w.Bodies().Length);
+                CollectionAssert.AreEqual(new[] { w.DefaultGroup, w.ContactGroup }, w.Groups());
+                var ball = w.Colliders().Single();
+                double[] at, rot;
+                w.ColliderTransform(ball, out at, out rot);
+                CollectionAssert.AreEqual(new[] { 0.3, 0.2, -1.45 }, at);
+                CollectionAssert.AreEqual(new[] { 1.0, 0.0, 0.0, 0.0 }, rot);
+                w.Step(150);  // halfway along the sphere's path from frame 120 to 180
+                w.ColliderTransform(ball, out at, out rot);
+                Assert.AreEqual(0.0, at[0], 1e-12);
+                Assert.AreEqual(0.2, at[1], 1e-12);
+                Assert.AreEqual(-1.4, at[2], 1e-12);
+                var stale = Assert.Throws<EmbraInvalidOperationException>(() => w.PinParticle(new PinId { Index = 0, Generation = 9 }));
+                Assert.AreEqual(Status.StaleId, stale.Status);
+            }
+        }
+
+        [Test]
         public void GridPinsTolerancesAndAMeshOfQuads()
         {
             using (var w = new World())

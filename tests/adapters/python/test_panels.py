@@ -42,7 +42,9 @@ def c_drape(cli, scene_path, tmp_path_factory):
                    stdout=subprocess.DEVNULL)
     with open(out / "metrics.jsonl") as f:
         records = [json.loads(line) for line in f]
-    return {"positions": read_obj_vertices(out / "final.obj"), "metrics": records[-1],
+    with open(out / "final.errors.json") as f:
+        errors = json.load(f)
+    return {"positions": read_obj_vertices(out / "final.obj"), "metrics": records[-1], "errors": errors,
             "json": (out / "panels_0.json").read_text(), "csv": (out / "panels_0.csv").read_text()}
 
 
@@ -312,3 +314,47 @@ def test_refused_panel_queries(panels):
     w.close()
     with pytest.raises(embra.InvalidArgumentError, match="world is NULL.*closed"):
         w.panel_metrics(body)
+
+
+def test_a_loaded_scene_names_its_objects_through_the_id_lists(scene_path):
+    """The id lists pair with the saved scene's arrays entry by entry; the sphere read back follows
+    the scene's path (frames 120 to 180: (0.3, 0.2, -1.45) to (-0.3, 0.2, -1.35))."""
+    w = embra.World.load_file(scene_path)
+    saved = json.loads(w.save_json())
+    assert [w.pin_particle(p) for p in w.pins()] == [p["particle"] for p in saved["pins"]]
+    assert [w.pin_target(p) for p in w.pins()] == [tuple(p["target"]) for p in saved["pins"]]
+    assert len(w.bodies()) == len(saved["bodies"]) == 1
+    assert w.groups() == [w.default_group(), w.contact_group()]
+    (ball,) = w.colliders()
+    assert w.collider_transform(ball) == ((0.3, 0.2, -1.45), (1.0, 0.0, 0.0, 0.0))
+    w.step(150)
+    position, rotation = w.collider_transform(ball)
+    assert position == pytest.approx((0.0, 0.2, -1.4), abs=1e-12)
+    assert rotation == (1.0, 0.0, 0.0, 0.0)
+    w.destroy_pin(w.pins()[1])
+    assert [w.pin_particle(p) for p in w.pins()] == [saved["pins"][k]["particle"] for k in (0, 2, 3)]
+    with pytest.raises(embra.StaleIdError):
+        w.collider_transform(embra.ColliderId(0, 7))
+    w.close()
+
+
+def test_the_c_hosts_error_fields_are_the_vertex_errors_of_its_final_state(scene_path, c_drape):
+    """final.errors.json (the replay's colour maps): one value per particle per field, each the
+    World's own vertex error after the same frames to its 9 printed digits, and the field's
+    largest value the metrics record's max."""
+    errors = c_drape["errors"]
+    assert errors["format"] == "embra-vertex-errors" and errors["frame"] == FRAMES
+    w = embra.World.load_file(scene_path)
+    w.step(FRAMES)
+    (body,) = w.bodies()
+    record = c_drape["metrics"]
+    keys = {"planarity": "planarity_max", "thickness": "thickness_error_max", "miter": "miter_error_max"}
+    for name, key in keys.items():
+        field = errors["fields"][name]
+        assert len(field) == errors["particles"] == w.particle_count
+        ours = list(w.vertex_errors(body, name))
+        assert field == pytest.approx(ours, rel=1e-8, abs=0.0)
+        assert max(field) == pytest.approx(record[key], rel=1e-8, abs=0.0)
+    tol = w.tolerances
+    assert errors["tolerances"]["thickness"] == {"target": tol.thickness.target, "max": tol.thickness.max}
+    w.close()

@@ -1,0 +1,831 @@
+'use strict';
+// The World: a JS view of one embra_world *, covering the whole C ABI.
+//
+// Arguments are checked in JS first (TypeError for a wrong type or an unknown field, RangeError for a
+// wrong length, an integer out of int32 or an unknown name); then C checks the values. A refused call
+// throws the EmbraError of its status with the C library's message and leaves the world unchanged,
+// exactly as the C function does. Def fields keep their C names (snake_case, as in the scene JSON and
+// in every object read back); camelCase spellings are accepted as well (settleSpeed = settle_speed).
+// close() is idempotent; a closed World refuses every call (InvalidArgumentError "world is NULL ...
+// (this World was closed)"). A World not closed is destroyed when garbage-collected.
+
+const capi = require('./capi');
+const buf = require('./buffers');
+const { EmbraError, errorFor, check } = require('./errors');
+
+const { lib } = capi;
+
+const SHAPES = Object.freeze({
+  plane: capi.COLLIDER_PLANE, sphere: capi.COLLIDER_SPHERE, box: capi.COLLIDER_BOX, capsule: capi.COLLIDER_CAPSULE,
+  convex: capi.COLLIDER_CONVEX, mesh: capi.COLLIDER_MESH,
+});
+const KINDS = Object.freeze({
+  distance: capi.CONSTRAINT_DISTANCE, edge_angle: capi.CONSTRAINT_EDGE_ANGLE, dihedral: capi.CONSTRAINT_DIHEDRAL,
+  tet_volume: capi.CONSTRAINT_TET_VOLUME, weld: capi.CONSTRAINT_WELD, tether: capi.CONSTRAINT_TETHER,
+  planarity: capi.CONSTRAINT_PLANARITY, plane_offset: capi.CONSTRAINT_PLANE_OFFSET,
+});
+const GENERATE = Object.freeze({
+  stretch: capi.GENERATE_STRETCH, shear: capi.GENERATE_SHEAR, bend: capi.GENERATE_BEND,
+  volume: capi.GENERATE_VOLUME,
+});
+const PANEL_PINS = Object.freeze({
+  none: capi.PANEL_PINS_NONE, top_corners: capi.PANEL_PINS_TOP_CORNERS,
+  top_and_bottom_corners: capi.PANEL_PINS_TOP_AND_BOTTOM_CORNERS,
+});
+const PANEL_METRICS = Object.freeze({
+  planarity: capi.PANEL_METRIC_PLANARITY, thickness: capi.PANEL_METRIC_THICKNESS, miter: capi.PANEL_METRIC_MITER,
+  corner_distance: capi.PANEL_METRIC_CORNER_DISTANCE, conical: capi.PANEL_METRIC_CONICAL,
+});
+const CUTS_FORMATS = Object.freeze({ json: capi.CUTS_JSON, csv: capi.CUTS_CSV });
+
+// --- ids ------------------------------------------------------------------------------------------
+
+/** A value id {index, generation} of an object in a world; {0, 0} means "none" or "the default". */
+class Id {
+  constructor(index = 0, generation = 0) {
+    this.index = buf.uint32(index, `${new.target.name}.index`);
+    this.generation = buf.uint32(generation, `${new.target.name}.generation`);
+    Object.freeze(this);
+  }
+
+  equals(other) {
+    return other instanceof Id && other.constructor === this.constructor && other.index === this.index &&
+      other.generation === this.generation;
+  }
+
+  toString() {
+    return `${this.constructor.name}(index=${this.index}, generation=${this.generation})`;
+  }
+}
+
+/** embra_group_id: a constraint group ({0, 0} = the default group where a field says so). */
+class GroupId extends Id {}
+/** embra_body_id. */
+class BodyId extends Id {}
+/** embra_pin_id. */
+class PinId extends Id {}
+/** embra_collider_id. */
+class ColliderId extends Id {}
+/** embra_field_id: a wind, pressure, surface tension or vortex field. */
+class FieldId extends Id {}
+
+const ID_CLASSES = new Map([['embra_group_id', GroupId], ['embra_body_id', BodyId], ['embra_pin_id', PinId],
+  ['embra_collider_id', ColliderId], ['embra_field_id', FieldId]]);
+
+/** A body's id and its particle range [first, first + count). */
+class Body {
+  constructor(id, first, count) {
+    if (!(id instanceof BodyId)) throw new TypeError(`Body: expected a BodyId, got ${buf.describe(id)}`);
+    this.id = id;
+    this.first = buf.int32(first, 'Body.first');
+    this.count = buf.int32(count, 'Body.count');
+    Object.freeze(this);
+  }
+
+  toString() {
+    return `Body(index=${this.id.index}, first=${this.first}, count=${this.count})`;
+  }
+}
+
+function toId(value, cls, name) {
+  if (value === null || value === undefined) return new cls();
+  if (value instanceof Body && cls === BodyId) return value.id;
+  if (!(value instanceof cls)) throw new TypeError(`${name}: expected a ${cls.name}, got ${buf.describe(value)}`);
+  return value;
+}
+
+/** A struct read from C with its ids as Id objects (recursively). */
+function wrapIds(value, type) {
+  for (const [key, member] of Object.entries(type.members)) {
+    const cls = ID_CLASSES.get(member.type.name);
+    if (cls) value[key] = new cls(value[key].index, value[key].generation);
+    else if (member.type.primitive === 'Record') wrapIds(value[key], member.type);
+  }
+  return value;
+}
+
+// --- defs -----------------------------------------------------------------------------------------
+
+/** settleSpeed -> settle_speed: the C name of a field given in camelCase. */
+function cName(key) {
+  return key.replace(/[A-Z]/g, (c) => `_${c.toLowerCase()}`);
+}
+
+/** The options of a call as a Map from C names, each given once; unknown keys are left to the caller. */
+function options(value, what) {
+  if (value === null || value === undefined) return new Map();
+  if (typeof value !== 'object' || Array.isArray(value) || ArrayBuffer.isView(value)) {
+    throw new TypeError(`${what}: expected an object of named settings, got ${buf.describe(value)}`);
+  }
+  const out = new Map();
+  for (const [key, v] of Object.entries(value)) {
+    const name = cName(key);
+    if (out.has(name)) throw new TypeError(`${what}: '${name}' is given twice (as '${key}' too)`);
+    out.set(name, v);
+  }
+  return out;
+}
+
+/** Sets fields of a def (a JS object of koffi struct `type`) from a Map or object of values. */
+function fill(def, type, fields, what) {
+  const given = fields instanceof Map ? fields : options(fields, what);
+  for (const [key, value] of given) {
+    const member = type.members[key];
+    if (member === undefined) {
+      throw new TypeError(`${what} has no field '${key}' (fields: ${Object.keys(type.members).join(', ')})`);
+    }
+    const t = member.type;
+    const name = `${what}.${key}`;
+    const cls = ID_CLASSES.get(t.name);
+    if (cls) {
+      def[key] = toId(value, cls, name);
+    } else if (t.primitive === 'Record') {
+      fill(def[key], t, value, name);
+    } else if (t.primitive === 'Array') {
+      const v = buf.fixed(value, t.length, name);
+      def[key] = t.ref.primitive === 'Int32' ? v.map((x, i) => buf.int32(x, `${name}[${i}]`)) : v;
+    } else if (t.primitive === 'Int32') {
+      def[key] = buf.int32(value, name);
+    } else if (t.primitive === 'Int64') {
+      def[key] = buf.int64(value, name);
+    } else if (t.primitive === 'Float64') {
+      def[key] = buf.number(value, name);
+    } else {
+      throw new TypeError(`${name} is an array pointer: give the data as the call's own argument`);
+    }
+  }
+  return def;
+}
+
+function enumValue(value, table, name) {
+  if (typeof value === 'string') {
+    if (!Object.prototype.hasOwnProperty.call(table, value)) {
+      throw new RangeError(`${name}: unknown name '${value}' (known: ${Object.keys(table).join(', ')})`);
+    }
+    return table[value];
+  }
+  return buf.int32(value, name);
+}
+
+function take(opts, key) {
+  const v = opts.get(key);
+  opts.delete(key);
+  return v;
+}
+
+function wholeTuples(array, width, name, what) {
+  if (array.length % width) {
+    throw new RangeError(`${name}: ${array.length} ${what} is not a whole number of ${width}-tuples`);
+  }
+  return array.length / width;
+}
+
+function xyzCount(array, name) {
+  if (array.length % 3) throw new RangeError(`${name}: ${array.length} numbers is not a whole number of xyz triples`);
+  return buf.int32(array.length / 3, `${name} count`);
+}
+
+// --- the world ------------------------------------------------------------------------------------
+
+const registry = new FinalizationRegistry((ptr) => lib.embra_world_destroy(ptr));
+const ADOPT = Symbol('adopt');
+
+/** An embra world. Call close() when done (or let it be garbage-collected); a closed World refuses calls. */
+class World {
+  #ptr = null;
+
+  /**
+   * A world from embra_default_solver_def() and `settings`: any embra_solver_def field (dt, substeps,
+   * iterations, gravity, damping, settle_speed, tethers, realign_passes, self_collision).
+   */
+  constructor(settings, ptr) {
+    if (settings === ADOPT) {
+      this.#adopt(ptr);
+      return;
+    }
+    const def = fill(lib.embra_default_solver_def(), capi.SolverDef, settings, 'SolverDef');
+    const out = [null];
+    check(lib.embra_world_create(out, def));
+    this.#adopt(out[0]);
+  }
+
+  #adopt(ptr) {
+    this.#ptr = ptr;
+    registry.register(this, ptr, this);
+  }
+
+  /** A world from scene JSON text (a string or UTF-8 bytes); `baseDir` resolves relative OBJ paths. */
+  static loadJson(text, baseDir = null) {
+    let data;
+    if (typeof text === 'string') data = Buffer.from(text, 'utf8');
+    else if (text instanceof Uint8Array) data = text;
+    else throw new TypeError(`text: expected a string or a Uint8Array, got ${buf.describe(text)}`);
+    const dir = baseDir === null || baseDir === undefined ? null : buf.cString(baseDir, 'baseDir');
+    const out = [null];
+    check(lib.embra_world_load_json(out, data, data.length, dir));
+    return new World(ADOPT, out[0]);
+  }
+
+  /** A world from a scene file (relative OBJ paths resolve against its folder). */
+  static loadFile(path) {
+    const out = [null];
+    check(lib.embra_world_load_file(out, buf.cString(path, 'path')));
+    return new World(ADOPT, out[0]);
+  }
+
+  // --- lifetime -----------------------------------------------------------------------------------
+
+  /** Destroys the world (embra_world_destroy). Idempotent. */
+  close() {
+    const ptr = this.#ptr;
+    this.#ptr = null;
+    if (ptr !== null) {
+      registry.unregister(this);
+      lib.embra_world_destroy(ptr);
+    }
+  }
+
+  get closed() {
+    return this.#ptr === null;
+  }
+
+  /** Calls a C function with this world first; a closed World passes NULL, which C refuses. */
+  #call(name, ...args) {
+    const ptr = this.#ptr;
+    const status = lib[name](ptr, ...args);
+    if (status !== capi.OK) {
+      const err = errorFor(status);
+      if (ptr === null) throw new err.constructor(`${err.message} (this World was closed)`, status);
+      throw err;
+    }
+  }
+
+  // --- solver settings ----------------------------------------------------------------------------
+
+  /** The solver settings (a copy: change them with setSolver). */
+  get solver() {
+    const d = {};
+    this.#call('embra_world_get_solver', d);
+    return d;
+  }
+
+  /** Replaces the settings: the current ones with the given fields changed. */
+  setSolver(settings) {
+    const d = fill(this.solver, capi.SolverDef, settings, 'SolverDef');
+    this.#call('embra_world_set_solver', d);
+  }
+
+  /** Gravity in m/s^2 from the next step on (reverse it for the Gaudi paradigm). */
+  setGravity(gravity) {
+    this.#call('embra_world_set_gravity', Float64Array.from(buf.fixed(gravity, 3, 'gravity')));
+  }
+
+  /** {particles, bodies, groups, pins, colliders, constraints}. */
+  counts() {
+    const c = {};
+    this.#call('embra_world_get_counts', c);
+    return c;
+  }
+
+  get particleCount() {
+    return this.counts().particles;
+  }
+
+  /** Ids of the live objects of one kind, in creation order (two calls: count, then ids). */
+  #ids(name, cls) {
+    const n = [0];
+    this.#call(name, null, 0, n);
+    const out = new Uint32Array(2 * n[0]);
+    this.#call(name, out, n[0], n);
+    const ids = [];
+    for (let k = 0; k < n[0]; k++) ids.push(new cls(out[2 * k], out[2 * k + 1]));
+    return ids;
+  }
+
+  /** The BodyIds of the live bodies, in creation order (a loaded scene's: in the scene's order). */
+  bodies() {
+    return this.#ids('embra_world_get_bodies', BodyId);
+  }
+
+  /** The GroupIds of the live groups, the default and contact groups first. */
+  groups() {
+    return this.#ids('embra_world_get_groups', GroupId);
+  }
+
+  /** The PinIds of the live pins, in creation order. */
+  pins() {
+    return this.#ids('embra_world_get_pins', PinId);
+  }
+
+  /** The ColliderIds of the live colliders, in creation order. */
+  colliders() {
+    return this.#ids('embra_world_get_colliders', ColliderId);
+  }
+
+  // --- groups -------------------------------------------------------------------------------------
+
+  /** A constraint group: {order (lower first; default 0), weight (projections per pass; default 1)}. */
+  createGroup(settings) {
+    const d = fill(lib.embra_default_group_def(), capi.GroupDef, settings, 'GroupDef');
+    const g = {};
+    this.#call('embra_group_create', d, g);
+    return new GroupId(g.index, g.generation);
+  }
+
+  destroyGroup(group) {
+    this.#call('embra_group_destroy', toId(group, GroupId, 'group'));
+  }
+
+  setGroupOrder(group, order) {
+    this.#call('embra_group_set_order', toId(group, GroupId, 'group'), buf.int32(order, 'order'));
+  }
+
+  setGroupWeight(group, weight) {
+    this.#call('embra_group_set_weight', toId(group, GroupId, 'group'), buf.int32(weight, 'weight'));
+  }
+
+  defaultGroup() {
+    const g = {};
+    this.#call('embra_world_default_group', g);
+    return new GroupId(g.index, g.generation);
+  }
+
+  contactGroup() {
+    const g = {};
+    this.#call('embra_world_contact_group', g);
+    return new GroupId(g.index, g.generation);
+  }
+
+  /** {count, residual_max, residual_rms} of a group's last step. */
+  groupReport(group) {
+    const r = {};
+    this.#call('embra_group_get_report', toId(group, GroupId, 'group'), r);
+    return r;
+  }
+
+  // --- bodies -------------------------------------------------------------------------------------
+
+  /**
+   * Adds a body (embra_body_create) and returns its Body (id, first particle, count).
+   *
+   * positions: xyz per vertex (a Float64Array is used in place; flat or nested arrays are packed).
+   * options: triangles, edges, tets (body-local vertex indices, flat or nested); masses (kg per
+   * vertex); uvs (2 per vertex); generate (flags, a name or a list of names of GENERATE); material
+   * (embra_material fields) and/or material fields directly (mass, stretch_compliance, ...);
+   * stretch_group, shear_group, bend_group, volume_group (GroupId).
+   */
+  createBody(positions, opts) {
+    const o = options(opts, 'createBody options');
+    const d = lib.embra_default_body_def();
+    const xyz = buf.doublesIn(positions, 'positions');
+    if (xyz === null) throw new TypeError('positions: required');
+    const n = xyzCount(xyz, 'positions');
+    d.positions = xyz;
+    d.vertex_count = n;
+    const masses = buf.doublesIn(take(o, 'masses'), 'masses');
+    if (masses !== null) {
+      if (masses.length !== n) throw new RangeError(`masses: ${masses.length} values for ${n} vertices`);
+      d.masses = masses;
+    }
+    const uvs = buf.doublesIn(take(o, 'uvs'), 'uvs');
+    if (uvs !== null) {
+      if (uvs.length !== 2 * n) throw new RangeError(`uvs: ${uvs.length} numbers for ${n} vertices (2 per vertex)`);
+      d.uvs = uvs;
+    }
+    for (const [key, width, count] of [['triangles', 3, 'triangle_count'], ['edges', 2, 'edge_count'],
+      ['tets', 4, 'tet_count']]) {
+      const idx = buf.intsIn(take(o, key), key);
+      if (idx !== null) {
+        d[count] = buf.int32(wholeTuples(idx, width, key, 'indices'), `${key} count`);
+        d[key] = idx;
+      }
+    }
+    if (o.has('generate')) {
+      const g = take(o, 'generate');
+      d.generate = Array.isArray(g) ? g.reduce((flags, x, i) => flags | enumValue(x, GENERATE, `generate[${i}]`), 0)
+        : enumValue(g, GENERATE, 'generate');
+    }
+    if (o.has('material')) fill(d.material, capi.Material, take(o, 'material'), 'Material');
+    for (const key of ['stretch_group', 'shear_group', 'bend_group', 'volume_group']) {
+      if (o.has(key)) d[key] = toId(take(o, key), GroupId, key);
+    }
+    fill(d.material, capi.Material, o, 'Material');
+    const body = {};
+    const first = [0];
+    this.#call('embra_body_create', d, body, first);
+    return new Body(new BodyId(body.index, body.generation), first[0], n);
+  }
+
+  /** {first, count} of a body's particles. */
+  bodyParticles(body) {
+    const first = [0];
+    const count = [0];
+    this.#call('embra_body_get_particles', toId(body, BodyId, 'body'), first, count);
+    return { first: first[0], count: count[0] };
+  }
+
+  /** Scales the rest lengths of a body's generated stretch constraints (and volumes by scale^3). */
+  setRestScale(body, scale = 1.0, scaleU = 1.0, scaleV = 1.0) {
+    this.#call('embra_body_set_rest_scale', toId(body, BodyId, 'body'), buf.number(scale, 'scale'),
+      buf.number(scaleU, 'scaleU'), buf.number(scaleV, 'scaleV'));
+  }
+
+  /** A body's triangles as world particle indices, 3 per triangle (an Int32Array). */
+  bodyTriangles(body) {
+    const b = toId(body, BodyId, 'body');
+    const n = [0];
+    this.#call('embra_body_get_triangles', b, null, 0, n);
+    const out = new Int32Array(n[0]);
+    this.#call('embra_body_get_triangles', b, out, out.length, n);
+    return out;
+  }
+
+  // --- panel meshes -------------------------------------------------------------------------------
+
+  /**
+   * Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create) and returns its Body (8 particles
+   * per panel). settings: positions and quads (the top quad mesh: xyz per vertex, 4 indices per quad)
+   * or, without them, a grid of grid_columns x grid_rows panels of panel_size at origin; pins (a
+   * PANEL_PINS name or number); group; any other embra_panel_mesh_def field (thickness, mass, ...).
+   */
+  createPanelMesh(settings) {
+    const o = options(settings, 'createPanelMesh settings');
+    const d = lib.embra_default_panel_mesh_def();
+    const positions = take(o, 'positions');
+    const quads = take(o, 'quads');
+    if (o.has('pins')) d.pins = enumValue(take(o, 'pins'), PANEL_PINS, 'pins');
+    for (const key of ['vertex_count', 'quad_count']) {
+      if (o.has(key)) throw new TypeError(`createPanelMesh: ${key} is taken from positions and quads`);
+    }
+    fill(d, capi.PanelMeshDef, o, 'PanelMeshDef');
+    if ((positions === undefined || positions === null) !== (quads === undefined || quads === null)) {
+      throw new TypeError('createPanelMesh: positions and quads go together (neither: a grid)');
+    }
+    let panels = d.grid_columns * d.grid_rows;
+    if (positions !== undefined && positions !== null) {
+      const xyz = buf.doublesIn(positions, 'positions');
+      const q = buf.intsIn(quads, 'quads');
+      d.positions = xyz;
+      d.vertex_count = xyzCount(xyz, 'positions');
+      d.quads = q;
+      d.quad_count = buf.int32(wholeTuples(q, 4, 'quads', 'indices'), 'quad count');
+      panels = d.quad_count;
+    }
+    const body = {};
+    const first = [0];
+    this.#call('embra_panel_mesh_create', d, body, first);
+    return new Body(new BodyId(body.index, body.generation), first[0], 8 * panels);
+  }
+
+  /** The number of panels of a panel-mesh body. */
+  panelCount(body) {
+    const n = [0];
+    this.#call('embra_panel_mesh_get_panel_count', toId(body, BodyId, 'body'), n);
+    return n[0];
+  }
+
+  /** The fabrication tolerances the metrics are judged against (a copy). */
+  get tolerances() {
+    const t = {};
+    this.#call('embra_world_get_tolerances', t);
+    return t;
+  }
+
+  set tolerances(tolerances) {
+    this.setTolerances(tolerances);
+  }
+
+  /** Replaces the tolerances: the current ones with the given fields changed ({miter: {target, max}}). */
+  setTolerances(tolerances) {
+    const t = fill(this.tolerances, capi.Tolerances, tolerances, 'Tolerances');
+    this.#call('embra_world_set_tolerances', t);
+  }
+
+  /**
+   * The section 4.1 metrics of a panel-mesh body at the current positions, judged against
+   * `tolerances` (fields over the defaults) or, when omitted, the world's.
+   */
+  panelMetrics(body, tolerances = null) {
+    const b = toId(body, BodyId, 'body');
+    const t = tolerances === null || tolerances === undefined ? null
+      : fill(lib.embra_default_tolerances(), capi.Tolerances, tolerances, 'Tolerances');
+    const m = {};
+    this.#call('embra_panel_mesh_get_metrics', b, t, m);
+    return m;
+  }
+
+  /**
+   * One error value per particle of a panel-mesh body (8 per panel, in body order) for a colour map:
+   * metric a PANEL_METRICS name or number. A new Float64Array, or `out` written in place (too small:
+   * BufferTooSmallError, nothing written).
+   */
+  vertexErrors(body, metric, out = null) {
+    const b = toId(body, BodyId, 'body');
+    const m = enumValue(metric, PANEL_METRICS, 'metric');
+    const n = [0];
+    let result = out;
+    if (out === null || out === undefined) {
+      this.#call('embra_panel_mesh_get_vertex_errors', b, m, null, 0, n);
+      result = new Float64Array(n[0]);
+    } else {
+      buf.doublesOut(0, out, 'out');
+    }
+    this.#call('embra_panel_mesh_get_vertex_errors', b, m, result, result.length, n);
+    return result;
+  }
+
+  /** The cut list of a panel-mesh body at the current positions as text: format "json" or "csv". */
+  exportCuts(body, format = 'json') {
+    const b = toId(body, BodyId, 'body');
+    const f = enumValue(format, CUTS_FORMATS, 'format');
+    const n = [0];
+    this.#call('embra_panel_mesh_export_cuts', b, f, null, 0, n);
+    const out = Buffer.alloc(n[0]);
+    this.#call('embra_panel_mesh_export_cuts', b, f, out, out.length, n);
+    return out.toString('utf8', 0, n[0] - 1);
+  }
+
+  // --- constraints --------------------------------------------------------------------------------
+
+  /**
+   * One constraint (embra_constraint_add): kind a KINDS name or number, its particles (world indices),
+   * options {rest (omitted: measured from the current positions), compliance (default 0), group}.
+   */
+  addConstraint(kind, particles, opts) {
+    const o = options(opts, 'addConstraint options');
+    const d = lib.embra_default_constraint_def();
+    d.kind = enumValue(kind, KINDS, 'kind');
+    const ids = Array.from(buf.intsIn(particles, 'particles') || []);
+    const arity = lib.embra_constraint_arity(d.kind);
+    if (arity && ids.length !== arity) {
+      throw new RangeError(`particles: kind ${kind} takes ${arity} particles, got ${ids.length}`);
+    }
+    if (ids.length > 4) throw new RangeError(`particles: at most 4, got ${ids.length}`);
+    while (ids.length < 4) ids.push(0);
+    d.particles = ids;
+    const rest = take(o, 'rest');
+    if (rest !== undefined && rest !== null) {
+      d.rest_from_current = 0;
+      d.rest = buf.number(rest, 'rest');
+    }
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`addConstraint: unknown option '${o.keys().next().value}'`);
+    this.#call('embra_constraint_add', d);
+  }
+
+  /**
+   * Many constraints of one kind at once (embra_constraints_add), all or none; returns their count.
+   * particles: arity indices per constraint (flat or nested); options {rest, compliances (one value
+   * per constraint each), compliance (for all; default 0), group}.
+   */
+  addConstraints(kind, particles, opts) {
+    const o = options(opts, 'addConstraints options');
+    const d = lib.embra_default_constraint_batch_def();
+    d.kind = enumValue(kind, KINDS, 'kind');
+    const arity = lib.embra_constraint_arity(d.kind);
+    const p = buf.intsIn(particles, 'particles');
+    if (p === null) throw new TypeError('particles: required');
+    const count = arity ? wholeTuples(p, arity, 'particles', 'indices') : p.length;
+    d.count = buf.int32(count, 'count');
+    d.particles = p;
+    for (const key of ['rest', 'compliances']) {
+      const values = buf.doublesIn(take(o, key), key);
+      if (values !== null) {
+        if (values.length !== count) throw new RangeError(`${key}: ${values.length} values for ${count} constraints`);
+        d[key] = values;
+      }
+    }
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`addConstraints: unknown option '${o.keys().next().value}'`);
+    this.#call('embra_constraints_add', d);
+    return count;
+  }
+
+  // --- pins ---------------------------------------------------------------------------------------
+
+  /** Holds `particle` at `target` (m); options {compliance: 0 = hard, > 0 (m/N) a soft pin in `group`}. */
+  createPin(particle, target, opts) {
+    const o = options(opts, 'createPin options');
+    const d = lib.embra_default_pin_def();
+    d.particle = buf.int32(particle, 'particle');
+    d.target = buf.fixed(target, 3, 'target');
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createPin: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_pin_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
+  destroyPin(pin) {
+    this.#call('embra_pin_destroy', toId(pin, PinId, 'pin'));
+  }
+
+  /** Moves a pin's target (m); a hard-pinned particle travels there over the next step's substeps. */
+  setPinTarget(pin, target) {
+    this.#call('embra_pin_set_target', toId(pin, PinId, 'pin'), Float64Array.from(buf.fixed(target, 3, 'target')));
+  }
+
+  /** A pin's target [x, y, z] (m). */
+  pinTarget(pin) {
+    const out = new Float64Array(3);
+    this.#call('embra_pin_get_target', toId(pin, PinId, 'pin'), out);
+    return Array.from(out);
+  }
+
+  /** The particle a pin holds. */
+  pinParticle(pin) {
+    const p = [0];
+    this.#call('embra_pin_get_particle', toId(pin, PinId, 'pin'), p);
+    return p[0];
+  }
+
+  // --- colliders ----------------------------------------------------------------------------------
+
+  /**
+   * A collider: shape a SHAPES name or number; settings: embra_collider_def fields (position,
+   * rotation {w, x, y, z}, radius, thickness, friction_static, friction_dynamic, half_extents,
+   * half_length) and, for convex and mesh shapes, vertices (local xyz) and triangles.
+   */
+  createCollider(shape, settings) {
+    const o = options(settings, 'createCollider settings');
+    const d = lib.embra_default_collider_def();
+    d.shape = enumValue(shape, SHAPES, 'shape');
+    const vertices = buf.doublesIn(take(o, 'vertices'), 'vertices');
+    const triangles = buf.intsIn(take(o, 'triangles'), 'triangles');
+    for (const key of ['vertex_count', 'triangle_count']) {
+      if (o.has(key)) throw new TypeError(`createCollider: ${key} is taken from vertices and triangles`);
+    }
+    fill(d, capi.ColliderDef, o, 'ColliderDef');
+    if (vertices !== null) {
+      d.vertex_count = xyzCount(vertices, 'vertices');
+      d.vertices = vertices;
+    }
+    if (triangles !== null) {
+      d.triangle_count = buf.int32(wholeTuples(triangles, 3, 'triangles', 'indices'), 'triangle count');
+      d.triangles = triangles;
+    }
+    const c = {};
+    this.#call('embra_collider_create', d, c);
+    return new ColliderId(c.index, c.generation);
+  }
+
+  destroyCollider(collider) {
+    this.#call('embra_collider_destroy', toId(collider, ColliderId, 'collider'));
+  }
+
+  /** Where the collider is at the end of the next step: position (m), rotation {w, x, y, z}. */
+  setColliderTransform(collider, position, rotation = [1.0, 0.0, 0.0, 0.0]) {
+    this.#call('embra_collider_set_transform', toId(collider, ColliderId, 'collider'),
+      Float64Array.from(buf.fixed(position, 3, 'position')), Float64Array.from(buf.fixed(rotation, 4, 'rotation')));
+  }
+
+  /** Where the collider is now: {position: [x, y, z] (m), rotation: [w, x, y, z]}. */
+  colliderTransform(collider) {
+    const position = new Float64Array(3);
+    const rotation = new Float64Array(4);
+    this.#call('embra_collider_get_transform', toId(collider, ColliderId, 'collider'), position, rotation);
+    return { position: Array.from(position), rotation: Array.from(rotation) };
+  }
+
+  // --- fields -------------------------------------------------------------------------------------
+
+  #createField(def, type, create, what, fields) {
+    fill(def, type, fields, what);
+    const f = {};
+    this.#call(create, def, f);
+    return new FieldId(f.index, f.generation);
+  }
+
+  /** A wind field: embra_wind_def fields (body: a Body or BodyId, omitted = every body; direction, speed, ...). */
+  createWind(fields) {
+    return this.#createField(lib.embra_default_wind_def(), capi.WindDef, 'embra_wind_create', 'WindDef', fields);
+  }
+
+  /** Air pressure on a closed body (required: body): embra_pressure_def fields. */
+  createPressure(fields) {
+    return this.#createField(lib.embra_default_pressure_def(), capi.PressureDef, 'embra_pressure_create',
+      'PressureDef', fields);
+  }
+
+  /** A soap-film tension on a body's triangles (required: body; tension, regularisation). */
+  createSurfaceTension(fields) {
+    return this.#createField(lib.embra_default_surface_tension_def(), capi.SurfaceTensionDef,
+      'embra_surface_tension_create', 'SurfaceTensionDef', fields);
+  }
+
+  /** A decaying torsion field about an axis: embra_vortex_def fields (body, center, axis, strength, ...). */
+  createVortex(fields) {
+    return this.#createField(lib.embra_default_vortex_def(), capi.VortexDef, 'embra_vortex_create', 'VortexDef',
+      fields);
+  }
+
+  /** Destroys a field; its id becomes stale. */
+  destroyField(field) {
+    this.#call('embra_field_destroy', toId(field, FieldId, 'field'));
+  }
+
+  /** Number of live fields. */
+  get fieldCount() {
+    const n = [0];
+    this.#call('embra_world_get_field_count', n);
+    return n[0];
+  }
+
+  // --- stepping and reading back ------------------------------------------------------------------
+
+  /** Advances `frames` frames. NumericalError: the world is as before the failing frame. */
+  step(frames = 1) {
+    buf.int32(frames, 'frames');
+    if (frames < 0) throw new RangeError(`frames: ${frames} is negative`);
+    for (let i = 0; i < frames; i++) this.#call('embra_world_step');
+  }
+
+  /** The report of the last step: {frame, time, kinetic_energy, max_speed, residual_max, ...}. */
+  report() {
+    const r = {};
+    this.#call('embra_world_get_report', r);
+    return r;
+  }
+
+  /** The last numerical failure: {frame, particle} (-1 if none). */
+  warning() {
+    const w = {};
+    this.#call('embra_world_get_warning', w);
+    return w;
+  }
+
+  #read(name, first, count, out) {
+    buf.int32(first, 'first');
+    let n = count;
+    if (n === null || n === undefined) n = Math.max(this.particleCount - first, 0);
+    buf.int32(n, 'count');
+    const result = buf.doublesOut(3 * Math.max(n, 0), out, 'out');
+    this.#call(name, result, result.length, first, n);
+    return result;
+  }
+
+  /**
+   * Positions (m) of particles [first, first + count) (count omitted: to the last particle), flat xyz:
+   * a new Float64Array, or `out` written in place (too small: BufferTooSmallError, nothing written).
+   */
+  positions(first = 0, count = null, out = null) {
+    return this.#read('embra_world_get_positions', first, count, out);
+  }
+
+  /** Velocities (m/s), as positions(). */
+  velocities(first = 0, count = null, out = null) {
+    return this.#read('embra_world_get_velocities', first, count, out);
+  }
+
+  #write(name, xyz, first) {
+    const data = buf.doublesIn(xyz, 'xyz');
+    if (data === null) throw new TypeError('xyz: required');
+    const n = xyzCount(data, 'xyz');
+    this.#call(name, data, buf.int32(first, 'first'), n);
+  }
+
+  /** Moves particles [first, first + xyz.length / 3) to xyz (m); velocities are kept. */
+  setPositions(xyz, first = 0) {
+    this.#write('embra_world_set_positions', xyz, first);
+  }
+
+  /** Sets particles' velocities (m/s), as setPositions. */
+  setVelocities(xyz, first = 0) {
+    this.#write('embra_world_set_velocities', xyz, first);
+  }
+
+  // --- JSON scenes --------------------------------------------------------------------------------
+
+  /** The world as scene JSON text (complete: loading it steps on bit-identically). */
+  saveJson() {
+    const n = [0];
+    this.#call('embra_world_save_json', null, 0, n);
+    const out = Buffer.alloc(n[0]);
+    this.#call('embra_world_save_json', out, out.length, n);
+    return out.toString('utf8', 0, n[0] - 1);
+  }
+
+  /** Writes the world as scene JSON to a file (replaced whole). */
+  saveFile(path) {
+    this.#call('embra_world_save_file', buf.cString(path, 'path'));
+  }
+
+  /** The scene's own frame count (600 for a world not loaded from a scene). */
+  sceneFrames() {
+    const f = [0];
+    this.#call('embra_world_get_scene_frames', f);
+    return f[0];
+  }
+}
+
+if (typeof Symbol.dispose === 'symbol') {
+  World.prototype[Symbol.dispose] = World.prototype.close; // `using world = new World()`
+}
+
+module.exports = {
+  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_METRICS,
+  CUTS_FORMATS, EmbraError, wrapIds,
+};

@@ -1,0 +1,62 @@
+#!/usr/bin/env node
+'use strict';
+// embra-live SCENE.json [--port P] [--host H] [--save-dir DIR] [--web DIR]
+//
+// Loads a scene, steps it in real time and serves the page at http://H:P/ (loopback by default):
+// drag the mesh, move colliders, toggle gravity and pins, change group weights and rest scales,
+// save a design alternative as scene JSON, export glTF or Rhino .3dm. The protocol is
+// docs/live-protocol.md. Exit codes: 0 stopped by a signal, 1 usage, 2 the scene or a file is invalid.
+
+const fs = require('fs');
+const path = require('path');
+const { startServer } = require('./server');
+
+function usage(message) {
+  if (message) process.stderr.write(`embra-live: ${message}\n`);
+  process.stderr.write('usage: embra-live SCENE.json [--port P] [--host 127.0.0.1] [--save-dir DIR] [--web DIR]\n');
+  process.exit(1);
+}
+
+function parse(argv) {
+  const o = { port: 8710, host: '127.0.0.1', saveDir: '.', web: undefined, scene: undefined };
+  for (let i = 0; i < argv.length; ++i) {
+    const a = argv[i];
+    const value = () => {
+      if (i + 1 >= argv.length) usage(`${a} needs a value`);
+      return argv[++i];
+    };
+    if (a === '--port') {
+      o.port = Number(value());
+      if (!Number.isInteger(o.port) || o.port < 0 || o.port > 65535) usage('--port must be 0..65535');
+    } else if (a === '--host') o.host = value();
+    else if (a === '--save-dir') o.saveDir = value();
+    else if (a === '--web') o.web = value();
+    else if (a === '-h' || a === '--help') usage();
+    else if (a.startsWith('-')) usage(`unknown option ${a}`);
+    else if (o.scene === undefined) o.scene = a;
+    else usage('one scene at a time');
+  }
+  if (o.scene === undefined) usage('no scene given');
+  return o;
+}
+
+async function main() {
+  const o = parse(process.argv.slice(2));
+  const web = o.web || path.join(__dirname, '..', '..', 'web', 'dist');
+  if (!fs.existsSync(path.join(web, 'index.html')))
+    process.stderr.write(`embra-live: no page at ${web} (build it: cd host_adapters/web && npm run build); serving the socket only\n`);
+  let live;
+  try {
+    live = await startServer({ ...o, web });
+  } catch (e) {
+    process.stderr.write(`embra-live: ${o.scene}: ${e.message}\n`);
+    process.exit(2);
+  }
+  const s = live.session;
+  process.stdout.write(`embra-live: ${s.name} (${s.particles} particles, dt ${s.dt.toFixed(4)} s) at ${live.url}\n`);
+  const stop = () => live.close().then(() => process.exit(0));
+  process.on('SIGINT', stop);
+  process.on('SIGTERM', stop);
+}
+
+main();

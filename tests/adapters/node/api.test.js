@@ -1,0 +1,253 @@
+'use strict';
+// The Node adapter covers the C ABI, and each part of it does what the header says.
+
+const assert = require('node:assert/strict');
+const { spawnSync } = require('node:child_process');
+const fs = require('node:fs');
+const path = require('node:path');
+const test = require('node:test');
+
+const { embra, packageDir, tempDir, assertSameBits } = require('./helpers');
+
+const dist = (p, a, b) => Math.hypot(p[3 * a] - p[3 * b], p[3 * a + 1] - p[3 * b + 1], p[3 * a + 2] - p[3 * b + 2]);
+
+test('versions and status names', () => {
+  const v = embra.version();
+  const [major, minor, patch] = embra.versionString().split('.').map(Number);
+  assert.equal(v, major * 10000 + minor * 100 + patch);
+  assert.equal(embra.abiVersion(), embra.ABI_VERSION);
+  embra.checkAbi();
+  assert.throws(() => embra.checkAbi(embra.ABI_VERSION + 1), (e) => e instanceof embra.VersionError &&
+    /embra_check_abi/.test(e.message));
+  assert.equal(embra.statusName(-2), 'EMBRA_ERROR_STALE_ID');
+  assert.equal(embra.statusName(0), 'EMBRA_OK');
+});
+
+test('defaults are the documented ones', () => {
+  const s = embra.defaultSolverDef();
+  assert.deepEqual([s.version, s.substeps, s.iterations, s.tethers, s.realign_passes], [1, 20, 1, 2, 0]);
+  assert.equal(s.dt, 1.0 / 60.0);
+  assert.deepEqual(s.gravity, [0, 0, -9.81]);
+  assert.equal(s.settle_speed, 1e-3);
+  const m = embra.defaultMaterial();
+  assert.deepEqual([m.mass, m.density, m.stretch_compliance, m.bend_compliance], [0, 1, 0, 1]);
+  assert.deepEqual([m.friction_static, m.friction_dynamic], [0.5, 0.3]);
+  assert.deepEqual(['distance', 'edge_angle', 'dihedral', 'tet_volume', 'weld', 'tether', 'planarity',
+    'plane_offset'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4]);
+  const b = embra.defaultBodyDef();
+  assert.equal(b.generate, embra.GENERATE.stretch | embra.GENERATE.bend | embra.GENERATE.volume);
+  assert.ok(b.stretch_group instanceof embra.GroupId && b.stretch_group.equals(new embra.GroupId()));
+  const c = embra.defaultColliderDef();
+  assert.deepEqual([c.version, c.rotation, c.radius, c.half_extents, c.half_length],
+    [embra.capi.COLLIDER_DEF_VERSION, [1, 0, 0, 0], 1, [0.5, 0.5, 0.5], 0.5]);
+  assert.deepEqual([embra.defaultGroupDef().weight, embra.defaultPinDef().compliance,
+    embra.defaultConstraintDef().rest_from_current, embra.defaultConstraintBatchDef().compliance], [1, 0, 1, 0]);
+});
+
+test('free fall is symplectic Euler in closed form', () => {
+  // one free particle: after N substeps of h, z = z0 - h^2 g N (N + 1) / 2 exactly (v0 = 0)
+  const w = new embra.World({ gravity: [0.0, 0.0, -9.81], substeps: 10 });
+  const body = w.createBody([[0.0, 0.0, 5.0]], { mass: 2.0 });
+  w.step(30);
+  const n = 300;
+  const h = (1.0 / 60.0) / 10;
+  const z = w.positions(body.first, 1)[2];
+  assert.ok(Math.abs(z - (5.0 - 9.81 * h * h * n * (n + 1) / 2)) < 1e-10);
+  const vz = w.velocities(body.first, 1)[2];
+  assert.ok(Math.abs(vz - (-9.81 * n * h)) < 1e-9);
+  const r = w.report();
+  assert.equal(r.frame, 30);
+  assert.ok(Math.abs(r.time - 0.5) < 1e-12);
+  assert.ok(Math.abs(r.kinetic_energy - 0.5 * 2.0 * vz * vz) < 1e-9);
+  w.close();
+});
+
+test('groups, bulk constraints and reports: a hard chain hangs at its rest lengths', () => {
+  const xyz = [0, 1, 2, 3, 4, 5].map((i) => [0.1 * i, 0.0, 0.0]);
+  const w = new embra.World({ iterations: 20 });
+  const def = w.defaultGroup();
+  const contact = w.contactGroup();
+  assert.ok(!def.equals(contact));
+  const links = w.createGroup({ order: 5, weight: 3 });
+  w.setGroupOrder(links, 4);
+  w.setGroupWeight(links, 2);
+  const body = w.createBody(xyz, { generate: 0, mass: 0.6 });
+  assert.deepEqual(w.bodyParticles(body), { first: body.first, count: 6 });
+  assert.equal(w.addConstraints('distance', [0, 1, 2, 3, 4].map((i) => [i, i + 1]), { group: links }), 5);
+  assert.equal(w.counts().constraints, 5);
+  w.addConstraint('tether', [0, 5], { rest: 0.6, compliance: 1e-3, group: links }); // slack: never pulls
+  w.createPin(0, xyz[0]);
+  w.step(120);
+  assert.equal(w.counts().constraints, 6);
+  assert.equal(w.counts().groups, 3);
+  const p = w.positions();
+  for (let i = 0; i < 5; i++) assert.ok(Math.abs(dist(p, i, i + 1) - 0.1) < 1e-6, `link ${i}`);
+  const g = w.groupReport(links);
+  assert.equal(g.count, 6);
+  assert.ok(g.residual_max < 1e-6);
+  w.destroyGroup(links);
+  assert.equal(w.counts().constraints, 0);
+  assert.equal(w.counts().groups, 2);
+  assert.equal(w.warning().frame, -1);
+  w.close();
+});
+
+test('bulk rest and compliance arrays', () => {
+  const w = new embra.World({ gravity: [0, 0, 0], iterations: 50 });
+  w.createBody([[0, 0, 0], [1, 0, 0], [2, 0, 0]], { generate: 0, mass: 3.0 });
+  w.addConstraints(embra.KINDS.distance, new Int32Array([0, 1, 1, 2]), { rest: [0.5, 0.25],
+    compliances: new Float64Array([0, 0]) });
+  w.step(60);
+  const p = w.positions();
+  assert.ok(Math.abs(dist(p, 0, 1) - 0.5) < 1e-9);
+  assert.ok(Math.abs(dist(p, 1, 2) - 0.25) < 1e-9);
+  w.close();
+});
+
+test('pin targets move particles', () => {
+  const w = new embra.World();
+  w.createBody([[0, 0, 0]], { mass: 1.0 });
+  const pin = w.createPin(0, [0, 0, 0]);
+  w.setPinTarget(pin, [0.25, -0.5, 1.0]);
+  assert.deepEqual(w.pinTarget(pin), [0.25, -0.5, 1.0]);
+  w.step();
+  assert.deepEqual(Array.from(w.positions()), [0.25, -0.5, 1.0]);
+  w.close();
+});
+
+test('colliders hold a falling particle and carry it when moved', () => {
+  const w = new embra.World();
+  w.createBody([[0, 0, 2]], { mass: 1.0 });
+  const sphere = w.createCollider('sphere', { position: [0, 0, 0], radius: 1.0 });
+  const floor = w.createCollider('plane', { position: [0, 0, -5] });
+  w.step(120);
+  assert.ok(Math.abs(w.positions()[2] - 1.0) < 1e-6, 'resting on top of the sphere');
+  w.setColliderTransform(sphere, [0, 0, -1]);
+  w.destroyCollider(floor);
+  w.step(60);
+  assert.ok(Math.abs(w.positions()[2]) < 1e-6, 'followed the sphere down');
+  const hull = [[-1, -1, -1], [1, -1, -1], [0, 1, -1], [0, 0, 1]];
+  w.createCollider('convex', { position: [5, 0, 0], vertices: hull });
+  w.createCollider(embra.SHAPES.mesh, { position: [9, 0, 0], vertices: hull,
+    triangles: [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]] });
+  w.createCollider('box', { position: [-5, 0, 0], halfExtents: [1, 2, 3] });
+  w.createCollider('capsule', { position: [-9, 0, 0], radius: 0.5, half_length: 1.0 });
+  assert.equal(w.counts().colliders, 5);
+  w.close();
+});
+
+test('live ids in creation order, a pin\'s particle, a collider\'s pose', () => {
+  const w = new embra.World({ gravity: [0, 0, 0] });
+  const ids = (list) => list.map(String);
+  assert.deepEqual(ids(w.groups()), ids([w.defaultGroup(), w.contactGroup()]));
+  assert.deepEqual(w.bodies(), []);
+  const a = w.createBody([[0, 0, 0], [1, 0, 0]], { edges: [[0, 1]], mass: 1.0 });
+  const b = w.createBody([[0, 0, 1]], { mass: 1.0 });
+  const g = w.createGroup({ order: 3 });
+  assert.deepEqual(ids(w.bodies()), ids([a.id, b.id]));
+  assert.ok(w.bodies()[1] instanceof embra.BodyId);
+  assert.deepEqual(ids(w.groups()), ids([w.defaultGroup(), w.contactGroup(), g]));
+  const pins = [w.createPin(1, [1, 0, 0]), w.createPin(2, [0, 0, 1]), w.createPin(0, [0, 0, 0])];
+  assert.deepEqual(pins.map((p) => w.pinParticle(p)), [1, 2, 0]);
+  w.destroyPin(pins[1]);
+  assert.deepEqual(ids(w.pins()), ids([pins[0], pins[2]]));
+  const ball = w.createCollider('sphere', { position: [0, 0, -3], radius: 0.5 });
+  const box = w.createCollider('box', { position: [4, 0, 0], rotation: [0, 0, 0, 1] });
+  assert.deepEqual(ids(w.colliders()), ids([ball, box]));
+  assert.deepEqual(w.colliderTransform(ball), { position: [0, 0, -3], rotation: [1, 0, 0, 0] });
+  assert.deepEqual(w.colliderTransform(box), { position: [4, 0, 0], rotation: [0, 0, 0, 1] });
+  w.setColliderTransform(ball, [0, 1, -3]); // the pose it reaches at the end of the next step
+  assert.deepEqual(w.colliderTransform(ball).position, [0, 1, -3]);
+  w.step();
+  assert.deepEqual(w.colliderTransform(ball), { position: [0, 1, -3], rotation: [1, 0, 0, 0] });
+  w.destroyCollider(ball);
+  assert.deepEqual(ids(w.colliders()), ids([box]));
+  w.destroyGroup(g);
+  assert.equal(w.groups().length, 2);
+  w.close();
+});
+
+test('rest scale shrinks edges', () => {
+  const w = new embra.World({ gravity: [0, 0, 0], iterations: 10 });
+  const body = w.createBody([[0, 0, 0], [1, 0, 0]], { edges: [[0, 1]], mass: 1.0 });
+  w.setRestScale(body, 0.5, 1.0, 1.0);
+  w.step(120);
+  assert.ok(Math.abs(dist(w.positions(), 0, 1) - 0.5) < 1e-9);
+  w.close();
+});
+
+test('positions, velocities and triangles round trip; typed arrays are used in place', () => {
+  const w = new embra.World();
+  const xyz = new Float64Array([0, 0, 0, 1, 0, 0, 0, 1, 0]);
+  const body = w.createBody(xyz, { triangles: new Int32Array([0, 1, 2]), mass: 1.0 });
+  w.setPositions([[0.5, 0.25, 2.0]], 2);
+  w.setVelocities(new Float64Array([1, 2, 3, 4, 5, 6]), 0);
+  assert.deepEqual(Array.from(w.positions(2, 1)), [0.5, 0.25, 2.0]);
+  assert.deepEqual(Array.from(w.velocities()), [1, 2, 3, 4, 5, 6, 0, 0, 0]);
+  const tri = w.bodyTriangles(new embra.BodyId(0, 1));
+  assert.ok(tri instanceof Int32Array);
+  assert.deepEqual(Array.from(tri), [0, 1, 2]);
+  const out = new Float64Array(9);
+  assert.equal(w.positions(body.first, 3, out), out); // C wrote into the caller's array
+  assert.deepEqual(Array.from(out), [0, 0, 0, 1, 0, 0, 0.5, 0.25, 2.0]);
+  const part = new Float64Array(12).fill(-1);
+  w.positions(1, 2, part.subarray(3, 9)); // a view into a larger buffer: written at its offset
+  assert.deepEqual(Array.from(part), [-1, -1, -1, 1, 0, 0, 0.5, 0.25, 2.0, -1, -1, -1]);
+  assert.equal(w.particleCount, 3);
+  w.close();
+});
+
+test('a saved scene steps on bit-identically', () => {
+  const dir = tempDir('saved');
+  const xyz = [];
+  for (let i = 0; i < 4; i++) for (let j = 0; j < 4; j++) xyz.push([0.1 * j, 0.1 * i, 0.0]);
+  const tri = [];
+  for (const v of [0, 1, 2, 4, 5, 6, 8, 9, 10]) tri.push([v, v + 1, v + 5]);
+  for (const v of [0, 1, 2, 4, 5, 6, 8, 9, 10]) tri.push([v, v + 5, v + 4]);
+  const a = new embra.World();
+  a.createBody(xyz, { triangles: tri, mass: 0.2 });
+  a.createPin(0, xyz[0]);
+  a.step(10);
+  const text = a.saveJson();
+  a.saveFile(path.join(dir, 'mid.json'));
+  const b = embra.World.loadJson(text);
+  const c = embra.World.loadFile(path.join(dir, 'mid.json'));
+  for (const w of [a, b, c]) w.step(20);
+  assertSameBits(b.positions(), a.positions(), 'from text');
+  assertSameBits(c.positions(), a.positions(), 'from file');
+  assert.equal(b.saveJson(), a.saveJson());
+  for (const w of [a, b, c]) w.close();
+});
+
+test('solver settings round trip', () => {
+  const w = new embra.World({ substeps: 7, damping: 0.5 });
+  assert.deepEqual([w.solver.substeps, w.solver.damping], [7, 0.5]);
+  w.setSolver({ iterations: 3 });
+  w.setGravity([0.0, 0.0, 9.81]);
+  const s = w.solver;
+  assert.deepEqual([s.substeps, s.iterations, s.gravity], [7, 3, [0, 0, 9.81]]);
+  assert.equal(w.sceneFrames(), 600);
+  w.close();
+});
+
+function whichLibrary(env) {
+  const code = `const e = require(${JSON.stringify(path.join(packageDir, 'lib'))}); console.log(e.libraryPath);`;
+  return spawnSync(process.execPath, ['-e', code], { env, encoding: 'utf8' });
+}
+
+test('the library is found from EMBRA_LIBRARY, else by SONAME through the loader\'s search', () => {
+  const lib = fs.realpathSync(process.env.EMBRA_LIBRARY);
+  const env = { ...process.env };
+  delete env.EMBRA_LIBRARY;
+  delete env.LD_LIBRARY_PATH;
+  let run = whichLibrary({ ...env, EMBRA_LIBRARY: lib });
+  assert.equal(run.status, 0, run.stderr);
+  assert.equal(run.stdout.trim(), lib);
+  run = whichLibrary({ ...env, LD_LIBRARY_PATH: path.dirname(lib) });
+  assert.equal(run.status, 0, run.stderr);
+  assert.equal(run.stdout.trim(), `libembra.so.${embra.ABI_VERSION}`);
+  run = whichLibrary({ ...env, EMBRA_LIBRARY: path.join(tempDir('nolib'), 'libembra.so.0') });
+  assert.notEqual(run.status, 0);
+  assert.match(run.stderr, /cannot load libembra/);
+  assert.match(run.stderr, /EMBRA_LIBRARY/);
+});

@@ -1,0 +1,27 @@
+'use strict';
+// The ctest entry of the Node adapter tests (adapters.node): checks that the adapter's npm packages
+// are installed, then runs every *.test.js here with `node --test`.
+
+const { spawnSync } = require('node:child_process');
+const fs = require('node:fs');
+const path = require('node:path');
+
+const source = process.env.EMBRA_SOURCE_DIR;
+if (!source) {
+  console.error('adapters.node: EMBRA_SOURCE_DIR is not set (run through ctest)');
+  process.exit(1);
+}
+const modules = path.join(source, 'host_adapters', 'node', 'node_modules');
+if (!fs.existsSync(path.join(modules, 'koffi', 'package.json'))) {
+  console.error(`adapters.node: ${modules} has no koffi: the Node adapter's packages are not installed.\n` +
+    `  Install them with: (cd ${path.dirname(modules)} && npm ci)   (scripts/deps.sh does)`);
+  process.exit(1);
+}
+const tests = fs.readdirSync(__dirname).filter((f) => f.endsWith('.test.js')).sort()
+  .map((f) => path.join(__dirname, f));
+if (tests.length === 0) {
+  console.error(`adapters.node: no *.test.js in ${__dirname}`);
+  process.exit(1);
+}
+const run = spawnSync(process.execPath, ['--test', ...tests], { stdio: 'inherit' });
+process.exit(run.status === null ? 1 : run.status);
