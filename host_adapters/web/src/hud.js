@@ -22,7 +22,8 @@ export function mm(v) {
 function cell(className) {
   const el = document.createElement('div');
   el.className = `hud-cell ${className}`;
-  el.innerHTML = '<span class="hud-label"></span><span class="hud-value"></span><span class="hud-sub"></span>';
+  el.innerHTML = '<span class="hud-label"></span><span class="hud-value"><span class="hud-number"></span>'
+    + '<span class="hud-unit"></span></span><span class="hud-sub"></span>';
   return el;
 }
 
@@ -43,9 +44,10 @@ export class Hud {
     add('fps', 'received');
   }
 
-  set(key, value, sub = '', state = '') {
+  set(key, value, sub = '', state = '', unit = '') {
     const el = this.cells[key];
-    el.querySelector('.hud-value').textContent = value;
+    el.querySelector('.hud-number').textContent = value;
+    el.querySelector('.hud-unit').textContent = unit;
     el.querySelector('.hud-sub').textContent = sub;
     el.dataset.state = state;
   }
@@ -68,10 +70,10 @@ export class Hud {
       }
       measured = true;
       const over = value > tol.target;
-      const sub = LENGTHS.has(m.field)
-        ? `≤ ${sci(tol.target)} · ${mm(value * scale)} / ${mm(tol.target * scale)} mm/m`
-        : `≤ ${sci(tol.target)}`;
-      this.set(m.field, sci(value), sub, over ? (m.field === 'miter' ? 'over-yellow' : 'over') : 'ok');
+      const length = LENGTHS.has(m.field);
+      const sub = length ? `tolerance ${sci(tol.target)} · ${mm(tol.target * scale)} mm/m` : `tolerance ${sci(tol.target)}`;
+      const unit = length ? `${mm(value * scale)} mm/m` : '';
+      this.set(m.field, sci(value), sub, over ? (m.field === 'miter' ? 'over-yellow' : 'over') : 'ok', unit);
       if (row?.within_tolerance === undefined && over) within = false;
     }
     if (within === undefined && measured) within = true;

@@ -46,10 +46,20 @@ export class Plot {
         { label: 'frame', labelSize: 16, size: 34, stroke: '#495057', grid: { stroke: '#e9ecef' }, ticks: { stroke: '#ced4da' } },
         {
           size: 58, stroke: '#495057', grid: { stroke: '#e9ecef' }, ticks: { stroke: '#ced4da' },
-          values: (u, splits) => splits.map((v) => (Math.abs(Math.log10(v) % 1) < 1e-9 ? `1e${Math.round(Math.log10(v))}` : '')),
+          // one grid line per decade, or every second / third one over a wide range
+          splits: (u, axis, min, max) => {
+            const lo = Math.ceil(Math.log10(min) - 1e-9);
+            const hi = Math.floor(Math.log10(max) + 1e-9);
+            const step = Math.max(1, Math.ceil((hi - lo) / 6));
+            const out = [];
+            for (let e = hi; e >= lo; e -= step) out.unshift(10 ** e);
+            return out;
+          },
+          filter: (u, splits) => splits,
+          values: (u, splits) => splits.map((v) => (v > 0 ? `1e${Math.round(Math.log10(v))}` : '')),
         },
       ],
-      legend: { live: true },
+      legend: { live: false },
       cursor: { drag: { x: false, y: false }, points: { size: 6 } },
       hooks: { draw: [(u) => this.drawCurrent(u)] },
     };

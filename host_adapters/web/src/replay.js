@@ -211,7 +211,7 @@ export async function openReplay(files) {
     if (entry.errors) errors = entry.errors === 'final.errors.json' ? finalErrors : await readJson(files, entry.errors);
     const fields = scene.fields.map((name) => {
       const values = errors?.fields?.[name];
-      const out = new Float32Array(scene.particles).fill(NaN);
+      const out = new Float64Array(scene.particles).fill(NaN); // doubles: colours exactly as from the file
       if (values) values.forEach((v, k) => { if (v !== null && k < out.length) out[k] = v; });
       return out;
     });

@@ -9,7 +9,8 @@ const BACKGROUND = 0xf3f4f6;
 const COLLIDER_COLOR = 0x7f93a8;
 const PIN_COLOR = 0x1f2933;
 const DRAG_COLOR = 0xe8590c;
-const VIEW_DIRECTION = new THREE.Vector3(0.95, -1.35, 0.85).normalize();
+const VIEW_DIRECTION = new THREE.Vector3(0.9, -1.3, 1.05).normalize(); // from the south east, 36° up
+const CREASE_COS = Math.cos(THREE.MathUtils.degToRad(35));
 
 /**
  * The colour attribute holds the page's colours as given (errorColor's sRGB values, exactly);
@@ -54,6 +55,31 @@ function colliderGeometry(c, planeSize) {
   }
 }
 
+/** Edges of one triangle only, and edges between triangles folded by more than 35 degrees. */
+function featureEdges(triangles, positions) {
+  const normal = (t) => {
+    const [a, b, c] = [0, 1, 2].map((k) => new THREE.Vector3().fromArray(positions, 3 * triangles[3 * t + k]));
+    return b.sub(a).cross(c.sub(a)).normalize();
+  };
+  const edges = new Map();
+  for (let t = 0; 3 * t < triangles.length; t++) {
+    for (let k = 0; k < 3; k++) {
+      const i = triangles[3 * t + k];
+      const j = triangles[3 * t + ((k + 1) % 3)];
+      const key = i < j ? `${i},${j}` : `${j},${i}`;
+      const entry = edges.get(key);
+      if (entry) entry.push(t);
+      else edges.set(key, [t]);
+    }
+  }
+  const out = [];
+  for (const [key, tris] of edges) {
+    const crease = tris.length === 2 && normal(tris[0]).dot(normal(tris[1])) < CREASE_COS;
+    if (tris.length === 1 || crease) out.push(...key.split(',').map(Number));
+  }
+  return out;
+}
+
 export class View {
   constructor(container) {
     this.container = container;
@@ -74,11 +100,11 @@ export class View {
 
     // Light that shows folds: a soft sky / ground fill, a key light from the front left and above,
     // a weaker rim light from behind on the right.
-    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x9a948a, 1.25));
-    this.key = new THREE.DirectionalLight(0xffffff, 2.1);
-    this.key.position.set(-1.2, -2.0, 3.0);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x8a857d, 0.95));
+    this.key = new THREE.DirectionalLight(0xffffff, 2.6);
+    this.key.position.set(-2.2, -1.2, 2.4);
     this.scene.add(this.key);
-    this.rim = new THREE.DirectionalLight(0xffffff, 0.7);
+    this.rim = new THREE.DirectionalLight(0xffffff, 0.55);
     this.rim.position.set(2.0, 2.5, 1.2);
     this.scene.add(this.rim);
 
@@ -147,7 +173,14 @@ export class View {
       const mesh = new THREE.Mesh(geometry, material);
       mesh.userData.body = body.index;
       mesh.userData.smooth = !body.panel_mesh;
-      this.bodyGroup.add(mesh);
+      mesh.userData.triangles = body.triangles;
+      // Outlines (every panel's border, a cloth's border, creases), found at the first frame.
+      const lines = new THREE.BufferGeometry();
+      lines.setAttribute('position', this.position);
+      const outline = new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ color: 0x3d434a, transparent: true, opacity: 0.55 }));
+      outline.frustumCulled = false;
+      mesh.userData.outline = outline;
+      this.bodyGroup.add(mesh, outline);
       return mesh;
     });
 
@@ -194,6 +227,10 @@ export class View {
     this.position.array.set(positions);
     this.position.needsUpdate = true;
     for (const mesh of this.meshes) {
+      const lines = mesh.userData.outline.geometry;
+      if (!lines.index) lines.setIndex(featureEdges(mesh.userData.triangles, positions));
+    }
+    for (const mesh of this.meshes) {
       if (mesh.userData.smooth) mesh.geometry.computeVertexNormals();
       mesh.geometry.boundingSphere = null; // recomputed for culling and picking
       mesh.geometry.boundingBox = null;
@@ -235,22 +272,50 @@ export class View {
 
   /** Frames the camera on the bodies and colliders (planes excepted), looking down from the south east. */
   frameAll() {
-    const box = new THREE.Box3();
+    const points = [];
     const p = new THREE.Vector3();
     for (let i = 0; i < this.particles; i++) {
-      if (Number.isFinite(this.position.array[3 * i])) box.expandByPoint(this.particle(i, p));
+      if (Number.isFinite(this.position.array[3 * i])) points.push(this.particle(i, new THREE.Vector3()));
     }
     for (const object of this.colliders) {
-      if (!object.userData.plane) box.expandByObject(object);
+      if (object.userData.plane) continue;
+      const vertices = object.geometry.attributes.position;
+      if (!vertices) continue;
+      const stride = Math.max(1, Math.floor(vertices.count / 4000));
+      for (let k = 0; k < vertices.count; k += stride) points.push(p.fromBufferAttribute(vertices, k).applyMatrix4(object.matrixWorld).clone());
     }
-    if (box.isEmpty()) return;
+    if (points.length === 0) return;
+    const box = new THREE.Box3().setFromPoints(points);
     const sphere = box.getBoundingSphere(new THREE.Sphere());
     const radius = Math.max(sphere.radius, 1e-3);
-    const vfov = THREE.MathUtils.degToRad(this.camera.fov);
-    const hfov = 2 * Math.atan(Math.tan(vfov / 2) * this.camera.aspect);
-    const distance = (radius / Math.sin(Math.min(vfov, hfov) / 2)) * 0.92;
-    this.controls.target.copy(sphere.center);
-    this.camera.position.copy(sphere.center).addScaledVector(VIEW_DIRECTION, distance);
+    // Centre the points' extent across the view, then back off to the nearest distance at which
+    // every point is inside the frustum (with a margin).
+    const forward = VIEW_DIRECTION.clone().negate();
+    const right = new THREE.Vector3().crossVectors(forward, this.camera.up).normalize();
+    const up = new THREE.Vector3().crossVectors(right, forward);
+    const lo = [Infinity, Infinity];
+    const hi = [-Infinity, -Infinity];
+    for (const q of points) {
+      const d = q.clone().sub(sphere.center);
+      const xy = [d.dot(right), d.dot(up)];
+      for (let k = 0; k < 2; k++) {
+        lo[k] = Math.min(lo[k], xy[k]);
+        hi[k] = Math.max(hi[k], xy[k]);
+      }
+    }
+    const target = sphere.center.clone()
+      .addScaledVector(right, (lo[0] + hi[0]) / 2)
+      .addScaledVector(up, (lo[1] + hi[1]) / 2);
+    const tanV = Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) * 0.88;
+    const tanH = tanV * this.camera.aspect;
+    let distance = 0;
+    for (const q of points) {
+      const d = q.clone().sub(target);
+      const depth = d.dot(VIEW_DIRECTION); // towards the camera
+      distance = Math.max(distance, depth + Math.abs(d.dot(right)) / tanH, depth + Math.abs(d.dot(up)) / tanV);
+    }
+    this.controls.target.copy(target);
+    this.camera.position.copy(target).addScaledVector(VIEW_DIRECTION, distance);
     this.camera.near = distance / 200;
     this.camera.far = distance * 50;
     this.camera.updateProjectionMatrix();
