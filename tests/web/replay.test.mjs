@@ -2,10 +2,12 @@
 // `embra run examples/poq_drape.json --out TMP --every 30 --frames 300` folder, served with the
 // built page (host_adapters/web/dist) by a small http server on 127.0.0.1. Checks the mesh, the
 // chart, the slider and that every vertex's colour is the shared colour function's for the errors
-// file of the shown frame; saves docs/screenshots/poq_replay_errors.png.
+// file of the shown frame; saves docs/screenshots/poq_replay_errors.png (or EMBRA_SCREENSHOT).
 //
+//   (cd host_adapters/web && npm run build)
 //   EMBRA_CLI=build/host_adapters/cli/embra node --test tests/web/replay.test.mjs
-// (ctest runs it as web.replay after building the page: web.build)
+// ctest runs it as web.replay after building the page (web.build), with the screenshot in the
+// build folder. Chromium: /usr/bin/chromium (or EMBRA_CHROMIUM), WebGL through SwiftShader.
 
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
@@ -22,7 +24,7 @@ const web = path.join(source, 'host_adapters', 'web');
 const dist = path.join(web, 'dist');
 const cli = process.env.EMBRA_CLI || path.join(source, 'build', 'host_adapters', 'cli', 'embra');
 const chromiumPath = process.env.EMBRA_CHROMIUM || '/usr/bin/chromium';
-const screenshot = path.join(source, 'docs', 'screenshots', 'poq_replay_errors.png');
+const screenshot = process.env.EMBRA_SCREENSHOT || path.join(source, 'docs', 'screenshots', 'poq_replay_errors.png');
 
 const require = createRequire(import.meta.url);
 const { errorColor, GREY, UNMEASURED } = require(path.join(source, 'host_adapters', 'node', 'lib', 'colors.js'));
