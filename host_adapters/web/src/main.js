@@ -220,7 +220,7 @@ function buildLivePanels(scene) {
     input.addEventListener('change', () => {
       const weight = Math.round(Number(input.value));
       if (weight >= 1 && weight <= 1000) send({ type: 'group_weight', index: g.index, weight });
-      else showError(`group weight ${input.value}: 1 to 1000`);
+      else showError(`group weight ${input.value}: a whole number from 1 to 1000`);
     });
     row.appendChild(input);
     groups.appendChild(row);
@@ -297,6 +297,7 @@ function onPointerDown(e) {
   view.controls.enabled = false; // OrbitControls' own pointerdown (on the canvas) now does nothing
   view.canvas.setPointerCapture(e.pointerId);
   view.showHover(null);
+  $('hover').hidden = true;
   e.preventDefault();
 }
 
@@ -565,6 +566,10 @@ window.embraView = {
   get replayFrames() { return state.replay ? state.replay.frames.map((f) => f.frame) : []; },
   get frameIndex() { return state.frameIndex; },
   screenOf: (particle) => view.screenOf(particle),
+  /** A world point's page pixel coordinates, e.g. a collider's centre: screenOfPoint([x, y, z]). */
+  screenOfPoint: ([x, y, z]) => view.screenOfPoint({ x, y, z }),
+  /** A collider's shown position (moved by frames and by shift-drags). */
+  colliderPosition: (index) => view.colliderPosition(index)?.toArray() ?? null,
   setMetric,
   showFrameIndex,
   frameAll: () => view.frameAll(),

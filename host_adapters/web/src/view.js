@@ -126,7 +126,7 @@ export class View {
     this.meshes = [];
     this.colliders = [];
     this.pins = [];
-    this.markerSize = 0.02;
+    this.sceneSize = 1;
     this.framed = false;
     this.heldCollider = -1;
     this.drag = null;
@@ -212,7 +212,18 @@ export class View {
       this.pinGroup.add(marker);
       return marker;
     });
+    this.applySizes();
     this.dirty = true;
+  }
+
+  /** Markers and planes sized by the framed scene's size. */
+  applySizes() {
+    const size = this.sceneSize * 0.018;
+    for (const marker of [...this.pins, this.dragMarker]) marker.scale.setScalar(size);
+    this.hoverMarker.scale.setScalar(size * 0.7);
+    this.colliders.forEach((object) => {
+      if (object.userData.plane) object.scale.setScalar(this.sceneSize * 8);
+    });
   }
 
   setPose(object, p, q) {
@@ -321,12 +332,8 @@ export class View {
     this.camera.updateProjectionMatrix();
     this.controls.update();
 
-    this.markerSize = radius * 0.018;
-    for (const marker of [...this.pins, this.dragMarker]) marker.scale.setScalar(this.markerSize);
-    this.hoverMarker.scale.setScalar(this.markerSize * 0.7);
-    this.colliders.forEach((object) => {
-      if (object.userData.plane) object.scale.setScalar(radius * 8);
-    });
+    this.sceneSize = radius;
+    this.applySizes();
 
     if (this.grid) {
       this.scene.remove(this.grid);
@@ -437,7 +444,12 @@ export class View {
 
   /** A particle's page pixel coordinates. */
   screenOf(i) {
-    const p = this.particle(i).project(this.camera);
+    return this.screenOfPoint(this.particle(i));
+  }
+
+  /** A world point's page pixel coordinates. */
+  screenOfPoint(point) {
+    const p = new THREE.Vector3().copy(point).project(this.camera);
     const rect = this.canvas.getBoundingClientRect();
     return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
   }
