@@ -1,0 +1,135 @@
+// web.live: the page against a real embra-live server (host_adapters/node/live) on 127.0.0.1 in
+// headless Chromium: frames arrive and are drawn, a mouse drag on the mesh pulls its particle, a
+// shift-drag moves the sphere, pause / step, and the colours of a paused frame are the shared
+// colour function's for the frame's per-vertex fields.
+//
+//   (cd host_adapters/web && npm run build)
+//   EMBRA_LIBRARY=build/libembra.so.0 node --test tests/web/live.test.mjs
+// ctest runs it as web.live after web.build. Needs host_adapters/node's packages (npm ci there).
+
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { after, before, test } from 'node:test';
+import { createRequire } from 'node:module';
+import { fileURLToPath } from 'node:url';
+
+const source = process.env.EMBRA_SOURCE_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
+const web = path.join(source, 'host_adapters', 'web');
+const chromiumPath = process.env.EMBRA_CHROMIUM || '/usr/bin/chromium';
+const require = createRequire(import.meta.url);
+const { errorColor } = require(path.join(source, 'host_adapters', 'node', 'lib', 'colors.js'));
+
+let tmp;
+let live;
+let context;
+let page;
+const pageErrors = [];
+
+const view = (fn, arg) => page.evaluate(fn, arg);
+
+before(async () => {
+  assert.ok(fs.existsSync(path.join(web, 'dist', 'app.js')), `the page is not built: run \`npm run build\` in ${web}`);
+  assert.ok(fs.existsSync(path.join(source, 'host_adapters', 'node', 'node_modules', 'ws')),
+    'host_adapters/node has no node_modules: run `npm ci` there');
+  assert.ok(fs.existsSync(chromiumPath), `no Chromium at ${chromiumPath}`);
+  tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'embra-web-live-'));
+  const { startServer } = require(path.join(source, 'host_adapters', 'node', 'live', 'server.js'));
+  live = await startServer({
+    scene: path.join(source, 'examples', 'poq_drape.json'), host: '127.0.0.1', port: 0,
+    web: path.join(web, 'dist'), saveDir: tmp, log: () => {},
+  });
+  const { chromium } = require(path.join(web, 'node_modules', 'playwright-core'));
+  context = await chromium.launchPersistentContext(path.join(tmp, 'profile'), {
+    executablePath: chromiumPath,
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+    viewport: { width: 1280, height: 800 },
+  });
+  page = context.pages()[0] || await context.newPage();
+  page.on('pageerror', (err) => pageErrors.push(err.message));
+  await page.goto(live.url);
+  await page.waitForFunction(() => window.embraView?.connected && window.embraView.framesReceived > 20, null, { timeout: 30000 });
+});
+
+after(async () => {
+  await context?.close();
+  await live?.close();
+  if (tmp) fs.rmSync(tmp, { recursive: true, force: true });
+});
+
+test('frames arrive and are drawn', async () => {
+  const v = await view(() => ({
+    mode: embraView.mode, particles: embraView.scene.particles, positions: embraView.positions.length,
+    vertexCount: embraView.vertexCount, fields: embraView.scene.fields, received: embraView.framesReceived,
+    plotPoints: embraView.plotPoints, frame: embraView.frame,
+  }));
+  assert.equal(v.mode, 'live');
+  assert.equal(v.particles, 128);
+  assert.equal(v.vertexCount, 128);
+  assert.equal(v.positions, 3 * 128);
+  assert.deepEqual(v.fields, ['planarity', 'thickness', 'miter']);
+  assert.ok(v.plotPoints > 10 && v.plotPoints <= v.received, JSON.stringify(v));
+  await page.waitForFunction((f) => embraView.frame > f + 10 && embraView.fps > 0, v.frame);
+  assert.notEqual(await page.textContent('.hud-frame .hud-number'), '–');
+});
+
+test('a mouse drag on the mesh pulls the particle under it', async () => {
+  await page.waitForFunction(() => embraView.frame > 120); // draped over the sphere
+  const particle = 60;
+  const start = await view((i) => ({ at: embraView.screenOf(i), z: embraView.positions[3 * i + 2] }), particle);
+  await page.mouse.move(start.at.x, start.at.y);
+  await page.mouse.down();
+  for (let k = 1; k <= 15; k++) {
+    await page.mouse.move(start.at.x, start.at.y - 10 * k);
+    await page.waitForTimeout(30);
+  }
+  await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.15, [particle, start.z], { timeout: 10000 });
+  await page.mouse.up();
+  assert.equal(await view(() => embraView.lastError), null);
+});
+
+test('shift-drag moves the sphere', async () => {
+  const before = await view(() => embraView.colliderPosition(0));
+  const at = await view((p) => embraView.screenOfPoint(p), before);
+  await page.keyboard.down('Shift');
+  await page.mouse.move(at.x, at.y);
+  await page.mouse.down();
+  for (let k = 1; k <= 10; k++) {
+    await page.mouse.move(at.x - 12 * k, at.y);
+    await page.waitForTimeout(30);
+  }
+  await page.mouse.up();
+  await page.keyboard.up('Shift');
+  await page.waitForTimeout(300); // the server's frames carry the new pose
+  const moved = await view(() => embraView.colliderPosition(0));
+  assert.ok(Math.hypot(moved[0] - before[0], moved[1] - before[1]) > 0.2, `${before} -> ${moved}`);
+  assert.ok(Math.abs(moved[2] - before[2]) < 1e-3 + Math.abs(moved[0] - before[0]), 'moved in the plane facing the camera');
+  assert.equal(await view(() => embraView.lastError), null);
+});
+
+test('pause and step; the paused frame is coloured by the shared colour function', async () => {
+  await page.click('#pause');
+  await page.waitForFunction(() => document.getElementById('pause').textContent === 'Run');
+  await page.waitForTimeout(200);
+  const paused = await view(() => embraView.frame);
+  await page.waitForTimeout(300);
+  assert.equal(await view(() => embraView.frame), paused);
+  await page.click('#step');
+  await page.waitForFunction((f) => embraView.frame === f + 1, paused);
+  for (const metric of ['planarity', 'thickness', 'miter']) {
+    await page.selectOption('#metric', metric);
+    const { colors, values, tol } = await view((m) => ({
+      colors: Array.from(embraView.colors), values: Array.from(embraView.fields[m]), tol: embraView.scene.tolerances[m],
+    }), metric);
+    values.forEach((v, i) => {
+      const want = errorColor(metric, v, tol);
+      for (let k = 0; k < 3; k++) assert.ok(Math.abs(colors[3 * i + k] - want[k]) < 1e-6, `${metric} vertex ${i}`);
+    });
+  }
+  await page.click('#pause');
+  assert.deepEqual(pageErrors, []);
+});
