@@ -9,7 +9,8 @@
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
  * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames; with
  * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
- * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by.
+ * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
+ * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses.
  *
  * `demo tent` is the paper's Gaudi paradigm (section 3.2, figure 6): a triangular cloth pinned at
  * its three corners under reversed gravity. The membrane is elastic, so reversed gravity stretches
@@ -432,6 +433,70 @@ static int cmd_validate(int argc, char** argv) {
   return 0;
 }
 
+/* The run's index (DIR/index.json): every file it wrote, and per OBJ frame its files and where each
+ * collider was, so a replay shows the colliders where they were without re-running the scene. The
+ * entries accumulate in memory streams and are written at the end. */
+typedef struct run_index {
+  FILE* files;
+  FILE* frames;
+  char *files_text, *frames_text;
+  size_t files_length, frames_length;
+  int file_count, frame_count;
+} run_index;
+
+static int run_index_open(run_index* x) {
+  memset(x, 0, sizeof *x);
+  x->files = open_memstream(&x->files_text, &x->files_length);
+  x->frames = open_memstream(&x->frames_text, &x->frames_length);
+  return x->files && x->frames ? 0 : -1;
+}
+
+/* Records a file written into DIR (its name only: every name embra writes is plain ASCII). */
+static void run_index_file(run_index* x, const char* name) {
+  fprintf(x->files, "%s\"%s\"", x->file_count++ ? "," : "", name);
+}
+
+/* Records an OBJ frame: its files (errors: NULL for none) and every live collider's pose. */
+static void run_index_frame(run_index* x, embra_world* world, long frame, const char* obj, const char* errors) {
+  fprintf(x->frames, "%s{\"frame\":%ld,\"obj\":\"%s\"", x->frame_count++ ? "," : "", frame, obj);
+  if (errors) fprintf(x->frames, ",\"errors\":\"%s\"", errors);
+  fputs(",\"colliders\":[", x->frames);
+  int32_t n = 0;
+  if (embra_world_get_colliders(world, NULL, 0, &n) == EMBRA_OK && n > 0) {
+    embra_collider_id* ids = malloc(sizeof *ids * (size_t)n);
+    if (ids && embra_world_get_colliders(world, ids, n, &n) == EMBRA_OK) {
+      for (int32_t i = 0; i < n; ++i) {
+        double p[3], q[4];
+        if (embra_collider_get_transform(world, ids[i], p, q) != EMBRA_OK) continue;
+        fprintf(x->frames, "%s[%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g]", i ? "," : "", p[0], p[1], p[2], q[0], q[1],
+                q[2], q[3]);
+      }
+    }
+    free(ids);
+  }
+  fputs("]}", x->frames);
+}
+
+/* Writes DIR/index.json and frees the index. */
+static int run_index_write(run_index* x, const char* dir) {
+  fclose(x->files);
+  fclose(x->frames);
+  char path[4200];
+  snprintf(path, sizeof path, "%s/index.json", dir);
+  FILE* f = fopen(path, "w");
+  int rc = -1;
+  if (f) {
+    fprintf(f, "{\"format\":\"embra-run-index\",\"version\":1,\"files\":[%s,\"index.json\"],\"frames\":[%s]}\n",
+            x->files_text, x->frames_text);
+    rc = fclose(f) == 0 ? 0 : -1;
+  } else {
+    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+  }
+  free(x->files_text);
+  free(x->frames_text);
+  return rc;
+}
+
 static void progress(long done, long total, double ms) {
   const int width = 40;
   const int filled = total > 0 ? (int)(width * done / total) : width;
@@ -480,6 +545,13 @@ static int cmd_run(int argc, char** argv) {
   FILE* metrics = fopen(path, "w");
   if (!metrics) {
     fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    embra_world_destroy(world);
+    return EXIT_INVALID;
+  }
+  run_index index;
+  if (run_index_open(&index) != 0) {
+    fprintf(stderr, "embra: out of memory\n");
+    fclose(metrics);
     embra_world_destroy(world);
     return EXIT_INVALID;
   }
@@ -544,6 +616,12 @@ static int cmd_run(int argc, char** argv) {
         rc = EXIT_INVALID;
         break;
       }
+      char obj_name[64], errors_name[64];
+      snprintf(obj_name, sizeof obj_name, "frame_%05ld.obj", f);
+      snprintf(errors_name, sizeof errors_name, "frame_%05ld.errors.json", f);
+      run_index_file(&index, obj_name);
+      if (panel_count > 0) run_index_file(&index, errors_name);
+      run_index_frame(&index, world, f, obj_name, panel_count > 0 ? errors_name : NULL);
     }
     if (tty && (f % 10 == 0 || f == frames)) progress(f, frames, total_ms);
   }
@@ -560,6 +638,19 @@ static int cmd_run(int argc, char** argv) {
   snprintf(path, sizeof path, "%s/final.errors.json", out);
   if (panel_count > 0 && write_error_fields(path, world, panel_bodies, panel_count, (long)r.frame) != 0 && rc == 0)
     rc = EXIT_INVALID;
+  run_index_file(&index, "final.json");
+  run_index_file(&index, "metrics.jsonl");
+  run_index_file(&index, "final.obj");
+  if (panel_count > 0) run_index_file(&index, "final.errors.json");
+  run_index_frame(&index, world, (long)r.frame, "final.obj", panel_count > 0 ? "final.errors.json" : NULL);
+  for (int i = 0; i < panel_count; ++i) {
+    char name[64];
+    snprintf(name, sizeof name, "panels_%u.json", panel_bodies[i].index);
+    run_index_file(&index, name);
+    snprintf(name, sizeof name, "panels_%u.csv", panel_bodies[i].index);
+    run_index_file(&index, name);
+  }
+  if (run_index_write(&index, out) != 0 && rc == 0) rc = EXIT_INVALID;
   embra_world_counts c;
   embra_world_get_counts(world, &c);
   printf("%-18s %s\n", "scene", scene);

@@ -77,10 +77,12 @@ test('frames arrive and are drawn', async () => {
   assert.notEqual(await page.textContent('.hud-frame .hud-number'), '–');
 });
 
-test('a mouse drag on the mesh pulls the particle under it', async () => {
+test('a mouse drag on a panel corner pulls it; the streamed positions and the error plot follow', async () => {
   await page.waitForFunction(() => embraView.frame > 120); // draped over the sphere
-  const particle = 60;
-  const start = await view((i) => ({ at: embraView.screenOf(i), z: embraView.positions[3 * i + 2] }), particle);
+  const particle = 58; // panel 7's top corner 2 (8 particles per panel, top corners first)
+  const start = await view((i) => ({ at: embraView.screenOf(i), z: embraView.positions[3 * i + 2],
+                                     plot: embraView.plotPoints }), particle);
+  const serverZ = live.session.positions[3 * particle + 2];
   await page.mouse.move(start.at.x, start.at.y);
   await page.mouse.down();
   for (let k = 1; k <= 15; k++) {
@@ -89,6 +91,10 @@ test('a mouse drag on the mesh pulls the particle under it', async () => {
   }
   await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.15, [particle, start.z], { timeout: 10000 });
   await page.mouse.up();
+  // The world itself moved (the page drew what the server streamed), and the plot kept growing.
+  assert.ok(live.session.positions[3 * particle + 2] > serverZ + 0.15);
+  const plot = await view(() => embraView.plotPoints);
+  assert.ok(plot > start.plot + 10, `plot points ${start.plot} -> ${plot}`);
   assert.equal(await view(() => embraView.lastError), null);
 });
 

@@ -62,8 +62,10 @@ before(async () => {
   run = path.join(tmp, 'run');
   execFileSync(cli, ['run', path.join(source, 'examples', 'poq_drape.json'), '--out', run, '--every', '30', '--frames', '300'],
     { stdio: ['ignore', 'ignore', 'inherit'] });
-  // ?replay=URL reads the folder's file list from URL/index.json
-  fs.writeFileSync(path.join(run, 'index.json'), JSON.stringify(fs.readdirSync(run).sort()));
+  // ?replay=URL reads the folder's file list from URL/index.json, which embra run writes: it lists
+  // every file in the folder.
+  const index = JSON.parse(fs.readFileSync(path.join(run, 'index.json'), 'utf8'));
+  assert.deepEqual([...index.files].sort(), fs.readdirSync(run).sort());
   server = await serve({ dist, run });
 
   const { chromium } = require(path.join(web, 'node_modules', 'playwright-core'));
@@ -168,6 +170,17 @@ test('the slider moves the frame; the geometry is that frame\'s OBJ', async () =
   assert.match(await page.textContent('.hud-thickness .hud-unit'), /^[0-9.]+ mm\/m$/);
   assert.ok(Math.abs(parseFloat(await page.textContent('.hud-thickness .hud-unit')) - mmPerM) < 5e-3 * mmPerM);
   assert.equal(await page.textContent('.hud-within .hud-number'), row.within_tolerance ? 'yes' : 'no');
+});
+
+test('the sphere is drawn where the run had it: the scene path recorded in index.json', async () => {
+  await page.locator('#slider').fill('4'); // frames[4] = 150: halfway along (0.3, 0.2, -1.45) -> (-0.3, 0.2, -1.35)
+  await page.waitForFunction(() => window.embraView.frame === 150);
+  const at = await page.evaluate(() => window.embraView.colliderPosition(0));
+  [0.0, 0.2, -1.4].forEach((v, k) => assert.ok(Math.abs(at[k] - v) < 1e-6, `sphere at ${at}`));
+  await page.locator('#slider').fill('5');
+  await page.waitForFunction(() => window.embraView.frame === 180);
+  const end = await page.evaluate(() => window.embraView.colliderPosition(0));
+  [-0.3, 0.2, -1.35].forEach((v, k) => assert.ok(Math.abs(end[k] - v) < 1e-6, `sphere at ${end}`));
 });
 
 test('vertex colours follow the errors file through the shared colour function', async () => {

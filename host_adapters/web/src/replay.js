@@ -2,8 +2,9 @@
 // folder"): final.json gives names, colliders, pins and tolerances, metrics.jsonl the plot,
 // frame_NNNNN.obj (+ frame_NNNNN.errors.json) the geometry and colour map of every K-th frame, and
 // final.obj (+ final.errors.json) the last state. The folder comes from a directory picker, from
-// dropped files, or over http: `?replay=URL` reads URL/index.json, a JSON list of the folder's
-// file names (or {"files": [...]}); without one only final.* and metrics.jsonl are read.
+// dropped files, or over http: `?replay=URL` reads URL/index.json, which `embra run` writes (the
+// files of the run, and each OBJ frame's collider poses); without one only final.* and
+// metrics.jsonl are read.
 
 import { parseObj, parseObjPositions } from './obj.js';
 
@@ -63,18 +64,6 @@ function parseMetrics(text) {
     if (line.trim()) rows.push(JSON.parse(line));
   }
   return rows;
-}
-
-/** An action's value at `frame`: linear between the keys around it, held outside them. */
-export function actionValue(keys, frame) {
-  let hi = 0;
-  while (hi < keys.length && keys[hi].frame < frame) hi++;
-  if (hi === 0) return keys[0].value;
-  if (hi === keys.length) return keys[keys.length - 1].value;
-  const a = keys[hi - 1];
-  const b = keys[hi];
-  const t = (frame - a.frame) / (b.frame - a.frame);
-  return a.value.map((v, k) => (1 - t) * v + t * b.value[k]);
 }
 
 function colliderOf(def, index) {
@@ -183,24 +172,18 @@ export async function openReplay(files) {
   const errorsName = frames.find((f) => f.errors)?.errors;
   const sampleErrors = errorsName === 'final.errors.json' ? finalErrors : errorsName ? await readJson(files, errorsName) : null;
   const scene = sceneOf(final, firstObj, sampleErrors, metrics);
-  const actions = (final?.actions || []).filter((a) => a.type === 'collider_pose');
-  const colliderIndex = new Map(scene.colliders.map((c) => [c.name, c.index]));
+  // Collider poses per frame from the run's index.json (written by `embra run`); a folder without
+  // one shows the colliders where final.json has them.
+  const index = files.has('index.json') ? await readJson(files, 'index.json') : null;
+  const indexed = new Map((index?.frames || []).map((f) => [f.obj, f.colliders]));
 
   const cache = new Map();
-  const posesAt = (frame) => {
+  const posesAt = (entry) => {
     const poses = new Float32Array(7 * scene.colliders.length);
+    const recorded = indexed.get(entry.obj);
     for (const c of scene.colliders) {
-      poses.set([...c.position, ...c.rotation], 7 * c.index);
-    }
-    for (const action of actions) {
-      const c = colliderIndex.get(action.collider);
-      if (c === undefined || !action.keys?.length) continue;
-      const v = actionValue(action.keys, frame);
-      poses.set(v.slice(0, 3), 7 * c);
-      if (v.length === 7) {
-        const norm = Math.hypot(v[3], v[4], v[5], v[6]) || 1;
-        poses.set(v.slice(3).map((q) => q / norm), 7 * c + 3);
-      }
+      const pose = recorded?.[c.index];
+      poses.set(pose && pose.length === 7 ? pose : [...c.position, ...c.rotation], 7 * c.index);
     }
     return poses;
   };
@@ -215,7 +198,7 @@ export async function openReplay(files) {
       if (values) values.forEach((v, k) => { if (v !== null && k < out.length) out[k] = v; });
       return out;
     });
-    return { frame: entry.frame, positions, poses: posesAt(entry.frame), fields, hasErrors: !!errors };
+    return { frame: entry.frame, positions, poses: posesAt(entry), fields, hasErrors: !!errors };
   }
 
   return {
