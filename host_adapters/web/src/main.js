@@ -556,6 +556,8 @@ window.embraView = {
   get plotPoints() { return plot.points; },
   get scene() { return state.scene; },
   get lastError() { return state.lastError; },
+  /** The particle a mouse drag holds (null when none). */
+  get dragParticle() { return pointer.drag?.kind === 'particle' ? pointer.drag.particle : null; },
   get metric() { return state.metric; },
   get fields() { return state.fields; },
   /** The colour attribute's array (3 floats per particle, errorColor's values). */
