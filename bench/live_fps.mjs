@@ -12,25 +12,18 @@ import os from 'node:os';
 import path from 'node:path';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
+import { launchChromium } from '../host_adapters/web/headless.mjs';
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
 const scene = path.resolve(process.argv[2] || path.join(source, 'bench', 'scenes', 'poq_drape_32.json'));
 const seconds = Number(process.argv[3] || 20);
 const { startServer } = require(path.join(source, 'host_adapters', 'node', 'live', 'server.js'));
-const { chromium } = require(path.join(source, 'host_adapters', 'web', 'node_modules', 'playwright-core'));
 
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'embra-live-fps-'));
 const live = await startServer({ scene, port: 0, web: path.join(source, 'host_adapters', 'web', 'dist'), saveDir: tmp,
                                  log: () => {} });
-const context = await chromium.launchPersistentContext(path.join(tmp, 'profile'), {
-  executablePath: process.env.EMBRA_CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  viewport: { width: 1280, height: 800 },
-});
+const context = await launchChromium(path.join(tmp, 'profile'), { width: 1280, height: 800 });
 const page = context.pages()[0] || await context.newPage();
 await page.goto(live.url);
 await page.waitForFunction(() => window.embraView?.connected && window.embraView.framesReceived > 0, null,

@@ -9,11 +9,11 @@ import os from 'node:os';
 import path from 'node:path';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
+import { launchChromium } from '../host_adapters/web/headless.mjs';
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
 const { startServer } = require(path.join(source, 'host_adapters', 'node', 'live', 'server.js'));
-const { chromium } = require(path.join(source, 'host_adapters', 'web', 'node_modules', 'playwright-core'));
 
 const shots = [
   { scene: 'examples/poq_drape.json', frame: 170, metric: 'miter', out: 'poq_live_miter.png' },
@@ -21,14 +21,7 @@ const shots = [
 ];
 
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'embra-shots-'));
-const context = await chromium.launchPersistentContext(path.join(tmp, 'profile'), {
-  executablePath: process.env.EMBRA_CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  viewport: { width: 1440, height: 900 },
-});
+const context = await launchChromium(path.join(tmp, 'profile'));
 for (const shot of shots) {
   const live = await startServer({ scene: path.join(source, shot.scene), port: 0, saveDir: tmp, log: () => {},
                                    web: path.join(source, 'host_adapters', 'web', 'dist') });

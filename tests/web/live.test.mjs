@@ -14,10 +14,10 @@ import path from 'node:path';
 import { after, before, test } from 'node:test';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
+import { chromiumPath, launchChromium } from '../../host_adapters/web/headless.mjs';
 
 const source = process.env.EMBRA_SOURCE_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const web = path.join(source, 'host_adapters', 'web');
-const chromiumPath = process.env.EMBRA_CHROMIUM || '/usr/bin/chromium';
 const require = createRequire(import.meta.url);
 const { errorColor } = require(path.join(source, 'host_adapters', 'node', 'lib', 'colors.js'));
 
@@ -40,15 +40,7 @@ before(async () => {
     scene: path.join(source, 'examples', 'poq_drape.json'), host: '127.0.0.1', port: 0,
     web: path.join(web, 'dist'), saveDir: tmp, log: () => {},
   });
-  const { chromium } = require(path.join(web, 'node_modules', 'playwright-core'));
-  context = await chromium.launchPersistentContext(path.join(tmp, 'profile'), {
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync',
-      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-    viewport: { width: 1280, height: 800 },
-  });
+  context = await launchChromium(path.join(tmp, 'profile'), { width: 1280, height: 800 });
   page = context.pages()[0] || await context.newPage();
   page.on('pageerror', (err) => pageErrors.push(err.message));
   await page.goto(live.url);

@@ -18,12 +18,12 @@ import path from 'node:path';
 import { after, before, test } from 'node:test';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
+import { chromiumPath, launchChromium } from '../../host_adapters/web/headless.mjs';
 
 const source = process.env.EMBRA_SOURCE_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const web = path.join(source, 'host_adapters', 'web');
 const dist = path.join(web, 'dist');
 const cli = process.env.EMBRA_CLI || path.join(source, 'build', 'host_adapters', 'cli', 'embra');
-const chromiumPath = process.env.EMBRA_CHROMIUM || '/usr/bin/chromium';
 const screenshot = process.env.EMBRA_SCREENSHOT || path.join(source, 'docs', 'screenshots', 'poq_replay_errors.png');
 
 const require = createRequire(import.meta.url);
@@ -68,16 +68,7 @@ before(async () => {
   assert.deepEqual([...index.files].sort(), fs.readdirSync(run).sort());
   server = await serve({ dist, run });
 
-  const { chromium } = require(path.join(web, 'node_modules', 'playwright-core'));
-  context = await chromium.launchPersistentContext(path.join(tmp, 'profile'), {
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync',
-      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-    viewport: { width: 1440, height: 900 },
-    deviceScaleFactor: 1,
-  });
+  context = await launchChromium(path.join(tmp, 'profile'));
   page = context.pages()[0] || await context.newPage();
   page.on('pageerror', (err) => pageErrors.push(err.message));
   page.on('console', (msg) => { if (msg.type() === 'error') pageErrors.push(msg.text()); });

@@ -294,3 +294,19 @@ test('the http side serves only the page folder', async () => {
   assert.ok([403, 404].includes(await get('%2e%2e/%2e%2e/package.json')));
   assert.equal(await get('no-such-file.js'), 404);
 });
+
+test('the embra-live command: usage errors exit 1, an invalid scene exits 2 naming the problem', () => {
+  const { spawnSync } = require('node:child_process');
+  const cmd = path.join(packageDir, 'live', 'embra-live.js');
+  const run = (...args) => spawnSync(process.execPath, [cmd, ...args], { encoding: 'utf8', env: process.env, timeout: 30000 });
+  assert.equal(run().status, 1);
+  assert.equal(run(scene, '--port', '70000').status, 1);
+  assert.equal(run(scene, '--bogus').status, 1);
+  const bad = path.join(tempDir('live-bad'), 'bad.json');
+  require('node:fs').writeFileSync(bad, '{"format": "embra-scene", "version": 1, "bodies": [{"mesh": 3}]}');
+  const r = run(bad, '--port', '0');
+  assert.equal(r.status, 2, r.stderr);
+  assert.match(r.stderr, /bad\.json: .*\/bodies\/0/);
+  const missing = run('/nonexistent/scene.json', '--port', '0');
+  assert.equal(missing.status, 2, missing.stderr);
+});
