@@ -365,7 +365,7 @@ static int write_error_fields(const char* path, embra_world* world, const embra_
     fprintf(f, "%s\"%s\":[", k > 0 ? "," : "", fields[k].name);
     for (int32_t p = 0; p < counts.particles && rc == 0; ++p) {
       if (p > 0) fputc(',', f);
-      if (measured[p])
+      if (measured[p] && isfinite(value[p]))
         fprintf(f, "%.9g", value[p]);
       else
         fputs("null", f);
@@ -448,7 +448,12 @@ static int run_index_open(run_index* x) {
   memset(x, 0, sizeof *x);
   x->files = open_memstream(&x->files_text, &x->files_length);
   x->frames = open_memstream(&x->frames_text, &x->frames_length);
-  return x->files && x->frames ? 0 : -1;
+  if (x->files && x->frames) return 0;
+  if (x->files) fclose(x->files);
+  if (x->frames) fclose(x->frames);
+  free(x->files_text);
+  free(x->frames_text);
+  return -1;
 }
 
 /* Records a file written into DIR (its name only: every name embra writes is plain ASCII). */

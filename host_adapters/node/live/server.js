@@ -130,7 +130,7 @@ function startServer(options) {
         } catch {
           throw new RefusedMessage('not JSON');
         }
-        const result = await session.handle(msg);
+        const result = await session.handle(msg, ws);
         for (const r of result.replies || []) send(ws, r);
         if (result.broadcast) for (const other of clients) if (other !== ws) for (const r of result.replies || []) send(other, r);
         if (result.scene) {
@@ -148,7 +148,10 @@ function startServer(options) {
         send(ws, { type: 'error', message: e.message });
       }
     });
-    ws.on('close', () => clients.delete(ws));
+    ws.on('close', () => {
+      clients.delete(ws);
+      session.releaseDrag(ws); // a page that goes away lets go of what it held
+    });
     ws.on('error', (e) => log(`socket error: ${e.message}`));
   });
   wss.on('error', (e) => log(`websocket server error: ${e.message}`));

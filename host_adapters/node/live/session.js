@@ -57,7 +57,7 @@ class Session {
     this.paused = paused;
     this.gravityOn = true;
     this.pinsOn = true;
-    this.drag = null;
+    this.drags = new Map(); // page -> {pin, particle}: each page holds at most one drag
     this.lastMs = 0;
     const saved = JSON.parse(world.saveJson());
     this.name = saved.name || path.basename(this.scenePath, '.json');
@@ -208,7 +208,7 @@ class Session {
    * (objects) and whether everyone needs a new `scene`. Refusals throw RefusedMessage or EmbraError,
    * after which nothing has changed.
    */
-  async handle(msg) {
+  async handle(msg, page = 'page') {
     if (msg === null || typeof msg !== 'object' || Array.isArray(msg)) refuse('a message must be a JSON object');
     const w = this.world;
     switch (msg.type) {
@@ -217,21 +217,20 @@ class Session {
           refuse(`particle ${JSON.stringify(msg.particle)} is not in [0, ${this.particles})`);
         const target = finite3(msg.target, 'target');
         const pin = w.createPin(msg.particle, target, { compliance: DRAG_COMPLIANCE });
-        if (this.drag) w.destroyPin(this.drag.pin);
-        this.drag = { pin, particle: msg.particle };
+        this.releaseDrag(page);
+        this.drags.set(page, { pin, particle: msg.particle });
         return {};
       }
       case 'drag': {
         const target = finite3(msg.target, 'target');
-        if (!this.drag) refuse('drag without drag_start');
-        w.setPinTarget(this.drag.pin, target);
+        const drag = this.drags.get(page);
+        if (!drag) refuse('drag without drag_start');
+        w.setPinTarget(drag.pin, target);
         return {};
       }
-      case 'drag_end': {
-        if (this.drag) w.destroyPin(this.drag.pin);
-        this.drag = null;
+      case 'drag_end':
+        this.releaseDrag(page);
         return {};
-      }
       case 'collider_pose': {
         const c = indexIn(msg.index, this.colliders, 'collider');
         const position = finite3(msg.position, 'position');
@@ -288,7 +287,7 @@ class Session {
         this.#load(this.paused);
         return { scene: true };
       case 'save': {
-        const json = w.saveJson();
+        const json = this.#saveWithoutDrags();
         fs.mkdirSync(this.saveDir, { recursive: true });
         const file = path.join(this.saveDir, `${this.name}-${String(this.record.frame).padStart(5, '0')}.json`);
         fs.writeFileSync(file, json);
@@ -298,9 +297,9 @@ class Session {
         if (msg.format !== 'gltf' && msg.format !== '3dm') refuse('format must be "gltf" or "3dm"');
         const metric = msg.metric ?? 'planarity';
         if (!FIELDS.includes(metric)) refuse(`metric must be one of ${FIELDS.join(', ')}`);
+        const file = path.join(this.saveDir, `${this.name}-${String(this.record.frame).padStart(5, '0')}.${msg.format}`);
         const bytes = await this.exportBytes(msg.format, metric);
         fs.mkdirSync(this.saveDir, { recursive: true });
-        const file = path.join(this.saveDir, `${this.name}-${String(this.record.frame).padStart(5, '0')}.${msg.format}`);
         fs.writeFileSync(file, bytes);
         return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
       }
@@ -310,13 +309,36 @@ class Session {
     return {};
   }
 
+  /** Ends a page's drag (its pin destroyed); nothing when it holds none. Also when a page closes. */
+  releaseDrag(page) {
+    const drag = this.drags.get(page);
+    if (!drag) return;
+    this.drags.delete(page);
+    if (this.world) this.world.destroyPin(drag.pin);
+  }
+
+  /** The scene JSON of the current state without the pages' drag pins (a design, not a gesture). */
+  #saveWithoutDrags() {
+    const w = this.world;
+    const held = [...this.drags.entries()].map(([page, d]) => [page, d.particle, w.pinTarget(d.pin)]);
+    for (const [page] of held) this.releaseDrag(page);
+    try {
+      return w.saveJson();
+    } finally {
+      for (const [page, particle, target] of held)
+        this.drags.set(page, { pin: w.createPin(particle, target, { compliance: DRAG_COMPLIANCE }), particle });
+    }
+  }
+
   /** The current state as .gltf (JSON text) or .3dm bytes, coloured by `metric`'s error field. */
   async exportBytes(format, metric) {
     const k = FIELDS.indexOf(metric);
+    const meshes = this.bodies.filter((b) => b.triangles.length > 0);
+    if (meshes.length === 0) refuse('nothing to export: no body of this scene has triangles (export writes meshes)');
     const snapshot = {
       name: this.name,
       positions: Float64Array.from(this.positions),
-      meshes: this.bodies.filter((b) => b.triangles.length > 0).map((b) => ({ name: b.name, triangles: b.triangles })),
+      meshes: meshes.map((b) => ({ name: b.name, triangles: b.triangles })),
       colors: fieldColors(metric, this.fieldValues[k], this.tolerances[metric]),
     };
     if (format === 'gltf') return Buffer.from(JSON.stringify(toGltf(snapshot)));

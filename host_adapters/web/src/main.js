@@ -97,6 +97,17 @@ function setMetric(metric) {
 // --- scene -----------------------------------------------------------------------------------
 
 function applyScene(scene) {
+  // A new scene (a reset, another page's edit) ends a drag in progress (after a reset the server has
+  // already dropped its pin; drag_end then changes nothing).
+  if (pointer.drag) {
+    if (pointer.drag.kind === 'particle') {
+      send({ type: 'drag_end' });
+      view.showDrag(null, null);
+    }
+    else view.heldCollider = -1;
+    pointer.drag = null;
+    view.controls.enabled = true;
+  }
   const sameScene = state.scene && state.scene.name === scene.name && state.scene.particles === scene.particles;
   state.scene = scene;
   state.fields = {};
@@ -111,7 +122,9 @@ function applyScene(scene) {
   for (const option of select.options) option.disabled = option.value !== 'none' && !scene.fields.includes(option.value);
   const metric = scene.fields.includes(state.metric) ? state.metric : scene.fields[0] || 'none';
   setMetric(metric);
-  plot.reset(scene.tolerances);
+  // An edit (pins, a weight) re-sends the same scene: the history stays; a reset shows in the plot
+  // as a frame going back, which plot.push handles.
+  if (!sameScene) plot.reset(scene.tolerances);
   view.setPinsVisible(scene.pins_on !== false);
   if (state.mode === 'live') buildLivePanels(scene);
 }

@@ -271,6 +271,33 @@ test('the glTF export holds the same mesh at float precision', async () => {
   assert.equal(gltf.accessors[prim.indices].count, live.session.bodies[0].triangles.length);
 });
 
+test('two pages drag independently; a page that leaves lets go; save keeps no drag pin', async () => {
+  await paused(page);
+  const w = live.session.world;
+  const pins = w.counts().pins;
+  const other = await connect(live.url);
+  if (!other.inbox.some(ofType('scene'))) await next(other, ofType('scene'), 'the second page\'s scene');
+  send(page, { type: 'drag_start', particle: 3, target: [0, 0, 1] });
+  send(other, { type: 'drag_start', particle: 60, target: [0, 0, 2] });
+  send(page, { type: 'drag', target: [0, 0, 1.5] });
+  send(page, { type: 'save' });
+  const saved = await next(page, ofType('saved'), 'saved during two drags');
+  assert.equal(w.counts().pins, pins + 2);
+  const targets = w.pins().map((p) => [w.pinParticle(p), w.pinTarget(p)[2]]);
+  assert.deepEqual(targets.slice(pins).sort((a, b) => a[0] - b[0]), [[3, 1.5], [60, 2]]);
+  assert.equal(JSON.parse(saved.json).pins.length, pins, 'the saved design holds the scene\'s pins only');
+  other.ws.close();
+  await new Promise((resolve) => {
+    const poll = () => (w.counts().pins === pins + 1 ? resolve() : setTimeout(poll, 20));
+    poll();
+  });
+  assert.deepEqual(w.pins().slice(pins).map((p) => w.pinParticle(p)), [3]);
+  send(page, { type: 'drag_end' });
+  send(page, { type: 'step' });
+  await next(page, ofType('geometry'), 'a step');
+  assert.equal(w.counts().pins, pins);
+});
+
 test('reset reloads the scene at frame 0, still paused', async () => {
   await paused(page);
   send(page, { type: 'reset' });
