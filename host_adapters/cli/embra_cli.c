@@ -242,6 +242,20 @@ static double now_ms(void) {
   return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
 }
 
+/* The ids of the world's bodies (malloc'd, *count of them; NULL on failure or none). */
+static embra_body_id* world_bodies(const embra_world* world, int32_t* count) {
+  *count = 0;
+  int32_t n = 0;
+  if (embra_world_get_bodies(world, NULL, 0, &n) != EMBRA_OK || n == 0) return NULL;
+  embra_body_id* ids = malloc(sizeof *ids * (size_t)n);
+  if (ids && embra_world_get_bodies(world, ids, n, &n) == EMBRA_OK) {
+    *count = n;
+    return ids;
+  }
+  free(ids);
+  return NULL;
+}
+
 /* Writes every body's triangles as one OBJ, a group per body. */
 static int write_world_obj(const char* path, embra_world* world) {
   embra_world_counts counts;
@@ -261,18 +275,21 @@ static int write_world_obj(const char* path, embra_world* world) {
   fprintf(f, "# embra %s\n", embra_version_string());
   for (int32_t i = 0; i < counts.particles; ++i)
     fprintf(f, "v %.17g %.17g %.17g\n", xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  for (int32_t b = 0; b < counts.bodies; ++b) {
-    const embra_body_id body = {(uint32_t)b, 1};
+  int32_t body_count = 0;
+  embra_body_id* bodies = world_bodies(world, &body_count);
+  for (int32_t b = 0; b < body_count; ++b) {
+    const embra_body_id body = bodies[b];
     int64_t n = 0;
     if (embra_body_get_triangles(world, body, NULL, 0, &n) != EMBRA_OK || n == 0) continue;
     int32_t* tri = malloc(sizeof(int32_t) * (size_t)n);
     if (!tri) break;
     if (embra_body_get_triangles(world, body, tri, n, &n) == EMBRA_OK) {
-      fprintf(f, "g body_%d\n", b);
+      fprintf(f, "g body_%u\n", body.index);
       for (int64_t k = 0; k < n; k += 3) fprintf(f, "f %d %d %d\n", tri[k] + 1, tri[k + 1] + 1, tri[k + 2] + 1);
     }
     free(tri);
   }
+  free(bodies);
   free(xyz);
   return fclose(f) == 0 ? 0 : -1;
 }
@@ -280,14 +297,14 @@ static int write_world_obj(const char* path, embra_world* world) {
 /* Panel meshes: the bodies of the world that are panel meshes (up to 64). */
 #define MAX_PANEL_MESHES 64
 static int find_panel_meshes(embra_world* world, embra_body_id* out) {
-  embra_world_counts counts;
+  int32_t body_count = 0;
   int n = 0;
-  if (embra_world_get_counts(world, &counts) != EMBRA_OK) return 0;
-  for (int32_t b = 0; b < counts.bodies && n < MAX_PANEL_MESHES; ++b) {
-    const embra_body_id body = {(uint32_t)b, 1};
+  embra_body_id* bodies = world_bodies(world, &body_count);
+  for (int32_t b = 0; b < body_count && n < MAX_PANEL_MESHES; ++b) {
     int32_t panels = 0;
-    if (embra_panel_mesh_get_panel_count(world, body, &panels) == EMBRA_OK) out[n++] = body;
+    if (embra_panel_mesh_get_panel_count(world, bodies[b], &panels) == EMBRA_OK) out[n++] = bodies[b];
   }
+  free(bodies);
   return n;
 }
 

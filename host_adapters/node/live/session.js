@@ -89,15 +89,17 @@ class Session {
     });
     const groupByName = new Map(this.groups.map((g) => [g.name, g.id]));
     const savedPins = saved.pins || [];
-    this.pins = world.pins().map((id, i) => {
-      const entry = savedPins.length === world.pins().length ? savedPins[i] : {};
+    const pinIds = world.pins();
+    this.pins = pinIds.map((id, i) => {
+      const entry = savedPins.length === pinIds.length ? savedPins[i] : {};
       const compliance = entry.compliance || 0;
       return { id, index: i, name: entry.name || `pin_${i}`, particle: world.pinParticle(id), compliance,
                group: compliance > 0 && entry.group ? groupByName.get(entry.group) : undefined };
     });
     const savedColliders = saved.colliders || [];
-    this.colliders = world.colliders().map((id, i) => {
-      const entry = savedColliders.length === world.colliders().length ? savedColliders[i] : {};
+    const colliderIds = world.colliders();
+    this.colliders = colliderIds.map((id, i) => {
+      const entry = savedColliders.length === colliderIds.length ? savedColliders[i] : {};
       return { id, index: i, name: entry.name || `collider_${i}`, shape: entry.shape || 'sphere',
                radius: entry.radius ?? 1, half_extents: entry.half_extents || [0.5, 0.5, 0.5],
                half_length: entry.half_length ?? 0.5, vertices: entry.vertices || [], triangles: entry.triangles || [] };
