@@ -399,22 +399,32 @@ void World::find_face_contacts() {
     const Collider& col = colliders_[c];
     if (!col.alive || col.desc.shape != ColliderShape::sphere) continue;
     const double r = col.desc.radius + col.desc.thickness;
+    const double move = (col.position - col.position_prev).norm();
     for (const PanelLayout& l : panel_layouts_)
       for (int32_t p = 0; p < l.panel_count(); ++p)
         for (int layer = 0; layer < 2; ++layer)
           for (int half = 0; half < 2; ++half) {
             const int32_t o = l.first_particle + 8 * p + 4 * layer;
+            const int32_t across = layer == 0 ? 4 : -4;
             const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
-            if (w_[ids[0]] == 0.0 && w_[ids[1]] == 0.0 && w_[ids[2]] == 0.0) continue;
+            const int32_t partner[3] = {ids[0] + across, ids[1] + across, ids[2] + across};
+            if (slab_weight(ids[0], partner[0]) == 0.0 && slab_weight(ids[1], partner[1]) == 0.0 &&
+                slab_weight(ids[2], partner[2]) == 0.0)
+              continue;
             double moved = 0.0;
             for (int32_t i : ids) moved = std::max(moved, (x_[i] - x_prev_[i]).norm());
             const Vec3 b = closest_barycentric(col.position, x_[ids[0]], x_[ids[1]], x_[ids[2]]);
             const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
-            const double move = (col.position - col.position_prev).norm();
             if ((q - col.position).norm() - r < moved + move)
-              face_contacts_.push_back(FaceContact{{ids[0], ids[1], ids[2]}, static_cast<int32_t>(c), 0.0});
+              face_contacts_.push_back(FaceContact{
+                  {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), r, 0.0});
           }
   }
+}
+
+double World::slab_weight(int32_t a, int32_t b) const {
+  const double wa = w_[a], wb = w_[b];
+  return wa > 0.0 && wb > 0.0 ? wa * wb / (wa + wb) : 0.0;
 }
 
 void World::project_face_contacts() {
@@ -429,16 +439,23 @@ void World::project_face_contacts() {
     const double len = d.norm();
     if (!(len > 1e-12)) continue;
     const Vec3 n = d / len;
-    const double gap = len - (col.desc.radius + col.desc.thickness);
-    double denom = 0.0;
-    for (int k = 0; k < 3; ++k) denom += w_[fc.ids[k]] * bary[k] * bary[k];
+    const double gap = len - fc.clearance;
+    double ws[3], denom = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      ws[k] = slab_weight(fc.ids[k], fc.partner[k]);
+      denom += ws[k] * bary[k] * bary[k];
+    }
     if (denom <= 0.0) continue;
-    // Hard, unilateral: C = gap >= 0, grad_k C = b_k n.
+    // Hard, unilateral: C = gap >= 0, grad_k C = b_k n, corner k and its partner moving as one.
     const double lambda = std::max(fc.lambda - gap / denom, 0.0);
     const double dl = lambda - fc.lambda;
     fc.lambda = lambda;
     if (dl == 0.0) continue;
-    for (int k = 0; k < 3; ++k) x_[fc.ids[k]] += (w_[fc.ids[k]] * bary[k] * dl) * n;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 step = (ws[k] * bary[k] * dl) * n;
+      x_[fc.ids[k]] += step;
+      x_[fc.partner[k]] += step;
+    }
   }
 }
 
@@ -564,7 +581,11 @@ void World::realign(const std::vector<Vec3>& predicted) {
     const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
     const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
     const Vec3 n = (q - col.position).normalized();
-    for (int k = 0; k < 3; ++k) corr[fc.ids[k]] += (w_[fc.ids[k]] * bary[k] * fc.lambda) * n;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 step = (slab_weight(fc.ids[k], fc.partner[k]) * bary[k] * fc.lambda) * n;
+      corr[fc.ids[k]] += step;
+      corr[fc.partner[k]] += step;
+    }
   }
   for (size_t i = 0; i < x_.size(); ++i)
     if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
@@ -670,7 +691,8 @@ void World::update_velocities(double h) {
   }
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
   // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
-  // projection shares it (particle k moves w_k b_k / sum_j w_j b_j^2 of it).
+  // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the
+  // inverse of their joint mass).
   for (const FaceContact& fc : face_contacts_) {
     if (fc.lambda <= 0.0) continue;
     const Collider& c = colliders_[fc.collider];
@@ -681,7 +703,7 @@ void World::update_velocities(double h) {
       const int32_t i = fc.ids[k];
       q += bary[k] * x_[i];
       moved += bary[k] * (x_[i] - x_prev_[i]);
-      denom += w_[i] * bary[k] * bary[k];
+      denom += slab_weight(i, fc.partner[k]) * bary[k] * bary[k];
       mu_s += bary[k] * mu_s_[i];
       mu_k += bary[k] * mu_k_[i];
     }
@@ -699,7 +721,11 @@ void World::update_velocities(double h) {
       remove = tangential;
     else if (len > 0.0)
       remove = tangential * std::min(mu_k * push / len, 1.0);
-    for (int k = 0; k < 3; ++k) x_[fc.ids[k]] -= (w_[fc.ids[k]] * bary[k] / denom) * remove;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 step = (slab_weight(fc.ids[k], fc.partner[k]) * bary[k] / denom) * remove;
+      x_[fc.ids[k]] -= step;
+      x_[fc.partner[k]] -= step;
+    }
   }
   const double inv_h = 1.0 / h;
   for (size_t i = 0; i < x_.size(); ++i) {
@@ -761,7 +787,7 @@ void World::measure() {
         const Collider& col = colliders_[fc.collider];
         const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
         const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
-        const double r = std::max(col.desc.radius + col.desc.thickness - (q - col.position).norm(), 0.0);
+        const double r = std::max(fc.clearance - (q - col.position).norm(), 0.0);
         max = std::max(max, r);
         sq += r * r;
         ++n;

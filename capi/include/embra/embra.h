@@ -541,7 +541,8 @@ EMBRA_API embra_status embra_body_get_triangles(const embra_world* world, embra_
  * initial bottom corner of a mesh vertex is where the offset planes of its faces meet (least
  * squares; exact for a conical mesh). The triangles of both layers (bottom ones facing down) take
  * face contacts against sphere colliders, so a rigid panel never passes into a sphere between its
- * corners.
+ * corners; a contact pushes the panel as a slab (each corner of the touching face together with the
+ * corner across the thickness from it), so the push does not fight the plane offsets.
  *
  * Metrics (section 4.1, computed from positions alone): planarity 1 - n1.n2 of the unit normals of
  * a quad's two triangles (the larger over both diagonals; dimensionless, quadratic in the fold),

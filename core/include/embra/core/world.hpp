@@ -269,13 +269,18 @@ struct Contact {
   double offset = 0.0;
 };
 
-/// A face contact (panel meshes against sphere colliders): the point of triangle `ids` closest to
-/// the sphere's centre, sum_k b_k x_k with barycentric weights b found again at every projection,
-/// kept `radius` (the sphere's radius plus its thickness) from the centre. Hard and unilateral;
-/// lambda is the accumulated push along the normal.
+/// A face contact (panel meshes against sphere colliders): the point of triangle `ids` (of either
+/// layer) closest to the sphere's centre, sum_k b_k x_k with barycentric weights b found again at
+/// every projection, kept `clearance` (the sphere's radius plus its thickness) from the centre.
+/// The push moves each corner together with its partner in the other layer (`partner`, the corner
+/// straight across the panel), as one particle of their joint mass: a panel is pushed as a slab
+/// instead of its touching face being pushed against the plane offsets that hold it to the other
+/// face. Hard and unilateral; lambda is the accumulated push along the normal.
 struct FaceContact {
   int32_t ids[3];
+  int32_t partner[3];
   int32_t collider;
+  double clearance;
   double lambda;
 };
 
@@ -457,6 +462,8 @@ class World {
   void find_self_contacts();
   void find_face_contacts();
   void project_face_contacts();
+  /// Inverse of the joint mass of a panel corner and its partner across the slab (0: one is fixed).
+  double slab_weight(int32_t a, int32_t b) const;
   void find_shape_contacts(int32_t collider, std::vector<Contact>& out) const;
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
