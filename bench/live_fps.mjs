@@ -2,7 +2,7 @@
 // headless Chromium, lets it run, and reports frames received per second by the page and the
 // server's ms per step. A measurement, not a test:
 //
-//   node bench/live_fps.mjs [SCENE.json] [SECONDS]     (default bench/scenes/poq_drape_32.json, 20)
+//   node bench/live_fps.mjs [SCENE.json] [SECONDS]     (default examples/large/poq_drape_32.json, 20)
 //
 // Needs the page built (cd host_adapters/web && npm run build), host_adapters/node's packages and
 // EMBRA_LIBRARY (or libembra.so.0 on the loader's path).
@@ -16,7 +16,7 @@ import { launchChromium } from '../host_adapters/web/headless.mjs';
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
-const scene = path.resolve(process.argv[2] || path.join(source, 'bench', 'scenes', 'poq_drape_32.json'));
+const scene = path.resolve(process.argv[2] || path.join(source, 'examples', 'large', 'poq_drape_32.json'));
 const seconds = Number(process.argv[3] || 20);
 const { startServer } = require(path.join(source, 'host_adapters', 'node', 'live', 'server.js'));
 

@@ -150,13 +150,73 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   }
 }
 
-enum class Op { distance, tether, dihedral };
+/// Quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2, x3)) or plane
+/// offset (signed distance of x0 from the plane of (x1, x2, x3)) = rest: the function and gradients
+/// of eval_quad_planarity / eval_plane_offset (constraint_math.hpp), written out flat. Both are
+/// C = s . u with u = n / |n|, n = a x b; with q = (s - C u) / |n| the gradient along a is b x q and
+/// along b is q x a.
+template <class T, bool kPlanarity>
+EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, const double* compliance, double* lambda,
+                                      double inv_h2, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  const V3<T> p[4] = {load_point<T>(x, ids, 4), load_point<T>(x, ids + 1, 4), load_point<T>(x, ids + 2, 4),
+                      load_point<T>(x, ids + 3, 4)};
+  const T wk[4] = {load_value<T>(w, ids, 4), load_value<T>(w, ids + 1, 4), load_value<T>(w, ids + 2, 4),
+                   load_value<T>(w, ids + 3, 4)};
+  const T r = gather<T>(rest), lam = gather<T>(lambda);
+  const T alpha = gather<T>(compliance) * inv_h2;
+  const V3<T> a = kPlanarity ? p[2] - p[0] : p[2] - p[1];
+  const V3<T> b = kPlanarity ? p[3] - p[1] : p[3] - p[1];
+  const V3<T> s = kPlanarity ? p[1] - p[0] : p[0] - p[1];
+  const V3<T> n = cross(a, b);
+  const T m = lanes::sqrt(dot(n, n));
+  const auto valid = m > 1e-300;
+  const V3<T> u = {n.x / m, n.y / m, n.z / m};
+  const T value = dot(s, u);
+  const V3<T> t = s - value * u;
+  const V3<T> q = {t.x / m, t.y / m, t.z / m};
+  const V3<T> ga = cross(b, q), gb = cross(q, a);
+  V3<T> g[4];
+  if constexpr (kPlanarity) {
+    g[0] = -u - ga;
+    g[1] = u - gb;
+  } else {
+    g[0] = u;
+    g[1] = -((u + ga) + gb);
+  }
+  g[2] = ga;
+  g[3] = gb;
+  T denom = alpha;
+  for (int k = 0; k < 4; ++k) denom = denom + wk[k] * dot(g[k], g[k]);
+  const auto ok = valid & (denom > 0.0);
+  const T dl = (-(value - r) - alpha * lam) / denom;
+  const T lam_new = lam + dl;
+  T sk[4];
+  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
+  for (int l = 0; l < L::count; ++l) {
+    if (!L::on(ok, l)) continue;
+    lambda[l] = L::get(lam_new, l);
+    for (int k = 0; k < 4; ++k) {
+      if (L::get(wk[k], l) == 0.0) continue;
+      double* o = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
+      const double f = L::get(sk[k], l);
+      o[0] += f * L::get(g[k].x, l);
+      o[1] += f * L::get(g[k].y, l);
+      o[2] += f * L::get(g[k].z, l);
+    }
+  }
+}
+
+enum class Op { distance, tether, dihedral, planarity, plane_offset };
 
 template <class T, Op kOp>
 EMBRA_ALWAYS_INLINE void block(const SolverArray& a, size_t i, double inv_h2, double* x, const double* w,
                                double* lambda) {
   if constexpr (kOp == Op::dihedral)
     dihedral_block<T>(&a.ids[4 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
+  else if constexpr (kOp == Op::planarity || kOp == Op::plane_offset)
+    offset_block<T, kOp == Op::planarity>(&a.ids[4 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
   else
     distance_block<T, kOp == Op::tether>(&a.ids[2 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
 }
@@ -178,21 +238,29 @@ EMBRA_ALWAYS_INLINE void pass(SolverArray& a, double inv_h2, double* x, const do
 }
 
 /// The passes for one lane type, compiled for one instruction set (ATTR).
-#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                               \
-  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) { \
-    pass<T, Op::distance>(a, inv_h2, x, w);                                              \
-  }                                                                                      \
-  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {   \
-    pass<T, Op::tether>(a, inv_h2, x, w);                                                \
-  }                                                                                      \
-  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) { \
-    pass<T, Op::dihedral>(a, inv_h2, x, w);                                              \
+#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                   \
+  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) {     \
+    pass<T, Op::distance>(a, inv_h2, x, w);                                                  \
+  }                                                                                          \
+  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {       \
+    pass<T, Op::tether>(a, inv_h2, x, w);                                                    \
+  }                                                                                          \
+  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) {     \
+    pass<T, Op::dihedral>(a, inv_h2, x, w);                                                  \
+  }                                                                                          \
+  ATTR void NAME##_planarity(SolverArray& a, double inv_h2, double* x, const double* w) {    \
+    pass<T, Op::planarity>(a, inv_h2, x, w);                                                 \
+  }                                                                                          \
+  ATTR void NAME##_plane_offset(SolverArray& a, double inv_h2, double* x, const double* w) { \
+    pass<T, Op::plane_offset>(a, inv_h2, x, w);                                              \
   }
 
 struct Kernels {
   void (*distance)(SolverArray&, double, double*, const double*);
   void (*tether)(SolverArray&, double, double*, const double*);
   void (*dihedral)(SolverArray&, double, double*, const double*);
+  void (*planarity)(SolverArray&, double, double*, const double*);
+  void (*plane_offset)(SolverArray&, double, double*, const double*);
   const char* name;
 };
 
@@ -209,15 +277,17 @@ EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels() {
   static const Kernels chosen = [] {
-    const Kernels scalar{scalar_distance, scalar_tether, scalar_dihedral, "scalar"};
+    const Kernels scalar{scalar_distance,  scalar_tether,       scalar_dihedral,
+                         scalar_planarity, scalar_plane_offset, "scalar"};
     const char* forced = std::getenv("EMBRA_KERNELS");
     const std::string want = forced ? forced : "";
     if (want == "scalar") return scalar;
 #if EMBRA_LANES_VECTOR
-    const Kernels vec2{vec2_distance, vec2_tether, vec2_dihedral, "vec2"};
+    const Kernels vec2{vec2_distance, vec2_tether, vec2_dihedral, vec2_planarity, vec2_plane_offset, "vec2"};
     if (want == "vec2") return vec2;
 #if defined(EMBRA_HAVE_AVX2_KERNELS)
-    if (__builtin_cpu_supports("avx2")) return Kernels{avx2_distance, avx2_tether, avx2_dihedral, "avx2"};
+    if (__builtin_cpu_supports("avx2"))
+      return Kernels{avx2_distance, avx2_tether, avx2_dihedral, avx2_planarity, avx2_plane_offset, "avx2"};
 #endif
     return vec2;
 #else
@@ -612,8 +682,8 @@ void World::project_group(Group& g, double h) {
   project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
   k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
-  project_generic<Kind::planarity>(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x_, w_);
-  project_generic<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x_, w_);
+  k.planarity(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
+  k.plane_offset(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
   if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
     self_collision::project(self_contacts_, x_, w_);
