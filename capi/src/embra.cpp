@@ -991,6 +991,17 @@ embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_i
   });
 }
 
+embra_status embra_panel_mesh_get_corner_gap(const embra_world* world, embra_body_id body,
+                                             embra_metric_summary* out_summary) {
+  return guard("embra_panel_mesh_get_corner_gap", [&] {
+    need(world, "world");
+    need(out_summary, "out_summary");
+    const embra::PanelLayout& l = layout_of(world, body);
+    const embra::PanelReport r = embra::report_panels(embra::measure_panels(l, world->world.positions()), {});
+    *out_summary = from_summary(r.corner_gap);
+  });
+}
+
 embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_body_id body, int32_t metric,
                                                 double* out, int64_t capacity, int64_t* out_count) {
   return guard("embra_panel_mesh_get_vertex_errors", [&] {

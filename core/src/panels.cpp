@@ -173,6 +173,22 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
     }
     e.conical.push_back(std::abs((a[0] + a[2]) - (a[1] + a[3])));
   }
+  // Corner copies per mesh vertex, in panel order.
+  std::vector<std::vector<std::pair<int32_t, int>>> around(static_cast<size_t>(layout.vertex_count));
+  for (int32_t p = 0; p < n; ++p)
+    for (int k = 0; k < 4; ++k) around[static_cast<size_t>(layout.quads[4 * p + k])].emplace_back(p, k);
+  for (const auto& copies : around) {
+    if (copies.size() < 2) continue;
+    double gap = 0.0;
+    for (size_t i = 0; i < copies.size(); ++i)
+      for (size_t j = i + 1; j < copies.size(); ++j) {
+        const auto [pi, ki] = copies[i];
+        const auto [pj, kj] = copies[j];
+        gap = std::max(gap, (x[layout.top(pi, ki)] - x[layout.top(pj, kj)]).norm());
+        gap = std::max(gap, (x[layout.bottom(pi, ki)] - x[layout.bottom(pj, kj)]).norm());
+      }
+    e.corner_gap.push_back(gap);
+  }
   return e;
 }
 
@@ -206,6 +222,7 @@ PanelReport report_panels(const PanelErrors& e, const Tolerances& t) {
   r.thickness = summarize(e.thickness, t.thickness);
   r.miter = summarize(e.miter, t.miter);
   r.conical = summarize(e.conical, none);
+  r.corner_gap = summarize(e.corner_gap, none);
   r.within_tolerance = r.planarity_top.max <= t.planarity.target && r.planarity_bottom.max <= t.planarity.target &&
                        r.corner_distance_top.max <= t.planarity_distance.target &&
                        r.corner_distance_bottom.max <= t.planarity_distance.target &&

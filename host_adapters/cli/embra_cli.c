@@ -310,7 +310,7 @@ static int find_panel_meshes(embra_world* world, embra_body_id* out) {
 
 /* The worst of every panel mesh's metrics (and whether all are within tolerance). */
 typedef struct panel_totals {
-  double planarity, planarity_top, planarity_bottom, corner_distance, thickness, miter, conical, diagonal;
+  double planarity, planarity_top, planarity_bottom, corner_distance, thickness, miter, conical, diagonal, corner_gap;
   int within;
 } panel_totals;
 
@@ -323,7 +323,11 @@ static int panel_totals_of(embra_world* world, const embra_body_id* bodies, int 
   t->within = 1;
   for (int i = 0; i < n; ++i) {
     embra_panel_metrics m;
-    if (embra_panel_mesh_get_metrics(world, bodies[i], NULL, &m) != EMBRA_OK) return -1;
+    embra_metric_summary gap;
+    if (embra_panel_mesh_get_metrics(world, bodies[i], NULL, &m) != EMBRA_OK ||
+        embra_panel_mesh_get_corner_gap(world, bodies[i], &gap) != EMBRA_OK)
+      return -1;
+    t->corner_gap = max2(t->corner_gap, gap.max);
     t->planarity_top = max2(t->planarity_top, m.planarity_top.max);
     t->planarity_bottom = max2(t->planarity_bottom, m.planarity_bottom.max);
     t->planarity = max2(t->planarity_top, t->planarity_bottom);
@@ -615,9 +619,10 @@ static int cmd_run(int argc, char** argv) {
       fprintf(metrics,
               ",\"planarity_max\":%.17g,\"planarity_top_max\":%.17g,\"planarity_bottom_max\":%.17g,"
               "\"corner_distance_max\":%.17g,\"diagonal_max\":%.17g,\"thickness_error_max\":%.17g,"
-              "\"miter_error_max\":%.17g,\"conical_defect_max\":%.17g,\"within_tolerance\":%s}\n",
+              "\"miter_error_max\":%.17g,\"conical_defect_max\":%.17g,\"corner_gap_max\":%.17g,"
+              "\"within_tolerance\":%s}\n",
               pt.planarity, pt.planarity_top, pt.planarity_bottom, pt.corner_distance, pt.diagonal, pt.thickness,
-              pt.miter, pt.conical, pt.within ? "true" : "false");
+              pt.miter, pt.conical, pt.corner_gap, pt.within ? "true" : "false");
       if (pt.within && within_since < 0) within_since = (long)r.frame;
       if (!pt.within) within_since = -1;
     }
@@ -707,6 +712,8 @@ static int cmd_run(int argc, char** argv) {
     print_tolerance_row("miter twist", pt.miter, tol.miter, tol.unit_scale, 1);
     printf("%-22s %12.3e %12s %10s\n", "diagonals / edge", pt.diagonal, "-", "-");
     printf("%-22s %12.3e %12s %10s\n", "conical defect (rad)", pt.conical, "-", "-");
+    printf("%-22s %12.3e %12s %10s %12.4f\n", "corner gap (welds)", pt.corner_gap, "-", "-",
+           pt.corner_gap * tol.unit_scale);
     if (within_since >= 0)
       printf("%-22s since frame %ld\n", "within tolerance", within_since);
     else

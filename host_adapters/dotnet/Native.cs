@@ -304,6 +304,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_tolerances(IntPtr world, out Tolerances tolerances);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_tolerances(IntPtr world, ref Tolerances tolerances);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_metrics(IntPtr world, BodyId body, [In] Tolerances[] tolerances, out PanelMetrics metrics);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_corner_gap(IntPtr world, BodyId body, out MetricSummary summary);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_vertex_errors(IntPtr world, BodyId body, int metric, [Out] double[] errors, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_export_cuts(IntPtr world, BodyId body, int format, [Out] byte[] text, long capacity, out long length);
         // constraints

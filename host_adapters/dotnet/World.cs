@@ -437,6 +437,15 @@ namespace Embra
             return m;
         }
 
+        /// <summary>The welds' error of a panel-mesh body (model units): per mesh vertex of two or more
+        /// panels, the largest distance between two of its corner copies in one layer.</summary>
+        public MetricSummary CornerGap(BodyId body)
+        {
+            var s = new MetricSummary();
+            Call(w => Native.embra_panel_mesh_get_corner_gap(w, body, out s));
+            return s;
+        }
+
         /// <summary>One error value per particle of a panel-mesh body (8 per panel, in body order) for a
         /// colour map, into `into` when given (capacity = its length) or a new array.</summary>
         public double[] VertexErrors(BodyId body, PanelMetric metric, double[] into = null)

@@ -269,6 +269,29 @@ static void test_large(const char* path, int32_t expect_panels) {
       m.corner_distance_top.max > m.corner_distance_bottom.max ? m.corner_distance_top.max
                                                                : m.corner_distance_bottom.max,
       worst_inside);
+  /* The welds' error, from positions alone: grid panel p = (column i, row j) has corners (i, j),
+   * (i + 1, j), (i + 1, j + 1), (i, j + 1); every copy of a mesh vertex against every other. */
+  int32_t side = 1;
+  while (side * side < panels) ++side;
+  double own_gap = 0.0;
+  for (int32_t p = 0; p < panels; ++p)
+    for (int32_t q = p + 1; q < panels; ++q)
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) {
+          const int32_t vi = p % side + (k == 1 || k == 2), vj = p / side + (k >= 2);
+          const int32_t ui = q % side + (l == 1 || l == 2), uj = q / side + (l >= 2);
+          if (vi != ui || vj != uj) continue;
+          for (int layer = 0; layer < 2; ++layer) {
+            const vec d = sub(at(x, 8 * p + 4 * layer + k), at(x, 8 * q + 4 * layer + l));
+            if (sqrt(dot(d, d)) > own_gap) own_gap = sqrt(dot(d, d));
+          }
+        }
+  embra_metric_summary gap;
+  CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
+  printf("corner gap (welds) at frame 300: %.3e (own %.3e), rms %.3e over %lld vertices\n", gap.max, own_gap, gap.rms,
+         (long long)gap.count);
+  CHECK_NEAR(gap.max, own_gap, 0.0);
+  CHECK_INT((int)gap.count, (side + 1) * (side + 1) - 4);
   CHECK(r.settled);
   CHECK(m.thickness.max <= 5e-5);
   CHECK(m.planarity_top.max <= 1e-6);
@@ -335,6 +358,13 @@ static void test_create(void) {
   bd.triangles = idx;
   CHECK_OK(embra_body_create(w, &bd, &not_panels, NULL));
   CHECK_STATUS(embra_panel_mesh_get_metrics(w, not_panels, NULL, &m), EMBRA_ERROR_INVALID_ARGUMENT);
+  embra_metric_summary gap;
+  CHECK_STATUS(embra_panel_mesh_get_corner_gap(w, not_panels, &gap), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_panel_mesh_get_corner_gap(w, body, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_panel_mesh_get_corner_gap(NULL, body, &gap), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
+  CHECK_NEAR(gap.max, 0.0, 0.0);        /* as built: every copy of a vertex where the grid puts it */
+  CHECK_INT((int)gap.count, 3 * 4 - 4); /* a 2 x 3 grid of panels: 12 mesh vertices, 4 of one panel */
   embra_world_destroy(w);
 }
 

@@ -647,6 +647,13 @@ EMBRA_API embra_status embra_panel_mesh_get_metrics(const embra_world* world, em
                                                     const embra_tolerances* tolerances,
                                                     embra_panel_metrics* out_metrics);
 
+/* The welds' error, which the paper's metrics do not see: for every mesh vertex shared by two or
+ * more panels, the largest distance between two of its corner copies in one layer (top or bottom),
+ * in model units; 0 when the panels meet exactly. Counts are against a target of 0. Gauss-Seidel
+ * leaves it largest on big meshes under load (bench/README.md, POQ drape). */
+EMBRA_API embra_status embra_panel_mesh_get_corner_gap(const embra_world* world, embra_body_id body,
+                                                       embra_metric_summary* out_summary);
+
 enum {
   EMBRA_PANEL_METRIC_PLANARITY = 0,       /* 1 - n1.n2 of the particle's layer of its panel */
   EMBRA_PANEL_METRIC_THICKNESS = 1,       /* m, its panel's thickness error */

@@ -318,6 +318,8 @@ const PROTOTYPES = {
   embra_world_set_tolerances: `embra_status embra_world_set_tolerances(${W}, const embra_tolerances *tolerances)`,
   embra_panel_mesh_get_metrics: `embra_status embra_panel_mesh_get_metrics(${CW}, embra_body_id body,
     const embra_tolerances *tolerances, _Out_ embra_panel_metrics *out_metrics)`,
+  embra_panel_mesh_get_corner_gap: `embra_status embra_panel_mesh_get_corner_gap(${CW}, embra_body_id body,
+    _Out_ embra_metric_summary *out_summary)`,
   embra_panel_mesh_get_vertex_errors: `embra_status embra_panel_mesh_get_vertex_errors(${CW}, embra_body_id body,
     int32_t metric, double *out, int64_t capacity, _Out_ int64_t *out_count)`,
   embra_panel_mesh_export_cuts: `embra_status embra_panel_mesh_export_cuts(${CW}, embra_body_id body,

@@ -515,6 +515,16 @@ class World {
   }
 
   /**
+   * The welds' error of a panel-mesh body (a summary in model units): per mesh vertex of two or more
+   * panels, the largest distance between two of its corner copies in one layer.
+   */
+  cornerGap(body) {
+    const s = {};
+    this.#call('embra_panel_mesh_get_corner_gap', toId(body, BodyId, 'body'), s);
+    return s;
+  }
+
+  /**
    * One error value per particle of a panel-mesh body (8 per panel, in body order) for a colour map:
    * metric a PANEL_METRICS name or number. A new Float64Array, or `out` written in place (too small:
    * BufferTooSmallError, nothing written).

@@ -286,6 +286,7 @@ PROTOTYPES = {
     "embra_world_get_tolerances": (_status, [_world, _P(Tolerances)]),
     "embra_world_set_tolerances": (_status, [_world, _P(Tolerances)]),
     "embra_panel_mesh_get_metrics": (_status, [_world, BodyId, _P(Tolerances), _P(PanelMetrics)]),
+    "embra_panel_mesh_get_corner_gap": (_status, [_world, BodyId, _P(MetricSummary)]),
     "embra_panel_mesh_get_vertex_errors": (_status, [_world, BodyId, c_int32, _pd, c_int64, _P(c_int64)]),
     "embra_panel_mesh_export_cuts": (_status, [_world, BodyId, c_int32, _P(c_char), c_int64, _P(c_int64)]),
     # constraints

@@ -14,7 +14,7 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    GroupId, GroupReport, Material, PanelMetrics, PinDef, PinId, SolverDef, StepReport, Tolerances,
+                    GroupId, GroupReport, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolverDef, StepReport, Tolerances,
                     Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
@@ -422,6 +422,13 @@ class World:
         self._call("embra_panel_mesh_get_metrics", _id(body, BodyId, "body"), None if t is None else byref(t),
                    byref(m))
         return m
+
+    def corner_gap(self, body):
+        """The welds' error of a panel-mesh body (a MetricSummary, in model units): per mesh vertex of
+        two or more panels, the largest distance between two of its corner copies in one layer."""
+        s = MetricSummary()
+        self._call("embra_panel_mesh_get_corner_gap", _id(body, BodyId, "body"), byref(s))
+        return s
 
     def vertex_errors(self, body, metric, out=None):
         """One error value per particle of a panel-mesh body (8 per panel, in body order) for a colour

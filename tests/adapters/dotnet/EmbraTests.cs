@@ -428,6 +428,7 @@ namespace Embra.Tests
                     Assert.AreEqual(Field(last, "planarity_top_max"), m.PlanarityTop.Max);
                     Assert.AreEqual(Field(last, "planarity_bottom_max"), m.PlanarityBottom.Max);
                     Assert.AreEqual(Field(last, "conical_defect_max"), m.Conical.Max);
+                    Assert.AreEqual(Field(last, "corner_gap_max"), w.CornerGap(body.Id).Max);
                     StringAssert.Contains("\"within_tolerance\":" + (m.WithinTolerance == 1 ? "true" : "false"), last);
                 }
             }

@@ -108,6 +108,7 @@ test('the drape built in Node matches the C host bit for bit: positions, metrics
     assert.equal(m.thickness.max, c.thickness_error_max);
     assert.equal(m.miter.max, c.miter_error_max);
     assert.equal(m.conical.max, c.conical_defect_max);
+    assert.equal(w.cornerGap(drape.body).max, c.corner_gap_max);
     assert.equal(m.within_tolerance === 1, c.within_tolerance);
     assert.ok(m.miter.max > 0, 'folding: the metrics are not all zero');
     assert.equal(w.exportCuts(drape.body), fs.readFileSync(path.join(out, 'panels_0.json'), 'utf8'));

@@ -135,6 +135,7 @@ def test_drape_built_in_python_matches_the_c_host_bit_for_bit(scene, c_drape):
         assert (m.thickness.max, m.miter.max, m.conical.max) == (c["thickness_error_max"], c["miter_error_max"],
                                                                  c["conical_defect_max"])
         assert bool(m.within_tolerance) == c["within_tolerance"]
+        assert w.corner_gap(drape.body).max == c["corner_gap_max"]
         assert w.export_cuts(drape.body) == c_drape["json"]
         assert w.export_cuts(drape.body, "csv") == c_drape["csv"]
         assert json.loads(w.export_cuts(drape.body, "json"))["format"] == "embra-panel-cuts"

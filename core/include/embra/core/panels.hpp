@@ -97,7 +97,9 @@ struct PanelErrors {
   std::vector<double> diagonal_top, diagonal_bottom;                // per panel, relative
   std::vector<double> thickness;                                    // per panel, model units
   std::vector<double> miter;                                        // per joint (panel_joints order)
-  std::vector<double> conical;  // per conical vertex: |(a1 + a3) - (a2 + a4)| in radians
+  std::vector<double> conical;     // per conical vertex: |(a1 + a3) - (a2 + a4)| in radians
+  std::vector<double> corner_gap;  // per mesh vertex of two or more panels: the largest distance
+                                   // between two of its corner copies in one layer (the welds' error)
 };
 PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x);
 
@@ -130,7 +132,7 @@ MetricSummary summarize(std::span<const double> values, const Tolerance& toleran
 
 struct PanelReport {
   MetricSummary planarity_top, planarity_bottom, corner_distance_top, corner_distance_bottom, diagonal_top,
-      diagonal_bottom, thickness, miter, conical;
+      diagonal_bottom, thickness, miter, conical, corner_gap;
   bool within_tolerance = false;  // planarity (both layers), corner distance, thickness and miter within target
 };
 PanelReport report_panels(const PanelErrors& errors, const Tolerances& tolerances);
