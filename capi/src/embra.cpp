@@ -135,6 +135,7 @@ embra::Settings to_settings(const embra_solver_def& d) {
   s.settle_speed = d.settle_speed;
   s.tethers = d.tethers;
   s.realign_passes = d.realign_passes;
+  s.chebyshev_rho_milli = d.chebyshev_rho_milli;
   s.self_collision = d.self_collision;
   return s;
 }
@@ -150,6 +151,7 @@ embra_solver_def from_settings(const embra::Settings& s) {
   d.settle_speed = s.settle_speed;
   d.tethers = s.tethers;
   d.realign_passes = s.realign_passes;
+  d.chebyshev_rho_milli = s.chebyshev_rho_milli;
   d.self_collision = s.self_collision;
   return d;
 }

@@ -739,6 +739,20 @@ void World::project_contacts(Group& g, double /*h*/) {
   }
 }
 
+void World::chebyshev_step(int iteration, double rho, double& omega) {
+  // Wang (2015), "A Chebyshev semi-iterative approach for accelerating projective and position-based
+  // dynamics": x^(k+1) <- omega_(k+1) (x^(k+1) - x^(k-1)) + x^(k-1) with omega_2 = 2 / (2 - rho^2),
+  // omega_(k+1) = 4 / (4 - rho^2 omega_k), the first two iterations left as they are. Positions of
+  // movable particles only; the multipliers keep what the projections accumulated.
+  constexpr int kStart = 2;
+  if (iteration >= kStart) {
+    omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
+    for (size_t i = 0; i < x_.size(); ++i)
+      if (w_[i] != 0.0) x_[i] = omega * (x_[i] - chebyshev_prev_[i]) + chebyshev_prev_[i];
+  }
+  chebyshev_prev_.swap(chebyshev_now_);
+}
+
 void World::update_velocities(double h) {
   // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
   // it is below mu_s times the normal push, else reduced by mu_k times it.
@@ -913,12 +927,16 @@ void World::step() {
     if (settings_.realign_passes > 0) predicted_ = x_;
     for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
       if (pass > 0) realign(predicted_);
+      const double rho = settings_.chebyshev_rho_milli / 1000.0;
+      double omega = 1.0;
       for (int it = 0; it < settings_.iterations; ++it) {
+        if (rho > 0.0) chebyshev_now_ = x_;
         project_volumes(h);  // fields.cpp
         for (int32_t slot : order_) {
           Group& g = groups_[slot];
           for (int k = 0; k < g.desc.weight; ++k) project_group(g, h);
         }
+        if (rho > 0.0) chebyshev_step(it, rho, omega);
       }
     }
     update_velocities(h);

@@ -142,6 +142,8 @@ void World::set_settings(const Settings& s) {
   if (s.iterations < 1 || s.iterations > 10000) invalid("settings.iterations must be in [1, 10000]");
   if (s.tethers < 0 || s.tethers > 64) invalid("settings.tethers must be in [0, 64]");
   if (s.realign_passes < 0 || s.realign_passes > 100) invalid("settings.realign_passes must be in [0, 100]");
+  if (s.chebyshev_rho_milli < 0 || s.chebyshev_rho_milli > 990)
+    invalid("settings.chebyshev_rho_milli must be in [0, 990]");
   if (s.self_collision != 0 && s.self_collision != 1) invalid("settings.self_collision must be 0 or 1");
   for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
   check_non_negative(s.damping, "settings.damping");

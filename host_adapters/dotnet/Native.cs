@@ -55,7 +55,7 @@ namespace Embra
         public const int CurrentVersion = 1;
         public int Version, Substeps;
         public double Dt;
-        public int Iterations, Reserved0;
+        public int Iterations, ChebyshevRhoMilli;
         public fixed double Gravity[3];
         public double Damping, SettleSpeed;
         public int Tethers, RealignPasses, SelfCollision, Reserved1;

@@ -89,6 +89,7 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_solver_def, substeps), 4);
   CHECK_INT(offsetof(embra_solver_def, dt), 8);
   CHECK_INT(offsetof(embra_solver_def, iterations), 16);
+  CHECK_INT(offsetof(embra_solver_def, chebyshev_rho_milli), 20);
   CHECK_INT(offsetof(embra_solver_def, gravity), 24);
   CHECK_INT(offsetof(embra_solver_def, damping), 48);
   CHECK_INT(offsetof(embra_solver_def, settle_speed), 56);
@@ -148,7 +149,7 @@ static void test_defaults(void) {
   CHECK_INT(s.substeps, 20);
   CHECK_NEAR(s.dt, 1.0 / 60.0, 0.0);
   CHECK_INT(s.iterations, 1);
-  CHECK_INT(s.reserved0, 0);
+  CHECK_INT(s.chebyshev_rho_milli, 0);
   CHECK_NEAR(s.gravity[0], 0.0, 0.0);
   CHECK_NEAR(s.gravity[1], 0.0, 0.0);
   CHECK_NEAR(s.gravity[2], -9.81, 0.0);

@@ -511,6 +511,11 @@ static void test_world_create(void) {
   d.iterations = 10001;
   CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "iterations");
   d = embra_default_solver_def();
+  d.chebyshev_rho_milli = -1;
+  CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "chebyshev_rho_milli");
+  d.chebyshev_rho_milli = 991;
+  CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "chebyshev_rho_milli");
+  d = embra_default_solver_def();
   d.damping = -0.1;
   CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "damping");
   d = embra_default_solver_def();
@@ -522,6 +527,7 @@ static void test_world_create(void) {
   d.iterations = 10000;
   d.damping = 0.0;
   d.settle_speed = 0.0;
+  d.chebyshev_rho_milli = 990;
   CHECK_OK(embra_world_create(&w, &d));
   embra_world_destroy(w);
 #undef CREATE_REFUSED

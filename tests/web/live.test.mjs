@@ -88,9 +88,11 @@ test('a mouse drag on a panel corner pulls it; the streamed positions and the er
     await page.waitForTimeout(30);
   }
   await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.15, [particle, start.z], { timeout: 30000 });
-  await page.mouse.up();
-  // The world itself moved (the page drew what the server streamed), and the plot kept growing.
+  // The world itself moved (the page drew what the server streamed), read while the drag still holds
+  // it: once released the corner falls back, and on a loaded machine the server may be frames ahead.
   assert.ok(live.session.positions[3 * particle + 2] > serverZ + 0.15);
+  await page.mouse.up();
+  // The plot kept growing.
   await page.waitForFunction((n) => embraView.plotPoints > n + 10, start.plot, { timeout: 20000 });
   assert.equal(await view(() => embraView.lastError), null);
 });

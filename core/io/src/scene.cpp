@@ -393,6 +393,7 @@ class Builder {
       s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
       s.tethers = value_or(j, "tethers", s.tethers);
       s.realign_passes = value_or(j, "realign_passes", s.realign_passes);
+      s.chebyshev_rho_milli = value_or(j, "chebyshev_rho_milli", s.chebyshev_rho_milli);
       s.self_collision = value_or(j, "self_collision", s.self_collision);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
@@ -883,6 +884,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                    {"settle_speed", s.settle_speed},
                    {"tethers", s.tethers},
                    {"realign_passes", s.realign_passes},
+                   {"chebyshev_rho_milli", s.chebyshev_rho_milli},
                    {"self_collision", s.self_collision}};
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.

@@ -150,8 +150,9 @@ struct Settings {
   // which drives g to zero: the settled state becomes the equilibrium to rounding. Costs one gradient
   // sweep and `iterations` more projection passes per substep.
   int32_t realign_passes = 0;
-  int32_t tethers = 2;  // automatic long-range attachments per particle (0 = none)
-  Id contact_group;     // set by the world: the group that holds collider contacts
+  int32_t chebyshev_rho_milli = 0;  // embra_solver_def.chebyshev_rho_milli: [0, 990], 0 off
+  int32_t tethers = 2;              // automatic long-range attachments per particle (0 = none)
+  Id contact_group;                 // set by the world: the group that holds collider contacts
   // 1: cloth and shells (bodies with triangles) collide with themselves and each other, point against
   // triangle and edge against edge, kept their thickness apart (self_collision.hpp); 0 (default): off.
   int32_t self_collision = 0;
@@ -462,6 +463,8 @@ class World {
   void find_self_contacts();
   void find_face_contacts();
   void project_face_contacts();
+  /// One Chebyshev acceleration step after iteration `iteration` of a substep (solver.cpp).
+  void chebyshev_step(int iteration, double rho, double& omega);
   /// Inverse of the joint mass of a panel corner and its partner across the slab (0: one is fixed).
   double slab_weight(int32_t a, int32_t b) const;
   void find_shape_contacts(int32_t collider, std::vector<Contact>& out) const;
@@ -505,6 +508,7 @@ class World {
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
+  std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
                                            // bodies changed: rebuild the solver arrays
   StepReport report_;
