@@ -15,8 +15,9 @@
  * With --large SCENE PANELS it runs one of the larger versions instead (examples/large/: 16 x 16 and
  * 32 x 32 panels over the same area, the same sphere and path) for the scene's 300 frames: settled
  * at the end with max thickness error <= 0.00005, max planarity <= 1e-6 top and bottom and max miter
- * twist <= 0.001, and within every target of the scene's tolerance document (corner off plane too), our own planarity
- * equal to the reported one, and no panel face inside the sphere at any frame (the same per-triangle check).
+ * twist <= 0.001, and within every target of the scene's tolerance document (corner off plane
+ * too); our own planarity equal to the reported one every frame; no panel face inside the sphere at
+ * any frame (the same per-triangle check); the corner gap equal to our own from positions.
  *
  * usage: test_capi_panels EXAMPLES_DIR
  *        test_capi_panels --large SCENE PANELS */
