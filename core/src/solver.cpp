@@ -97,6 +97,47 @@ EMBRA_ALWAYS_INLINE void distance_block(const int32_t* ids, const double* rest, 
   }
 }
 
+/// The operands of a block of four-particle constraints: positions, inverse masses, rest values,
+/// multipliers and alpha~ = compliance / h^2, one lane per constraint.
+template <class T>
+struct QuadOperands {
+  lanes::V3<T> p[4];
+  T wk[4];
+  T r, lam, alpha;
+  EMBRA_ALWAYS_INLINE QuadOperands(const int32_t* ids, const double* rest, const double* compliance,
+                                   const double* lambda, double inv_h2, const double* x, const double* w) {
+    for (int k = 0; k < 4; ++k) {
+      p[k] = lanes::load_point<T>(x, ids + k, 4);
+      wk[k] = lanes::load_value<T>(w, ids + k, 4);
+    }
+    r = lanes::gather<T>(rest);
+    lam = lanes::gather<T>(lambda);
+    alpha = lanes::gather<T>(compliance) * inv_h2;
+  }
+};
+
+/// Writes back a block of four-particle constraints: each lane whose constraint is valid (ok) takes
+/// its new multiplier and moves its movable particles by w_k dlambda grad_k C.
+template <class T, class M>
+EMBRA_ALWAYS_INLINE void scatter4(const int32_t* ids, M ok, T lam_new, const T wk[4], T dl, const lanes::V3<T> g[4],
+                                  double* lambda, double* x) {
+  using L = lanes::Lanes<T>;
+  T sk[4];
+  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
+  for (int l = 0; l < L::count; ++l) {
+    if (!L::on(ok, l)) continue;
+    lambda[l] = L::get(lam_new, l);
+    for (int k = 0; k < 4; ++k) {
+      if (L::get(wk[k], l) == 0.0) continue;
+      double* q = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
+      const double f = L::get(sk[k], l);
+      q[0] += f * L::get(g[k].x, l);
+      q[1] += f * L::get(g[k].y, l);
+      q[2] += f * L::get(g[k].z, l);
+    }
+  }
+}
+
 /// Dihedral angle across the edge x0-x1 of triangles (x0, x1, x2) and (x1, x0, x3) = rest: the
 /// function and gradients of eval_dihedral (constraint_math.hpp), written out flat:
 ///   grad2 = -le / |n1|^2 n1, grad3 = -le / |n2|^2 n2, grad1 = -(s1 grad2 + s2 grad3),
@@ -106,12 +147,10 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
                                         double* lambda, double inv_h2, double* x, const double* w) {
   using namespace lanes;
   using L = Lanes<T>;
-  const V3<T> p[4] = {load_point<T>(x, ids, 4), load_point<T>(x, ids + 1, 4), load_point<T>(x, ids + 2, 4),
-                      load_point<T>(x, ids + 3, 4)};
-  const T wk[4] = {load_value<T>(w, ids, 4), load_value<T>(w, ids + 1, 4), load_value<T>(w, ids + 2, 4),
-                   load_value<T>(w, ids + 3, 4)};
-  const T r = gather<T>(rest), lam = gather<T>(lambda);
-  const T alpha = gather<T>(compliance) * inv_h2;
+  const QuadOperands<T> o(ids, rest, compliance, lambda, inv_h2, x, w);
+  const V3<T>* p = o.p;
+  const T* wk = o.wk;
+  const T r = o.r, lam = o.lam, alpha = o.alpha;
   const V3<T> edge = p[1] - p[0], a2 = p[2] - p[0], a3 = p[3] - p[0];
   const V3<T> n1 = cross(edge, a2), n2 = cross(a3, edge);
   const T le2 = dot(edge, edge), n1sq = dot(n1, n1), n2sq = dot(n2, n2);
@@ -132,22 +171,8 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   const T denom = wk[0] * dot(g0, g0) + wk[1] * dot(g1, g1) + wk[2] * dot(g2, g2) + wk[3] * dot(g3, g3) + alpha;
   const auto ok = valid & (denom > 0.0);
   const T dl = (-c - alpha * lam) / denom;
-  const T lam_new = lam + dl;
   const V3<T> g[4] = {g0, g1, g2, g3};
-  T sk[4];
-  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
-  for (int l = 0; l < L::count; ++l) {
-    if (!L::on(ok, l)) continue;
-    lambda[l] = L::get(lam_new, l);
-    for (int k = 0; k < 4; ++k) {
-      if (L::get(wk[k], l) == 0.0) continue;
-      double* q = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
-      const double f = L::get(sk[k], l);
-      q[0] += f * L::get(g[k].x, l);
-      q[1] += f * L::get(g[k].y, l);
-      q[2] += f * L::get(g[k].z, l);
-    }
-  }
+  scatter4<T>(ids, ok, lam + dl, wk, dl, g, lambda, x);
 }
 
 /// Quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2, x3)) or plane
@@ -159,13 +184,10 @@ template <class T, bool kPlanarity>
 EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, const double* compliance, double* lambda,
                                       double inv_h2, double* x, const double* w) {
   using namespace lanes;
-  using L = Lanes<T>;
-  const V3<T> p[4] = {load_point<T>(x, ids, 4), load_point<T>(x, ids + 1, 4), load_point<T>(x, ids + 2, 4),
-                      load_point<T>(x, ids + 3, 4)};
-  const T wk[4] = {load_value<T>(w, ids, 4), load_value<T>(w, ids + 1, 4), load_value<T>(w, ids + 2, 4),
-                   load_value<T>(w, ids + 3, 4)};
-  const T r = gather<T>(rest), lam = gather<T>(lambda);
-  const T alpha = gather<T>(compliance) * inv_h2;
+  const QuadOperands<T> o(ids, rest, compliance, lambda, inv_h2, x, w);
+  const V3<T>* p = o.p;
+  const T* wk = o.wk;
+  const T r = o.r, lam = o.lam, alpha = o.alpha;
   const V3<T> a = kPlanarity ? p[2] - p[0] : p[2] - p[1];
   const V3<T> b = kPlanarity ? p[3] - p[1] : p[3] - p[1];
   const V3<T> s = kPlanarity ? p[1] - p[0] : p[0] - p[1];
@@ -191,21 +213,7 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   for (int k = 0; k < 4; ++k) denom = denom + wk[k] * dot(g[k], g[k]);
   const auto ok = valid & (denom > 0.0);
   const T dl = (-(value - r) - alpha * lam) / denom;
-  const T lam_new = lam + dl;
-  T sk[4];
-  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
-  for (int l = 0; l < L::count; ++l) {
-    if (!L::on(ok, l)) continue;
-    lambda[l] = L::get(lam_new, l);
-    for (int k = 0; k < 4; ++k) {
-      if (L::get(wk[k], l) == 0.0) continue;
-      double* o = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
-      const double f = L::get(sk[k], l);
-      o[0] += f * L::get(g[k].x, l);
-      o[1] += f * L::get(g[k].y, l);
-      o[2] += f * L::get(g[k].z, l);
-    }
-  }
+  scatter4<T>(ids, ok, lam + dl, wk, dl, g, lambda, x);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };

@@ -92,35 +92,51 @@ static vec sphere_centre(int frame) {
   return centre;
 }
 
-/* Over every panel of positions x: the largest planarity of a top or bottom quad, and the deepest
- * point of a panel face (top or bottom triangle) inside the sphere of `radius` at `centre`. */
-static void panel_checks(const double* x, int32_t panels, vec centre, double radius, double* planarity_max,
-                         double* inside_max) {
-  *planarity_max = 0.0;
+/* Over every panel of positions x at `frame`: the largest planarity of a top or bottom quad, which
+ * must equal the reported one (m), and the deepest point of a panel face (top or bottom triangle)
+ * inside the sphere of `radius` at `centre`, kept in *inside_max. */
+static void panel_checks(const double* x, int32_t panels, vec centre, double radius, const embra_panel_metrics* m,
+                         int frame, double* inside_max) {
+  double planarity_max = 0.0;
   for (int32_t p = 0; p < panels; ++p)
     for (int layer = 0; layer < 2; ++layer) {
       const int32_t o = 8 * p + 4 * layer;
       const vec q0 = at(x, o), q1 = at(x, o + 1), q2 = at(x, o + 2), q3 = at(x, o + 3);
       const double pl = planarity(q0, q1, q2, q3);
-      if (pl > *planarity_max) *planarity_max = pl;
+      if (pl > planarity_max) planarity_max = pl;
       const double d1 = radius - triangle_distance(centre, q0, q1, q2);
       const double d2 = radius - triangle_distance(centre, q0, q2, q3);
       if (d1 > *inside_max) *inside_max = d1;
       if (d2 > *inside_max) *inside_max = d2;
     }
+  const double reported =
+      m->planarity_top.max > m->planarity_bottom.max ? m->planarity_top.max : m->planarity_bottom.max;
+  CAPI_CONTEXT("frame %d", frame);
+  CHECK_NEAR(planarity_max, reported, 1e-15);
+}
+
+/* Loads a drape scene and finds its panel mesh (the scene's first body): NULL if it cannot. */
+static embra_world* open_drape(const char* path, int32_t expect_panels, int32_t* first, int32_t* count) {
+  embra_world* w = NULL;
+  CHECK_OK(embra_world_load_file(&w, path));
+  if (w == NULL) return NULL;
+  const embra_body_id body = {0, 1};
+  int32_t panels = 0;
+  CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
+  CHECK_INT(panels, expect_panels);
+  CHECK_OK(embra_body_get_particles(w, body, first, count));
+  CHECK_INT(*count, 8 * expect_panels);
+  return w;
 }
 
 static void test_drape(const char* dir) {
   char path[4096];
   snprintf(path, sizeof path, "%s/poq_drape.json", dir);
-  embra_world* w = NULL;
-  CHECK_OK(embra_world_load_file(&w, path));
-  if (w == NULL) return;
   const embra_body_id body = {0, 1};
-  int32_t panels = 0, first = 0, count = 0;
-  CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
-  CHECK_INT(panels, 16);
-  CHECK_OK(embra_body_get_particles(w, body, &first, &count));
+  const int32_t panels = 16;
+  int32_t first = 0, count = 0;
+  embra_world* w = open_drape(path, panels, &first, &count);
+  if (w == NULL) return;
   /* The scene's objects through the id lists: one body, its four corner pins (each on a particle
    * sitting at its target before any step) and the sphere where the scene puts it. */
   embra_body_id bodies[2];
@@ -182,11 +198,7 @@ static void test_drape(const char* dir) {
       const double off = fabs(ball_at[k] - (k == 0 ? centre.x : k == 1 ? centre.y : centre.z));
       if (off > ball_off) ball_off = off;
     }
-    double own_planarity = 0.0;
-    panel_checks(x, panels, centre, radius, &own_planarity, &worst_inside);
-    const double reported = m.planarity_top.max > m.planarity_bottom.max ? m.planarity_top.max : m.planarity_bottom.max;
-    CAPI_CONTEXT("frame %d", f);
-    CHECK_NEAR(own_planarity, reported, 1e-15);
+    panel_checks(x, panels, centre, radius, &m, f, &worst_inside);
   }
   CAPI_CONTEXT("%s", "");
   printf(
@@ -225,16 +237,11 @@ static void test_drape(const char* dir) {
   embra_world_destroy(w);
 }
 
-static void test_large(const char* path, int32_t expect_panels) {
-  embra_world* w = NULL;
-  CHECK_OK(embra_world_load_file(&w, path));
-  if (w == NULL) return;
+static void test_large(const char* path, int32_t panels) {
   const embra_body_id body = {0, 1};
-  int32_t panels = 0, first = 0, count = 0;
-  CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
-  CHECK_INT(panels, expect_panels);
-  CHECK_OK(embra_body_get_particles(w, body, &first, &count));
-  CHECK_INT(count, 8 * expect_panels);
+  int32_t first = 0, count = 0;
+  embra_world* w = open_drape(path, panels, &first, &count);
+  if (w == NULL) return;
   double* x = malloc(sizeof(double) * 3 * (size_t)count);
   if (!CHECK(x != NULL)) return;
   double worst_inside = 0.0;
@@ -256,11 +263,7 @@ static void test_large(const char* path, int32_t expect_panels) {
         m.thickness.max <= 5e-5 && m.planarity_top.max <= 1e-6 && m.planarity_bottom.max <= 1e-6 && m.miter.max <= 1e-3;
     if (within && within_from < 0) within_from = f;
     if (!within) within_from = -1;
-    double own_planarity = 0.0;
-    panel_checks(x, panels, sphere_centre(f), 1.0, &own_planarity, &worst_inside);
-    const double reported = m.planarity_top.max > m.planarity_bottom.max ? m.planarity_top.max : m.planarity_bottom.max;
-    CAPI_CONTEXT("frame %d", f);
-    CHECK_NEAR(own_planarity, reported, 1e-15);
+    panel_checks(x, panels, sphere_centre(f), 1.0, &m, f, &worst_inside);
   }
   CAPI_CONTEXT("%s", "");
   printf(
