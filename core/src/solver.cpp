@@ -750,10 +750,11 @@ void World::project_contacts(Group& g, double /*h*/) {
 void World::chebyshev_step(int iteration, double rho, double& omega) {
   // Wang (2015), "A Chebyshev semi-iterative approach for accelerating projective and position-based
   // dynamics": x^(k+1) <- omega_(k+1) (x^(k+1) - x^(k-1)) + x^(k-1) with omega_2 = 2 / (2 - rho^2),
-  // omega_(k+1) = 4 / (4 - rho^2 omega_k), the first two iterations left as they are. Positions of
-  // movable particles only; the multipliers keep what the projections accumulated.
+  // omega_(k+1) = 4 / (4 - rho^2 omega_k), the first two iterations left as they are, and the last
+  // one too, so that a plain pass (contacts last) has the final word. Positions of movable particles
+  // only; the multipliers keep what the projections accumulated.
   constexpr int kStart = 2;
-  if (iteration >= kStart) {
+  if (iteration >= kStart && iteration + 1 < settings_.iterations) {
     omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
     for (size_t i = 0; i < x_.size(); ++i)
       if (w_[i] != 0.0) x_[i] = omega * (x_[i] - chebyshev_prev_[i]) + chebyshev_prev_[i];
