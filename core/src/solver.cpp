@@ -34,8 +34,9 @@ constexpr int arity_of() {
 // One Gauss-Seidel pass of XPBD over a solver array: for each constraint C with compliance alpha,
 //   dlambda = (-C - alpha~ lambda) / (sum_k w_k |grad_k C|^2 + alpha~),   alpha~ = alpha / h^2,
 //   x_k += w_k dlambda grad_k C.
-// Distance, tether and dihedral have tight hand-written loops over the raw xyz array (the bulk of
-// every cloth); the rarer kinds go through constraint_math.hpp. Constraints are stored colour by
+// Distance, tether, dihedral, quad planarity and plane offset have tight hand-written loops over the
+// raw xyz array (the bulk of every cloth and panel mesh); the rarer kinds go through
+// constraint_math.hpp. Constraints are stored colour by
 // colour, so consecutive constraints rarely share a particle and their arithmetic overlaps.
 
 /// Whether every lane lies in (-pi, pi] already.
@@ -345,8 +346,7 @@ double deviation(double value, double rest) {
     return value - rest;
 }
 
-/// The generic pass, through constraint_math.hpp (edge angle, tet volume, quad planarity, plane
-/// offset).
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume).
 template <Kind K>
 void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
   constexpr int N = arity_of<K>();
@@ -502,7 +502,7 @@ void World::find_face_contacts() {
 
 double World::slab_weight(int32_t a, int32_t b) const {
   const double wa = w_[a], wb = w_[b];
-  return wa > 0.0 && wb > 0.0 ? wa * wb / (wa + wb) : 0.0;
+  return wa > 0.0 && wb > 0.0 ? 1.0 / (1.0 / wa + 1.0 / wb) : 0.0;  // 1 / (m_a + m_b), no overflow
 }
 
 void World::project_face_contacts() {

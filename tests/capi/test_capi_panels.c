@@ -243,7 +243,10 @@ static void test_large(const char* path, int32_t panels) {
   embra_world* w = open_drape(path, panels, &first, &count);
   if (w == NULL) return;
   double* x = malloc(sizeof(double) * 3 * (size_t)count);
-  if (!CHECK(x != NULL)) return;
+  if (!CHECK(x != NULL)) {
+    embra_world_destroy(w);
+    return;
+  }
   double worst_inside = 0.0;
   int settled_from = -1, within_from = -1;
   embra_panel_metrics m;
@@ -367,6 +370,8 @@ static void test_create(void) {
   CHECK_STATUS(embra_panel_mesh_get_corner_gap(w, not_panels, &gap), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_STATUS(embra_panel_mesh_get_corner_gap(w, body, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_STATUS(embra_panel_mesh_get_corner_gap(NULL, body, &gap), EMBRA_ERROR_INVALID_ARGUMENT);
+  const embra_body_id stale_body = {body.index, body.generation + 1};
+  CHECK_STATUS(embra_panel_mesh_get_corner_gap(w, stale_body, &gap), EMBRA_ERROR_STALE_ID);
   CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
   CHECK_NEAR(gap.max, 0.0, 0.0);        /* as built: every copy of a vertex where the grid puts it */
   CHECK_INT((int)gap.count, 3 * 4 - 4); /* a 2 x 3 grid of panels: 12 mesh vertices, 4 of one panel */

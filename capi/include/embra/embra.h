@@ -150,15 +150,13 @@ typedef struct embra_solver_def {
   double dt;                   /* s per frame (per embra_world_step), > 0; default 1/60 */
   int32_t iterations;          /* passes over the ordered groups per substep, [1, 10000]; default 1 */
   int32_t chebyshev_rho_milli; /* [0, 990], default 0 (off). Chebyshev semi-iterative acceleration of
-                             the iterations (Wang 2015): from the third iteration of a substep to
-                             the last but one, each iteration's result x is pushed on to
-                             omega (x - x_prev2) + x_prev2 (the last stays a plain pass: contacts
-                             keep the final word),
-                             omega from the estimated spectral radius rho = chebyshev_rho_milli / 1000
-                             of the Gauss-Seidel pass. For many iterations over stiff, long chains of
-                             constraints (large panel meshes): 900 reaches the accuracy of 2 to 2.5x
-                             the iterations. Too large a rho diverges (on the 16 x 16 panel drape
-                             930 holds and 950 does not); no effect with 1 to 3 iterations. */
+                             the iterations (Wang 2015): from the third iteration of each pass
+                             (1 + realign_passes per substep) to the last but one, each iteration's result x is pushed
+                             on to omega (x - x_prev2) + x_prev2 (the last stays a plain pass: contacts keep the final
+                             word), omega from the estimated spectral radius rho = chebyshev_rho_milli / 1000 of the
+                             Gauss-Seidel pass. For many iterations over stiff, long chains of constraints (large panel
+                             meshes): 900 reaches the accuracy of 2 to 2.5x the iterations. Too large a rho diverges (on
+                             the 16 x 16 panel drape 930 holds and 950 does not); no effect with 1 to 3 iterations. */
   double gravity[3];           /* m/s^2; default {0, 0, -9.81} (z up). Any direction: negate to hang */
   double damping;              /* 1/s, velocity decay rate applied to every particle; >= 0; default 0 */
   double settle_speed;         /* m/s: a frame is "settled" when no particle moves faster; default 1e-3 */
@@ -551,7 +549,8 @@ EMBRA_API embra_status embra_body_get_triangles(const embra_world* world, embra_
  * squares; exact for a conical mesh). The triangles of both layers (bottom ones facing down) take
  * face contacts against sphere colliders, so a rigid panel never passes into a sphere between its
  * corners; a contact pushes the panel as a slab (each corner of the touching face together with the
- * corner across the thickness from it), so the push does not fight the plane offsets.
+ * corner across the thickness from it, as one particle of their joint mass), so the push does not
+ * fight the plane offsets; a corner whose partner is hard-pinned is not pushed.
  *
  * Metrics (section 4.1, computed from positions alone): planarity 1 - n1.n2 of the unit normals of
  * a quad's two triangles (the larger over both diagonals; dimensionless, quadratic in the fold),
