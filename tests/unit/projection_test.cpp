@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numbers>
 
 namespace embra {
@@ -157,6 +158,50 @@ TEST(Projection, OneProjectionReducesTheResidualOfEveryKind) {
       RecordProperty(std::string(kind_name(kind)) + (compliance == 0.0 ? "_hard" : "_soft") + "_worst_ratio",
                      test::sci(worst_ratio));
     }
+  }
+}
+
+// The solver's hand-written kernels (distance, dihedral, quad planarity, plane offset: lanes of
+// core/src/solver.cpp) against the textbook projection written here from constraint_math.hpp's
+// value and gradient: one hard projection moves particle k by w_k dlambda grad_k C with
+// dlambda = -(C - rest) / sum_j w_j |grad_j C|^2. (scenes.kernels_same_bits shows the SSE2 and AVX2
+// lanes give the scalar kernel's bits.)
+TEST(Projection, KernelsMoveEachParticleAlongTheTextbookGradientStep) {
+  for (Kind kind : {Kind::distance, Kind::dihedral, Kind::planarity, Kind::plane_offset}) {
+    Rng rng(300 + static_cast<int>(kind));
+    double worst = 0.0;
+    for (int c = 0; c < kCases; ++c) {
+      const std::vector<Vec3> ref = random_config(kind, rng);
+      std::vector<Vec3> start = ref;
+      for (Vec3& p : start) p += rng.vec(-0.03, 0.03);
+      const std::vector<double> masses = random_masses(operands(kind), rng);
+      Single s{World(test::settings(1, 1)), {}, 0.0};
+      build(s, kind, start, masses, rest_of(kind, ref), 0.0);
+      const int n = operands(kind);
+      double value = 0.0;
+      std::vector<Vec3> grad(n);
+      auto take = [&](const auto& e) {
+        value = e.value;
+        for (int k = 0; k < n; ++k) grad[k] = e.grad[k];
+      };
+      if (kind == Kind::distance) take(eval_distance(start[0], start[1]));
+      if (kind == Kind::dihedral) take(eval_dihedral(start[0], start[1], start[2], start[3]));
+      if (kind == Kind::planarity) take(eval_quad_planarity(start[0], start[1], start[2], start[3]));
+      if (kind == Kind::plane_offset) take(eval_plane_offset(start[0], start[1], start[2], start[3]));
+      double c_dev = value - s.rest, denom = 0.0;
+      if (kind == Kind::dihedral) c_dev = std::remainder(c_dev, 2.0 * std::numbers::pi);
+      for (int k = 0; k < n; ++k) denom += (masses[k] > 0.0 ? 1.0 / masses[k] : 0.0) * grad[k].squaredNorm();
+      const double dl = -c_dev / denom;
+      s.world.step();
+      for (int k = 0; k < n; ++k) {
+        const double w = masses[k] > 0.0 ? 1.0 / masses[k] : 0.0;
+        const Vec3 want = start[k] + (w * dl) * grad[k];
+        const double off = (s.world.positions()[s.ids[k]] - want).norm();
+        worst = std::max(worst, off);
+        EXPECT_LT(off, 1e-13) << kind_name(kind) << " case " << c << " particle " << k;
+      }
+    }
+    RecordProperty(std::string(kind_name(kind)) + "_largest_difference", test::sci(worst));
   }
 }
 
