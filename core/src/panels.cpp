@@ -38,6 +38,15 @@ double plane_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
   return std::abs((p - a).dot(unit_normal(a, b, c)));
 }
 
+/// The corners on each mesh vertex, (panel, corner k) in panel order, from quads of 4 indices.
+std::vector<std::vector<std::pair<int32_t, int32_t>>> corners_around(std::span<const int32_t> quads,
+                                                                     int64_t vertex_count) {
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> around(static_cast<size_t>(vertex_count));
+  for (size_t q = 0; q < quads.size() / 4; ++q)
+    for (int k = 0; k < 4; ++k) around[static_cast<size_t>(quads[4 * q + k])].emplace_back(static_cast<int32_t>(q), k);
+  return around;
+}
+
 /// Undirected edge key.
 std::pair<int32_t, int32_t> edge_key(int32_t a, int32_t b) {
   return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
@@ -101,9 +110,7 @@ std::vector<PanelJoint> panel_joints(const PanelLayout& layout) {
 }
 
 std::vector<ConicalVertex> conical_vertices(const PanelLayout& layout) {
-  std::vector<std::vector<std::pair<int32_t, int32_t>>> around(layout.vertex_count);
-  for (int32_t p = 0; p < layout.panel_count(); ++p)
-    for (int k = 0; k < 4; ++k) around[layout.quads[4 * p + k]].emplace_back(p, k);
+  const auto around = corners_around(layout.quads, layout.vertex_count);
   std::map<std::pair<int32_t, int32_t>, int> edge_uses;
   for (int32_t p = 0; p < layout.panel_count(); ++p)
     for (int k = 0; k < 4; ++k) ++edge_uses[edge_key(layout.quads[4 * p + k], layout.quads[4 * p + (k + 1) % 4])];
@@ -173,11 +180,7 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
     }
     e.conical.push_back(std::abs((a[0] + a[2]) - (a[1] + a[3])));
   }
-  // Corner copies per mesh vertex, in panel order.
-  std::vector<std::vector<std::pair<int32_t, int>>> around(static_cast<size_t>(layout.vertex_count));
-  for (int32_t p = 0; p < n; ++p)
-    for (int k = 0; k < 4; ++k) around[static_cast<size_t>(layout.quads[4 * p + k])].emplace_back(p, k);
-  for (const auto& copies : around) {
+  for (const auto& copies : corners_around(layout.quads, layout.vertex_count)) {
     if (copies.size() < 2) continue;
     double gap = 0.0;
     for (size_t i = 0; i < copies.size(); ++i)
@@ -443,7 +446,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   }
 
   // --- bottom layer: each vertex offset to where its faces' offset planes meet ---
-  std::vector<std::vector<std::pair<int32_t, int32_t>>> around(nv);
+  const auto around = corners_around(d.quads, nv);
   std::vector<Vec3> face_normal(np);
   std::vector<double> area(np);
   for (int64_t q = 0; q < np; ++q) {
@@ -451,7 +454,6 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     const Vec3 n = (P(v[2]) - P(v[0])).cross(P(v[3]) - P(v[1]));
     area[q] = 0.5 * n.norm();
     face_normal[q] = n.normalized();
-    for (int k = 0; k < 4; ++k) around[v[k]].emplace_back(static_cast<int32_t>(q), k);
   }
   std::vector<Vec3> offset(nv, Vec3::Zero());  // bottom - top per mesh vertex
   for (int64_t v = 0; v < nv; ++v) {

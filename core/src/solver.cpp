@@ -495,7 +495,7 @@ void World::find_face_contacts() {
             const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
             if ((q - col.position).norm() - r < moved + move)
               face_contacts_.push_back(FaceContact{
-                  {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), r, 0.0});
+                  {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), 0.0});
           }
   }
 }
@@ -517,7 +517,7 @@ void World::project_face_contacts() {
     const double len = d.norm();
     if (!(len > 1e-12)) continue;
     const Vec3 n = d / len;
-    const double gap = len - fc.clearance;
+    const double gap = len - (col.desc.radius + col.desc.thickness);
     double ws[3], denom = 0.0;
     for (int k = 0; k < 3; ++k) {
       ws[k] = slab_weight(fc.ids[k], fc.partner[k]);
@@ -880,7 +880,7 @@ void World::measure() {
         const Collider& col = colliders_[fc.collider];
         const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
         const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
-        const double r = std::max(fc.clearance - (q - col.position).norm(), 0.0);
+        const double r = std::max(col.desc.radius + col.desc.thickness - (q - col.position).norm(), 0.0);
         max = std::max(max, r);
         sq += r * r;
         ++n;
@@ -936,7 +936,8 @@ void World::step() {
     if (settings_.realign_passes > 0) predicted_ = x_;
     for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
       if (pass > 0) realign(predicted_);
-      const double rho = settings_.chebyshev_rho_milli / 1000.0;
+      // Chebyshev acceleration acts on iterations 2 .. iterations - 2 (chebyshev_step): none below 4.
+      const double rho = settings_.iterations > 3 ? settings_.chebyshev_rho_milli / 1000.0 : 0.0;
       double omega = 1.0;
       for (int it = 0; it < settings_.iterations; ++it) {
         if (rho > 0.0) chebyshev_now_ = x_;

@@ -272,7 +272,7 @@ struct Contact {
 
 /// A face contact (panel meshes against sphere colliders): the point of triangle `ids` (of either
 /// layer) closest to the sphere's centre, sum_k b_k x_k with barycentric weights b found again at
-/// every projection, kept `clearance` (the sphere's radius plus its thickness) from the centre.
+/// every projection, kept the sphere's radius plus its thickness from the centre.
 /// The push moves each corner together with its partner in the other layer (`partner`, the corner
 /// straight across the panel), as one particle of their joint mass: a panel is pushed as a slab
 /// instead of its touching face being pushed against the plane offsets that hold it to the other
@@ -281,7 +281,6 @@ struct FaceContact {
   int32_t ids[3];
   int32_t partner[3];
   int32_t collider;
-  double clearance;
   double lambda;
 };
 
