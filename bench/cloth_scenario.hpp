@@ -125,6 +125,8 @@ inline ClothScene build_cloth(World& world, const ClothCase& c) {
 
 struct Strain {
   double max = 0.0;       // max over all edges of |len / rest - 1|
+  double stretch = 0.0;   // max over all edges of len / rest - 1 (0 if none is longer than its rest)
+  double squeeze = 0.0;   // max over all edges of 1 - len / rest (0 if none is shorter)
   double near_pin = 0.0;  // the same over the edges near the pins
   double rms = 0.0;       // root mean square over all edges
 };
@@ -135,13 +137,16 @@ inline Strain measure_strain(const World& world, const ClothScene& s) {
   const auto& x = world.positions();
   double sq = 0.0;
   for (size_t e = 0; e < s.rest.size(); ++e) {
-    const double strain = std::abs((x[s.edges[2 * e]] - x[s.edges[2 * e + 1]]).norm() / s.rest[e] - 1.0);
+    const double signed_strain = (x[s.edges[2 * e]] - x[s.edges[2 * e + 1]]).norm() / s.rest[e] - 1.0;
+    const double strain = std::abs(signed_strain);
     r.max = std::max(r.max, strain);
+    r.stretch = std::max(r.stretch, signed_strain);
+    r.squeeze = std::max(r.squeeze, -signed_strain);
     if (s.near[e]) r.near_pin = std::max(r.near_pin, strain);
     sq += strain * strain;
   }
   r.rms = std::sqrt(sq / static_cast<double>(s.rest.size()));
-  if (!std::isfinite(sq)) r.max = r.near_pin = r.rms = std::numeric_limits<double>::infinity();
+  if (!std::isfinite(sq)) r.max = r.stretch = r.squeeze = r.near_pin = r.rms = std::numeric_limits<double>::infinity();
   return r;
 }
 

@@ -137,6 +137,7 @@ embra::Settings to_settings(const embra_solver_def& d) {
   s.realign_passes = d.realign_passes;
   s.chebyshev_rho_milli = d.chebyshev_rho_milli;
   s.self_collision = d.self_collision;
+  s.chain_solve = d.chain_solve;
   return s;
 }
 
@@ -153,6 +154,7 @@ embra_solver_def from_settings(const embra::Settings& s) {
   d.realign_passes = s.realign_passes;
   d.chebyshev_rho_milli = s.chebyshev_rho_milli;
   d.self_collision = s.self_collision;
+  d.chain_solve = s.chain_solve;
   return d;
 }
 

@@ -145,11 +145,12 @@ void World::set_settings(const Settings& s) {
   if (s.chebyshev_rho_milli < 0 || s.chebyshev_rho_milli > 990)
     invalid("settings.chebyshev_rho_milli must be in [0, 990]");
   if (s.self_collision != 0 && s.self_collision != 1) invalid("settings.self_collision must be 0 or 1");
+  if (s.chain_solve != 0 && s.chain_solve != 1) invalid("settings.chain_solve must be 0 or 1");
   for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
   check_non_negative(s.damping, "settings.damping");
   check_non_negative(s.settle_speed, "settings.settle_speed");
   const Id contacts = settings_.contact_group;
-  if (s.tethers != settings_.tethers) solver_dirty_ = true;
+  if (s.tethers != settings_.tethers || s.chain_solve != settings_.chain_solve) solver_dirty_ = true;
   settings_ = s;
   settings_.contact_group = contacts;
 }
@@ -997,9 +998,74 @@ std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<c
   return out;
 }
 
+/// Lays a distance array's constraints end to end into chains (SolverArray::chain_start): from each
+/// constraint not yet in a chain, in array order, the chain grows at both ends by the constraint
+/// that continues it straightest (over `rest`, the particles' rest positions), within about 26
+/// degrees, that joins no particle the chain already has. On a regular grid the chains are its
+/// rows, columns and diagonals; elsewhere they are whatever straight runs the mesh has, down to
+/// single constraints, which the chain pass projects exactly as the plain pass does.
+void build_chains(SolverArray& a, const std::vector<Vec3>& rest) {
+  constexpr double kStraight = 0.9;  // cosine: the turn a chain may take at a particle
+  const size_t n = a.size();
+  std::vector<int32_t> start(rest.size() + 1, 0), incident(2 * n);
+  for (int32_t p : a.ids) ++start[p + 1];
+  for (size_t p = 0; p < rest.size(); ++p) start[p + 1] += start[p];
+  std::vector<int32_t> fill(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 2; ++k) incident[fill[a.ids[2 * i + k]]++] = static_cast<int32_t>(i);
+  std::vector<uint8_t> used(n, 0), in_chain(rest.size(), 0);
+  auto other = [&](int32_t e, int32_t p) { return a.ids[2 * e] == p ? a.ids[2 * e + 1] : a.ids[2 * e]; };
+  // Grows the chain from `at` (reached from `from`), appending its constraints and particles.
+  auto grow = [&](int32_t from, int32_t at, std::vector<int32_t>& edges, std::vector<int32_t>& parts) {
+    for (;;) {
+      const Vec3 dir = (rest[at] - rest[from]).normalized();
+      int32_t best = -1;
+      double best_cos = kStraight;
+      for (int32_t j = start[at]; j < start[at + 1]; ++j) {
+        const int32_t e = incident[j], q = other(e, at);
+        if (used[e] || in_chain[q]) continue;
+        const double c = (rest[q] - rest[at]).normalized().dot(dir);
+        if (c > best_cos) best_cos = c, best = e;
+      }
+      if (best < 0) return;
+      used[best] = 1;
+      from = at;
+      at = other(best, at);
+      in_chain[at] = 1;
+      edges.push_back(best);
+      parts.push_back(at);
+    }
+  };
+  a.chain_start.assign(1, 0);
+  a.chain_edge.clear();
+  a.chain_part.clear();
+  std::vector<int32_t> fe, fp, be, bp;
+  for (size_t i = 0; i < n; ++i) {
+    if (used[i]) continue;
+    used[i] = 1;
+    const int32_t p0 = a.ids[2 * i], p1 = a.ids[2 * i + 1];
+    fe.clear(), fp.clear(), be.clear(), bp.clear();
+    in_chain[p0] = in_chain[p1] = 1;
+    grow(p0, p1, fe, fp);
+    grow(p1, p0, be, bp);
+    a.chain_part.insert(a.chain_part.end(), bp.rbegin(), bp.rend());
+    a.chain_part.insert(a.chain_part.end(), {p0, p1});
+    a.chain_part.insert(a.chain_part.end(), fp.begin(), fp.end());
+    a.chain_edge.insert(a.chain_edge.end(), be.rbegin(), be.rend());
+    a.chain_edge.push_back(static_cast<int32_t>(i));
+    a.chain_edge.insert(a.chain_edge.end(), fe.begin(), fe.end());
+    a.chain_start.push_back(static_cast<int32_t>(a.chain_edge.size()));
+    in_chain[p0] = in_chain[p1] = 0;
+    for (int32_t q : fp) in_chain[q] = 0;
+    for (int32_t q : bp) in_chain[q] = 0;
+  }
+}
+
 void World::rebuild_solver() {
   std::vector<uint8_t> none(x_.size(), 0);
   std::vector<int32_t> order;
+  std::vector<Vec3> rest;
+  size_t longest = 0;
   for (Group& g : groups_) {
     if (!g.alive) continue;
     for (int k = 0; k < kKindCount; ++k) {
@@ -1017,6 +1083,16 @@ void World::rebuild_solver() {
         sa.rest.push_back(a.rest_now[i]);
       }
       sa.lambda.assign(per * a.size(), 0.0);
+      if (k == static_cast<int>(Kind::distance) && settings_.chain_solve && sa.size() > 0) {
+        if (rest.empty()) {  // every particle's rest position: its body's rest shape
+          rest.resize(x_.size());
+          for (const BodyInfo& b : bodies_)
+            std::copy(b.rest_positions.begin(), b.rest_positions.end(), rest.begin() + b.first_particle);
+        }
+        build_chains(sa, rest);
+        for (size_t c = 0; c + 1 < sa.chain_start.size(); ++c)
+          longest = std::max<size_t>(longest, static_cast<size_t>(sa.chain_start[c + 1] - sa.chain_start[c]));
+      }
     }
     g.tethers = SolverArray{};
   }
@@ -1065,6 +1141,7 @@ void World::rebuild_solver() {
       t.lambda.assign(t.size(), 0.0);
     }
   }
+  chain_scratch_.assign(10 * longest + 3, 0.0);
   solver_dirty_ = false;
   refresh_rest();
 }

@@ -58,7 +58,7 @@ namespace Embra
         public int Iterations, ChebyshevRhoMilli;
         public fixed double Gravity[3];
         public double Damping, SettleSpeed;
-        public int Tethers, RealignPasses, SelfCollision, Reserved1;
+        public int Tethers, RealignPasses, SelfCollision, ChainSolve;
     }
 
     [StructLayout(LayoutKind.Sequential)]

@@ -95,6 +95,7 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_solver_def, settle_speed), 56);
   CHECK_INT(offsetof(embra_solver_def, tethers), 64);
   CHECK_INT(offsetof(embra_solver_def, self_collision), 72);
+  CHECK_INT(offsetof(embra_solver_def, chain_solve), 76);
 
   CHECK_INT(sizeof(embra_world_counts), 6 * 4 + 8);
   CHECK_INT(offsetof(embra_world_counts, constraints), 24);

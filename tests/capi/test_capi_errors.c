@@ -516,6 +516,11 @@ static void test_world_create(void) {
   d.chebyshev_rho_milli = 991;
   CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "chebyshev_rho_milli");
   d = embra_default_solver_def();
+  d.chain_solve = 2;
+  CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "chain_solve");
+  d.chain_solve = -1;
+  CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "chain_solve");
+  d = embra_default_solver_def();
   d.damping = -0.1;
   CREATE_REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "damping");
   d = embra_default_solver_def();

@@ -246,6 +246,7 @@ static embra_world* build_api_world(void) {
   sd.settle_speed = 2e-3;
   sd.tethers = 1;
   sd.realign_passes = 2;
+  sd.chain_solve = 0;
   if (!CHECK(embra_world_create(&w, &sd) == EMBRA_OK)) return NULL;
   CHECK_OK(embra_world_default_group(w, &g_default));
   CHECK_OK(embra_world_contact_group(w, &g_contact));

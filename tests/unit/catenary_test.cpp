@@ -114,10 +114,12 @@ struct Settled {
 
 /// Hangs the chain from the continuous catenary (sampled at equal arc length, an independent start
 /// about 1e-3 off the discrete answer) and steps `frames` frames of 1/60 s with damping 20/s.
-Settled settle(int n, int substeps, int iterations, int frames, int realign_passes = 0, int chebyshev_rho_milli = 0) {
+Settled settle(int n, int substeps, int iterations, int frames, int realign_passes = 0, int chebyshev_rho_milli = 0,
+               int chain_solve = 1) {
   Settings settings = test::settings(substeps, iterations, Vec3(0, 0, -kG), 20.0);
   settings.realign_passes = realign_passes;
   settings.chebyshev_rho_milli = chebyshev_rho_milli;
+  settings.chain_solve = chain_solve;
   World w(settings);
   const double a = catenary_parameter();
   std::vector<Vec3> start;
@@ -275,9 +277,11 @@ TEST(Catenary, TwentyLinksSettleDirectlyWithRealignment) {
 TEST(Catenary, ChebyshevAccelerationConvergesFurtherWithTheSameIterations) {
   const int n = 64;
   const DiscreteCatenary exact = exact_discrete(n);
-  const Settled plain = settle(n, 2, 40, 600);
-  const Settled fast = settle(n, 2, 40, 600, 0, 900);
-  const Settled longer = settle(n, 2, 80, 600);
+  // Gauss-Seidel passes, one constraint at a time (Settings::chain_solve = 0): the chain solve
+  // below satisfies a chain's links far better per pass, and Chebyshev's estimate is for Gauss-Seidel.
+  const Settled plain = settle(n, 2, 40, 600, 0, 0, 0);
+  const Settled fast = settle(n, 2, 40, 600, 0, 900, 0);
+  const Settled longer = settle(n, 2, 80, 600, 0, 0, 0);
   const double plain_error = max_error(plain.x, exact.nodes), fast_error = max_error(fast.x, exact.nodes);
   const double longer_error = max_error(longer.x, exact.nodes);
   std::printf(
@@ -289,6 +293,36 @@ TEST(Catenary, ChebyshevAccelerationConvergesFurtherWithTheSameIterations) {
   EXPECT_LT(fast.residual, 0.5 * plain.residual);
   EXPECT_LT(fast_error, longer_error);  // 40 accelerated iterations beat 80 plain ones
   EXPECT_LT(fast.max_speed, 1e-3);      // and it comes to rest
+}
+
+// Chain solve (Settings::chain_solve, the default): the 64 links, end to end and nearly straight
+// from one link to the next, form one chain, projected in the first iteration of every substep as
+// one linearised system, a Newton step for the whole chain. At embra's default schedule (20 substeps
+// of one iteration) the chain comes to rest with its links long only by what one Newton step leaves
+// of each substep's gravity sag g h^2 (quadratic: (g h^2)^2 / link, about 2.5e-9 m) and on the exact
+// discrete catenary up to XPBD's O(h^2 g) offset, where one Gauss-Seidel sweep per substep leaves
+// the links 1e5 times longer and the shape 2,000 times further off.
+TEST(Catenary, ChainSolveSettlesOnTheCatenaryWhereASweepPerSubstepDoesNot) {
+  const int n = 64;
+  const DiscreteCatenary exact = exact_discrete(n);
+  const Settled chain = settle(n, 20, 1, 600);
+  const Settled swept = settle(n, 20, 1, 600, 0, 0, 0);
+  const double chain_error = max_error(chain.x, exact.nodes), swept_error = max_error(swept.x, exact.nodes);
+  const double h = 1.0 / 60 / 20;
+  std::printf(
+      "64 links, 20 substeps x 1 iteration: distance from the exact discrete catenary %.3e (chain solve), %.3e "
+      "(Gauss-Seidel); link residual %.3e, %.3e; max speed %.1e, %.1e m/s; g h^2 = %.1e m\n",
+      chain_error, swept_error, chain.residual, swept.residual, chain.max_speed, swept.max_speed, kG * h * h);
+  RecordProperty("error_chain", test::sci(chain_error));
+  RecordProperty("error_gauss_seidel", test::sci(swept_error));
+  RecordProperty("residual_chain", test::sci(chain.residual));
+  RecordProperty("residual_gauss_seidel", test::sci(swept.residual));
+  const double sag = kG * h * h, link = kLength / n;
+  EXPECT_LT(chain.residual, 4.0 * sag * sag / link);
+  EXPECT_GT(swept.residual, 1e-5);
+  EXPECT_LT(chain_error, 10.0 * kG * h * h);  // XPBD's offset without realignment, O(h^2 g)
+  EXPECT_LT(chain_error, swept_error / 10.0);
+  EXPECT_LT(chain.max_speed, 1e-6);
 }
 
 }  // namespace

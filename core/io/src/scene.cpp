@@ -395,6 +395,7 @@ class Builder {
       s.realign_passes = value_or(j, "realign_passes", s.realign_passes);
       s.chebyshev_rho_milli = value_or(j, "chebyshev_rho_milli", s.chebyshev_rho_milli);
       s.self_collision = value_or(j, "self_collision", s.self_collision);
+      s.chain_solve = value_or(j, "chain_solve", s.chain_solve);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
     World& w = *world;
@@ -885,7 +886,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                    {"tethers", s.tethers},
                    {"realign_passes", s.realign_passes},
                    {"chebyshev_rho_milli", s.chebyshev_rho_milli},
-                   {"self_collision", s.self_collision}};
+                   {"self_collision", s.self_collision},
+                   {"chain_solve", s.chain_solve}};
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.
   std::vector<uint32_t> slots;

@@ -105,7 +105,7 @@ const FieldIdType = idStruct('embra_field_id');
 const SolverDef = koffi.struct('embra_solver_def', {
   version: 'int32_t', substeps: 'int32_t', dt: 'double', iterations: 'int32_t', chebyshev_rho_milli: 'int32_t',
   gravity: d3, damping: 'double', settle_speed: 'double', tethers: 'int32_t', realign_passes: 'int32_t',
-  self_collision: 'int32_t', reserved1: 'int32_t',
+  self_collision: 'int32_t', chain_solve: 'int32_t',
 });
 
 const WorldCounts = koffi.struct('embra_world_counts', {

@@ -196,7 +196,7 @@ class World {
 
   /**
    * A world from embra_default_solver_def() and `settings`: any embra_solver_def field (dt, substeps,
-   * iterations, chebyshev_rho_milli, gravity, damping, settle_speed, tethers, realign_passes, self_collision).
+   * iterations, chebyshev_rho_milli, gravity, damping, settle_speed, tethers, realign_passes, self_collision, chain_solve).
    */
   constructor(settings, ptr) {
     if (settings === ADOPT) {

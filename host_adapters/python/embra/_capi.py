@@ -120,7 +120,7 @@ class SolverDef(ctypes.Structure):
     _fields_ = [("version", c_int32), ("substeps", c_int32), ("dt", c_double), ("iterations", c_int32),
                 ("chebyshev_rho_milli", c_int32), ("gravity", _d3), ("damping", c_double), ("settle_speed", c_double),
                 ("tethers", c_int32), ("realign_passes", c_int32), ("self_collision", c_int32),
-                ("reserved1", c_int32)]
+                ("chain_solve", c_int32)]
 
 
 class WorldCounts(ctypes.Structure):

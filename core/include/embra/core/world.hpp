@@ -152,7 +152,13 @@ struct Settings {
   int32_t realign_passes = 0;
   int32_t chebyshev_rho_milli = 0;  // embra_solver_def.chebyshev_rho_milli: [0, 990], 0 off
   int32_t tethers = 2;              // automatic long-range attachments per particle (0 = none)
-  Id contact_group;                 // set by the world: the group that holds collider contacts
+  // 1 (default): distance constraints laid end to end in straight runs over the bodies' rest shapes
+  // (a cloth grid's rows, columns and diagonals) are projected a run at a time in the first iteration
+  // of each substep (not with realignment passes), each run as one linearised XPBD system solved
+  // exactly (tridiagonal), so a correction travels the whole run in one pass; 0: one constraint at a
+  // time (embra_solver_def.chain_solve, which says why only the first iteration).
+  int32_t chain_solve = 1;
+  Id contact_group;  // set by the world: the group that holds collider contacts
   // 1: cloth and shells (bodies with triangles) collide with themselves and each other, point against
   // triangle and edge against edge, kept their thickness apart (self_collision.hpp); 0 (default): off.
   int32_t self_collision = 0;
@@ -232,6 +238,11 @@ struct SolverArray {
   std::vector<int32_t> body;          // automatic tethers: the body whose rest scale applies
   std::vector<int32_t> colour_start;  // colour c is [colour_start[c], colour_start[c + 1])
   bool shared_tail = false;           // the last colour's constraints may share particles (project in order)
+  // Distance arrays under Settings::chain_solve: the constraints as chains, straight runs end to end.
+  // Chain c is the constraints chain_edge[chain_start[c] .. chain_start[c + 1]) in order, joining the
+  // particles chain_part[chain_start[c] + c .. chain_start[c + 1] + c] (one more than constraints);
+  // no particle appears twice in a chain. Every constraint is in exactly one chain.
+  std::vector<int32_t> chain_start, chain_edge, chain_part;
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
 };
@@ -466,7 +477,11 @@ class World {
   void chebyshev_step(int iteration, double rho, double& omega);
   /// Inverse of the joint mass of a panel corner and its partner across the slab (0: one is fixed).
   double slab_weight(int32_t a, int32_t b) const;
-  void find_shape_contacts(int32_t collider, std::vector<Contact>& out) const;
+  // Contacts of one collider with every movable particle, or with those listed in `only`.
+  void find_collider_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
+  void find_shape_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
+  void catch_late_contacts();
+  void project_contact(Contact& ct);
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
   void project_group(Group& g, double h);
@@ -507,6 +522,9 @@ class World {
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
+  int iteration_ = 0;
+  std::vector<Vec3> detected_;         // positions when this substep's contacts were found
+  std::vector<double> chain_scratch_;  // Settings::chain_solve: 10 per constraint of the longest chain, + 3
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
                                            // bodies changed: rebuild the solver arrays
