@@ -1059,6 +1059,43 @@ void build_chains(SolverArray& a, const std::vector<Vec3>& rest) {
     for (int32_t q : fp) in_chain[q] = 0;
     for (int32_t q : bp) in_chain[q] = 0;
   }
+  // Colour the chains (greedy, in order: the lowest colour none of its particles has yet), then order
+  // them by colour and, within one, longest first, so that neighbours have similar lengths.
+  constexpr int kMaxColours = 64;
+  const size_t chains = a.chain_start.size() - 1;
+  std::vector<uint64_t> taken(rest.size(), 0);
+  std::vector<int32_t> colour(chains);
+  for (size_t c = 0; c < chains; ++c) {
+    const int32_t* parts = &a.chain_part[a.chain_start[c] + c];
+    const int32_t count = a.chain_start[c + 1] - a.chain_start[c] + 1;
+    uint64_t used_colours = 0;
+    for (int32_t j = 0; j < count; ++j) used_colours |= taken[parts[j]];
+    colour[c] = std::countr_one(used_colours);  // 64 when all are taken: the shared tail
+    if (colour[c] < kMaxColours)
+      for (int32_t j = 0; j < count; ++j) taken[parts[j]] |= uint64_t{1} << colour[c];
+  }
+  std::vector<int32_t> order(chains);
+  for (size_t c = 0; c < chains; ++c) order[c] = static_cast<int32_t>(c);
+  auto length = [&](int32_t c) { return a.chain_start[c + 1] - a.chain_start[c]; };
+  std::stable_sort(order.begin(), order.end(), [&](int32_t l, int32_t r) {
+    return colour[l] != colour[r] ? colour[l] < colour[r] : length(l) > length(r);
+  });
+  std::vector<int32_t> sorted_start{0}, edge, part;
+  edge.reserve(a.chain_edge.size());
+  part.reserve(a.chain_part.size());
+  a.chain_colour_start.assign(1, 0);
+  for (size_t j = 0; j < chains; ++j) {
+    const int32_t c = order[j], first = a.chain_start[c], m = length(c);
+    edge.insert(edge.end(), a.chain_edge.begin() + first, a.chain_edge.begin() + first + m);
+    part.insert(part.end(), a.chain_part.begin() + first + c, a.chain_part.begin() + first + c + m + 1);
+    sorted_start.push_back(static_cast<int32_t>(edge.size()));
+    if (j + 1 == chains || colour[order[j + 1]] != colour[c])
+      a.chain_colour_start.push_back(static_cast<int32_t>(j + 1));
+  }
+  a.chain_shared_tail = colour[order.back()] == kMaxColours;
+  a.chain_start = std::move(sorted_start);
+  a.chain_edge = std::move(edge);
+  a.chain_part = std::move(part);
 }
 
 void World::rebuild_solver() {
@@ -1141,7 +1178,8 @@ void World::rebuild_solver() {
       t.lambda.assign(t.size(), 0.0);
     }
   }
-  chain_scratch_.assign(10 * longest + 3, 0.0);
+  chain_scratch_.assign(40 * (longest + 2), 0.0);
+  chain_index_scratch_.assign(12 * (longest + 1), 0);
   solver_dirty_ = false;
   refresh_rest();
 }

@@ -243,6 +243,11 @@ struct SolverArray {
   // particles chain_part[chain_start[c] + c .. chain_start[c + 1] + c] (one more than constraints);
   // no particle appears twice in a chain. Every constraint is in exactly one chain.
   std::vector<int32_t> chain_start, chain_edge, chain_part;
+  // The chains by colour: colour c is chains [chain_colour_start[c], chain_colour_start[c + 1]), which
+  // share no particle (so they can be solved side by side), longest first; the last colour may share
+  // particles when chain_shared_tail (solved one chain after another).
+  std::vector<int32_t> chain_colour_start;
+  bool chain_shared_tail = false;
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
 };
@@ -523,8 +528,9 @@ class World {
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
   int iteration_ = 0;
-  std::vector<Vec3> detected_;         // positions when this substep's contacts were found
-  std::vector<double> chain_scratch_;  // Settings::chain_solve: 10 per constraint of the longest chain, + 3
+  std::vector<Vec3> detected_;                // positions when this substep's contacts were found
+  std::vector<double> chain_scratch_;         // Settings::chain_solve: 40 per constraint of the longest chain, + 80
+  std::vector<int32_t> chain_index_scratch_;  // and 12 per constraint, + 12
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
                                            // bodies changed: rebuild the solver arrays
