@@ -673,13 +673,20 @@ void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* on
   }
 }
 
+namespace {
+double contact_gap(const Collider& c, const Contact& ct, const Vec3& x, const Vec3& from, double r, Vec3& normal);
+}  // namespace
+
 void World::catch_late_contacts() {
   // find_contacts looked along each particle's predicted path, with its clearance as a margin; a
   // projection that carried a particle further (a chain solve pulling a whole run at once, a band
   // shrinking onto a pole) can have taken it into a collider no contact watched. Such particles are
   // looked at again along their path as it now ends, and any contact found is projected once more:
   // colliders keep the final word.
-  if (colliders_.empty()) return;
+  // Only when the contacts are projected last: a host that orders a group after them (the paper's
+  // evaluation order) has said that group wins.
+  if (colliders_.empty() || order_.empty() || order_.back() != static_cast<int32_t>(settings_.contact_group.index))
+    return;
   Group& g = groups_[settings_.contact_group.index];
   const size_t before = g.contacts.size();
   std::vector<int32_t> moved;
@@ -1005,6 +1012,28 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
   chebyshev_prev_.swap(chebyshev_now_);
 }
 
+void World::settle_contacts_on_surface() {
+  // A swept contact holds its particle on the tangent plane where the particle's path met the
+  // clearance surface. A particle that slides along that plane within the substep (a chain step
+  // moves a whole run at once; friction along a plane met near an edge) can end below the surface's
+  // curve or edge beside it; on a convex collider it is pushed out along the closest point (a mesh
+  // keeps the plane: the closest point of a thin mesh can lie on its far side). Only when the
+  // contacts are projected last, as catch_late_contacts.
+  if (colliders_.empty() || order_.empty() || order_.back() != static_cast<int32_t>(settings_.contact_group.index))
+    return;
+  Group& g = groups_[settings_.contact_group.index];
+  for (Contact& ct : g.contacts) {
+    const Collider& c = colliders_[ct.collider];
+    if (!ct.swept || c.desc.shape == ColliderShape::mesh) continue;
+    Contact closest = ct;
+    closest.swept = false;
+    Vec3 n;
+    const int32_t i = ct.particle;
+    const double gap = contact_gap(c, closest, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
+    if (gap < 0.0) x_[i] -= gap * n;
+  }
+}
+
 void World::update_velocities(double h) {
   // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
   // it is below mu_s times the normal push, else reduced by mu_k times it.
@@ -1063,6 +1092,7 @@ void World::update_velocities(double h) {
       x_[fc.partner[k]] -= step;
     }
   }
+  settle_contacts_on_surface();
   const double inv_h = 1.0 / h;
   for (size_t i = 0; i < x_.size(); ++i) {
     v_[i] = (x_[i] - x_prev_[i]) * inv_h;

@@ -306,8 +306,10 @@ double box_distance(const Vec3& x, const Vec3& centre, const Vec3& half) {
 }
 
 // The cloth cube falls onto the four cubes and settles (no particle faster than 1 mm/s after the
-// scene's 600 frames); after every frame no particle is inside a cube or the ground by more than
-// 0.1 mm beyond its half thickness, and at every 60th frame no two triangles intersect.
+// scene's 600 frames); after every frame no particle is inside a cube or the ground beyond its half
+// thickness (to 1e-9 m: colliders have the final word, and a particle held on a face's tangent plane
+// that slid towards an edge is put back on the surface), and at every 60th frame no two triangles
+// intersect.
 TEST(PaperScenes, DraperySettlesOnTheCubesWithoutInterpenetration) {
   Scene s = load_example("drapery.json");
   World& w = *s.world;
@@ -332,7 +334,7 @@ TEST(PaperScenes, DraperySettlesOnTheCubesWithoutInterpenetration) {
       "drapery: closest approach %.2e m beyond the half thickness, %d particles resting on a cube or the "
       "ground, %lld intersecting triangle pairs, final speed %.2e m/s\n",
       closest, touching, static_cast<long long>(crossings), w.report().max_speed);
-  EXPECT_GT(closest, -1e-4);
+  EXPECT_GT(closest, -1e-9);
   EXPECT_GT(touching, 0);
   EXPECT_EQ(crossings, 0);
   EXPECT_TRUE(w.report().settled);

@@ -486,6 +486,7 @@ class World {
   void find_collider_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
   void find_shape_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
   void catch_late_contacts();
+  void settle_contacts_on_surface();
   void project_contact(Contact& ct);
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
