@@ -261,7 +261,8 @@ EMBRA_ALWAYS_INLINE void pass(SolverArray& a, double inv_h2, double* x, const do
 /// overshoot. It is therefore kept only if it lowers the chain's residual sum of (C + alpha~ lambda)^2;
 /// otherwise the chain is projected one constraint at a time, as the plain pass does.
 ///
-/// Only the first iteration of a substep takes chain steps (project_group). Newton steps repeated
+/// Only a group's first projection in a substep takes chain steps (project_group; not its repeats
+/// under a weight above 1, nor later iterations). Newton steps repeated
 /// within one substep, each linearised where the last one ended, satisfy the links to rounding but
 /// add up to a correction that is not along the final gradients (the term XPBD drops, Macklin et al.
 /// 2016 eq. 11): a taut chain between two pins then keeps sliding along its constraints at a speed
@@ -339,6 +340,7 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   };
   // Forward: directions, the system, and elimination as it is built; the residual before.
   T merit = splat<T>(0.0), prev_inv = splat<T>(0.0), prev_rhs = splat<T>(0.0);
+  T reach = splat<T>(0.0);  // the chain's longest rest length
   V3<T> prev_n{splat<T>(0.0), splat<T>(0.0), splat<T>(0.0)};
   for (int32_t k = 0; k < M; ++k) {
     indices(k);
@@ -352,9 +354,10 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     const T il = select(valid, 1.0 / len, splat<T>(0.0));
     const V3<T> nk = il * d;
     T dk = select(on, w0 + w1 + alpha, splat<T>(0.0));
-    T rk = select(valid, -(len - load_value<T>(a.rest.data(), ie, 1)) - alpha * load_value<T>(a.lambda.data(), ie, 1),
-                  splat<T>(0.0));
+    const T rest = load_value<T>(a.rest.data(), ie, 1);
+    T rk = select(valid, -(len - rest) - alpha * load_value<T>(a.lambda.data(), ie, 1), splat<T>(0.0));
     merit = merit + select(dk > 0.0, rk * rk, splat<T>(0.0));
+    reach = select(on & (rest > reach), rest, reach);
     if (k > 0) {  // couple to constraint k - 1 through their shared particle
       const T upk = -w0 * dot(prev_n, nk);
       store(up + N * (k - 1), upk);
@@ -370,7 +373,7 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     store(n + 3 * N * k, nk.x), store(n + 3 * N * k + N, nk.y), store(n + 3 * N * k + 2 * N, nk.z);
   }
   // Backward: dlambda, and the moved positions (particle k + 1 once dlambda k and k + 1 are known).
-  T next = splat<T>(0.0);
+  T next = splat<T>(0.0), farthest = splat<T>(0.0);  // the largest squared move of a particle
   V3<T> next_n{splat<T>(0.0), splat<T>(0.0), splat<T>(0.0)};
   for (int32_t k = M - 1; k >= 0; --k) {
     indices(k);
@@ -380,7 +383,10 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     const V3<T> nk{L::make(n + 3 * N * k), L::make(n + 3 * N * k + N), L::make(n + 3 * N * k + 2 * N)};
     const V3<T> q = load_point<T>(x, i1, 1);
     const T wq = load_value<T>(w, i1, 1);
-    const V3<T> to = q + wq * (dl * nk - next * next_n);
+    const V3<T> step = wq * (dl * nk - next * next_n);
+    const T step2 = dot(step, step);
+    farthest = select(step2 > farthest, step2, farthest);
+    const V3<T> to = q + step;
     double* mv = moved + 3 * N * (k + 1);
     store(mv, to.x), store(mv + N, to.y), store(mv + 2 * N, to.z);
     next = dl;
@@ -389,7 +395,10 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   indices(0);
   {
     const V3<T> q = load_point<T>(x, i0, 1);
-    const V3<T> to = q - load_value<T>(w, i0, 1) * (next * next_n);
+    const V3<T> step = -(load_value<T>(w, i0, 1) * (next * next_n));
+    const T step2 = dot(step, step);
+    farthest = select(step2 > farthest, step2, farthest);
+    const V3<T> to = q + step;
     store(moved, to.x), store(moved + N, to.y), store(moved + 2 * N, to.z);
   }
   // The residual after the step.
@@ -407,9 +416,13 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
                 alpha * (load_value<T>(a.lambda.data(), ie, 1) + L::make(rhs + N * k));
     after = after + select(on & (dk > 0.0), r * r, splat<T>(0.0));
   }
-  // Each lane keeps its step if the step lowered its residual, else takes the one-at-a-time pass.
+  // Each lane keeps its step if the step lowered its residual and moved no particle further than half
+  // the chain's longest link, else takes the one-at-a-time pass. (A nearly straight chain squeezed
+  // or pulled along its length has near-zero pivots: the step could carry particles several links
+  // for a slight drop in the residual, and that motion becomes velocity.)
   for (int l = 0; l < count; ++l) {
-    if (!(L::get(after, l) <= L::get(merit, l))) {
+    const double half_link = 0.5 * L::get(reach, l);
+    if (!(L::get(after, l) <= L::get(merit, l)) || !(L::get(farthest, l) <= half_link * half_link)) {
       chain_sweep(a, c0 + static_cast<size_t>(l), inv_h2, x, w);
       continue;
     }
@@ -928,8 +941,8 @@ void World::project_group(Group& g, double h) {
   project_weld(g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
   const Kernels& k = kernels();
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
-  // Chains in the first iteration of a substep only (Settings::chain_solve): see chain_pass.
-  if (distance.chain_start.empty() || iteration_ > 0 || settings_.realign_passes > 0)
+  // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
+  if (distance.chain_start.empty() || !first_projection_ || settings_.realign_passes > 0)
     k.distance(distance, inv_h2, x, w);
   else
     k.chain(distance, inv_h2, x, w, chain_scratch_.data(), chain_index_scratch_.data());
@@ -1030,7 +1043,9 @@ void World::settle_contacts_on_surface() {
     Vec3 n;
     const int32_t i = ct.particle;
     const double gap = contact_gap(c, closest, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
-    if (gap < 0.0) x_[i] -= gap * n;
+    // Never out through the far side (a thin plate): only when the closest point's normal faces the
+    // way the particle came in.
+    if (gap < 0.0 && n.dot(c.rotation * ct.normal) > 0.0) x_[i] -= gap * n;
   }
 }
 
@@ -1213,12 +1228,14 @@ void World::step() {
       const double rho = settings_.iterations > 3 ? settings_.chebyshev_rho_milli / 1000.0 : 0.0;
       double omega = 1.0;
       for (int it = 0; it < settings_.iterations; ++it) {
-        iteration_ = it;
         if (rho > 0.0) chebyshev_now_ = x_;
         project_volumes(h);  // fields.cpp
         for (int32_t slot : order_) {
           Group& g = groups_[slot];
-          for (int k = 0; k < g.desc.weight; ++k) project_group(g, h);
+          for (int k = 0; k < g.desc.weight; ++k) {
+            first_projection_ = it == 0 && k == 0;  // the chain solve's turn (chain_pass)
+            project_group(g, h);
+          }
         }
         if (rho > 0.0) chebyshev_step(it, rho, omega);
       }

@@ -1122,7 +1122,7 @@ void World::rebuild_solver() {
       sa.lambda.assign(per * a.size(), 0.0);
       if (k == static_cast<int>(Kind::distance) && settings_.chain_solve && sa.size() > 0) {
         if (rest.empty()) {  // every particle's rest position: its body's rest shape
-          rest.resize(x_.size());
+          rest.assign(x_.size(), Vec3::Zero());
           for (const BodyInfo& b : bodies_)
             std::copy(b.rest_positions.begin(), b.rest_positions.end(), rest.begin() + b.first_particle);
         }

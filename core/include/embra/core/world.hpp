@@ -528,7 +528,7 @@ class World {
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
-  int iteration_ = 0;
+  bool first_projection_ = false;             // the group now projected has not been projected this substep
   std::vector<Vec3> detected_;                // positions when this substep's contacts were found
   std::vector<double> chain_scratch_;         // Settings::chain_solve: 40 per constraint of the longest chain, + 80
   std::vector<int32_t> chain_index_scratch_;  // and 12 per constraint, + 12
