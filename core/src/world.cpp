@@ -1174,6 +1174,17 @@ void World::rebuild_solver() {
         sorted.body[j] = t.body[i];
         sorted.rest[j] = t.rest[i];
       }
+      // The runs: a particle's tethers, in the order made (long_range_attachments lists a particle's
+      // attachments together, nearest anchor first).
+      sorted.run_start.assign(1, 0);
+      sorted.run_entry.resize(order.size());
+      std::vector<int32_t> position(order.size());
+      for (size_t j = 0; j < order.size(); ++j) position[order[j]] = static_cast<int32_t>(j);
+      for (size_t i = 0; i < order.size(); ++i) {
+        if (i > 0 && t.ids[2 * i] != t.ids[2 * i - 2]) sorted.run_start.push_back(static_cast<int32_t>(i));
+        sorted.run_entry[i] = position[i];
+      }
+      sorted.run_start.push_back(static_cast<int32_t>(order.size()));
       t = std::move(sorted);
       t.lambda.assign(t.size(), 0.0);
     }

@@ -248,6 +248,10 @@ struct SolverArray {
   // particles when chain_shared_tail (solved one chain after another).
   std::vector<int32_t> chain_colour_start;
   bool chain_shared_tail = false;
+  // Automatic tethers: the tethers of one particle, together. Run r is the entries
+  // run_entry[run_start[r] .. run_start[r + 1]) of this (colour-ordered) array, all pulling the same
+  // particle towards immovable anchors; runs share no particle.
+  std::vector<int32_t> run_start, run_entry;
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
 };
