@@ -224,7 +224,7 @@ namespace Embra.Grasshopper
             p.Add("BendCompliance", "Cb", "Bending compliance (rad/(N m)), default 1", GH_ParamAccess.item, true);
             p.Add("StretchWeight", "Ws", "Importance weight of the mesh edges, default 1", GH_ParamAccess.item, true);
             p.Add("Damping", "D", "Velocity decay (1/s), default 0", GH_ParamAccess.item, true);
-            p.Add("Substeps", "S", "Substeps per frame, default 20", GH_ParamAccess.item, true);
+            p.Add("Substeps", "S", "Substeps per frame, default 16", GH_ParamAccess.item, true);
             p.Add("Iterations", "I", "Passes per substep, default 1", GH_ParamAccess.item, true);
             p.Add("StepsPerSolve", "N", "Frames stepped per solution while running, default 1", GH_ParamAccess.item, true);
             p.Add("Reset", "R", "Rebuild from the inputs", GH_ParamAccess.item, true);
@@ -308,7 +308,7 @@ namespace Embra.Grasshopper
                 solver.Gravity[2] = gravity.Z;
             }
             solver.Damping = Item(DA, InDamping, 0.0);
-            solver.Substeps = Item(DA, InSubsteps, 20);
+            solver.Substeps = Item(DA, InSubsteps, 16);
             solver.Iterations = Item(DA, InIterations, 1);
 
             var next = new World(solver);  // built whole, then swapped in: a failure keeps the old world

@@ -147,7 +147,7 @@ static void test_defaults(void) {
   const embra_collider_def k = embra_default_collider_def();
 
   CHECK_INT(s.version, EMBRA_SOLVER_DEF_VERSION);
-  CHECK_INT(s.substeps, 20);
+  CHECK_INT(s.substeps, 16);
   CHECK_NEAR(s.dt, 1.0 / 60.0, 0.0);
   CHECK_INT(s.iterations, 1);
   CHECK_INT(s.chebyshev_rho_milli, 0);

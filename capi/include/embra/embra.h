@@ -145,7 +145,7 @@ typedef struct embra_collider_id {
 #define EMBRA_SOLVER_DEF_VERSION 1
 typedef struct embra_solver_def {
   int32_t version;             /* EMBRA_SOLVER_DEF_VERSION */
-  int32_t substeps;            /* substeps per frame, [1, 10000]; default 20 (small steps converge
+  int32_t substeps;            /* substeps per frame, [1, 10000]; default 16 (small steps converge
                                   stiff cloth far better than iterations at the same cost) */
   double dt;                   /* s per frame (per embra_world_step), > 0; default 1/60 */
   int32_t iterations;          /* passes over the ordered groups per substep, [1, 10000]; default 1 */

@@ -842,7 +842,7 @@ namespace Embra.Tests
         {
             var s = Library.DefaultSolverDef();
             Assert.AreEqual(SolverDef.CurrentVersion, s.Version);
-            Assert.AreEqual(20, s.Substeps);
+            Assert.AreEqual(16, s.Substeps);
             Assert.AreEqual(1, s.ChainSolve);
             Assert.AreEqual(1.0 / 60.0, s.Dt);
             unsafe { Assert.AreEqual(-9.81, s.Gravity[2]); }

@@ -137,7 +137,7 @@ struct ColliderDesc {
 
 struct Settings {
   double dt = 1.0 / 60.0;                // s per frame (one call to step)
-  int32_t substeps = 20;                 // chosen on the 128x128 cloth benchmark (bench/README.md)
+  int32_t substeps = 16;                 // chosen on the 128x128 cloth benchmark (bench/README.md)
   int32_t iterations = 1;                // passes over the ordered groups per substep
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2
   double damping = 0.0;                  // 1/s, applied to every particle
