@@ -1154,22 +1154,15 @@ void World::settle_contacts_on_surface() {
   Group& g = groups_[settings_.contact_group.index];
   for (Contact& ct : g.contacts) {
     const Collider& c = colliders_[ct.collider];
-    if (!ct.swept) {  // the closest point, as every projection of the contact: friction between the
-      Vec3 n;         // layers of a folded cloth (after the contacts) can have pushed the particle in
-      const int32_t i = ct.particle;
-      const double gap = contact_gap(c, ct, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
-      if (gap < 0.0) x_[i] -= gap * n;
-      continue;
-    }
-    if (c.desc.shape == ColliderShape::mesh) continue;
+    if (ct.swept && c.desc.shape == ColliderShape::mesh) continue;
     Contact closest = ct;
     closest.swept = false;
     Vec3 n;
     const int32_t i = ct.particle;
     const double gap = contact_gap(c, closest, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
-    // Never out through the far side (a thin plate): only when the closest point's normal faces the
-    // way the particle came in.
-    if (gap < 0.0 && n.dot(c.rotation * ct.normal) > 0.0) x_[i] -= gap * n;
+    // A swept contact never out through the far side (a thin plate): only when the closest point's
+    // normal faces the way the particle came in.
+    if (gap < 0.0 && (!ct.swept || n.dot(c.rotation * ct.normal) > 0.0)) x_[i] -= gap * n;
   }
 }
 
