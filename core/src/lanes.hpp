@@ -142,7 +142,31 @@ EMBRA_ALWAYS_INLINE T load_value(const double* w, const int32_t* ids, int stride
   return Lanes<T>::make(a);
 }
 
-/// atan2_det (constraint_math.hpp) lane by lane, its branches turned into selects.
+/// Lane l's (v.x, v.y, v.z) as the triple out[l][0..2] (out[l][3] is padding): a block's per-lane
+/// corrections laid out for writing back particle by particle. Four lanes transpose in registers.
+template <class T>
+EMBRA_ALWAYS_INLINE void transpose(const V3<T>& v, double (*out)[4]) {
+  for (int l = 0; l < Lanes<T>::count; ++l) {
+    out[l][0] = Lanes<T>::get(v.x, l);
+    out[l][1] = Lanes<T>::get(v.y, l);
+    out[l][2] = Lanes<T>::get(v.z, l);
+    out[l][3] = 0.0;
+  }
+}
+#if EMBRA_LANES_VECTOR && __has_builtin(__builtin_shufflevector)
+template <>
+EMBRA_ALWAYS_INLINE void transpose(const V3<D4>& v, double (*out)[4]) {
+  const D4 zero = {0.0, 0.0, 0.0, 0.0};
+  const D4 xy02 = __builtin_shufflevector(v.x, v.y, 0, 4, 2, 6), xy13 = __builtin_shufflevector(v.x, v.y, 1, 5, 3, 7);
+  const D4 z02 = __builtin_shufflevector(v.z, zero, 0, 4, 2, 6), z13 = __builtin_shufflevector(v.z, zero, 1, 5, 3, 7);
+  const D4 lanes[4] = {__builtin_shufflevector(xy02, z02, 0, 1, 4, 5), __builtin_shufflevector(xy13, z13, 0, 1, 4, 5),
+                       __builtin_shufflevector(xy02, z02, 2, 3, 6, 7), __builtin_shufflevector(xy13, z13, 2, 3, 6, 7)};
+  std::memcpy(out, lanes, sizeof lanes);
+}
+#endif
+
+/// atan2_det (constraint_math.hpp) lane by lane, its branches turned into selects: one division for
+/// the range reduction and one for the rational approximation.
 template <class T>
 EMBRA_ALWAYS_INLINE T atan2(T y, T x) {
   constexpr double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1, p2 = -7.500855792314704667340e1,
@@ -151,21 +175,22 @@ EMBRA_ALWAYS_INLINE T atan2(T y, T x) {
                    q3 = 4.853903996359136964868e2, q4 = 1.945506571482613964425e2;
   constexpr double tan_3pi_8 = 2.41421356237309504880, more_bits = 6.123233995736765886130e-17;
   constexpr double pi = std::numbers::pi;
-  const T t = y / x;
-  const T at = select(t < 0.0, -t, t);
-  const auto big = at > tan_3pi_8;
-  const auto mid = at > 0.66;
-  const T r = select(big, -1.0 / at, select(mid, (at - 1.0) / (at + 1.0), at));
+  const T ay = select(y < 0.0, -y, y), ax = select(x < 0.0, -x, x);
+  const auto big = ay > tan_3pi_8 * ax;
+  const auto mid = ay > 0.66 * ax;
+  const T num = select(big, -ax, select(mid, ay - ax, ay));
+  const T den = select(big, ay, select(mid, ay + ax, ax));
+  const T r = num / den;
   const T base = select(big, splat<T>(pi / 2), select(mid, splat<T>(pi / 4), splat<T>(0.0)));
   const T extra = select(big, splat<T>(more_bits), select(mid, splat<T>(0.5 * more_bits), splat<T>(0.0)));
   const T z = r * r;
   const T p = (((p0 * z + p1) * z + p2) * z + p3) * z + p4;
   const T q = ((((z + q0) * z + q1) * z + q2) * z + q3) * z + q4;
   const T u = base + ((r * (z * p / q) + r) + extra);
-  const T a = select(t < 0.0, -u, u);
-  const T left = select(y >= 0.0, a + pi, a - pi);
+  const T right = select(y < 0.0, -u, u);
+  const T left = select(y >= 0.0, pi - u, u - pi);
   const T axis = select(y > 0.0, splat<T>(pi / 2), select(y < 0.0, splat<T>(-pi / 2), splat<T>(0.0)));
-  return select(x == 0.0, axis, select(x > 0.0, a, left));
+  return select(x == 0.0, axis, select(x > 0.0, right, left));
 }
 
 }  // namespace embra::lanes

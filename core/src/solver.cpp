@@ -126,18 +126,17 @@ template <class T, class M>
 EMBRA_ALWAYS_INLINE void scatter4(const int32_t* ids, M ok, T lam_new, const T wk[4], T dl, const lanes::V3<T> g[4],
                                   double* lambda, double* x) {
   using L = lanes::Lanes<T>;
-  T sk[4];
-  for (int k = 0; k < 4; ++k) sk[k] = wk[k] * dl;
+  alignas(32) double step[4][L::count][4];  // particle k's move in lane l: (w_k dlambda) grad_k C
+  for (int k = 0; k < 4; ++k) lanes::transpose((wk[k] * dl) * g[k], step[k]);
   for (int l = 0; l < L::count; ++l) {
     if (!L::on(ok, l)) continue;
     lambda[l] = L::get(lam_new, l);
     for (int k = 0; k < 4; ++k) {
       if (L::get(wk[k], l) == 0.0) continue;
       double* q = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
-      const double f = L::get(sk[k], l);
-      q[0] += f * L::get(g[k].x, l);
-      q[1] += f * L::get(g[k].y, l);
-      q[2] += f * L::get(g[k].z, l);
+      q[0] += step[k][l][0];
+      q[1] += step[k][l][1];
+      q[2] += step[k][l][2];
     }
   }
 }

@@ -27,37 +27,40 @@ struct ConstraintEval {
   bool valid = false;
 };
 
-/// atan(x) for x >= 0 from +, -, *, / only: Cephes' range reduction and rational approximation.
-inline double atan_nonnegative(double x) {
+/// atan(num / den) for 0 <= num, 0 < den, from +, -, *, / only: Cephes' rational approximation on
+/// [0, tan(pi/8)] after its range reduction, with the reduction folded into the one division
+/// (atan(a/b) = pi/2 + atan(-b/a) = pi/4 + atan((a - b)/(a + b))).
+inline double atan_ratio(double num, double den) {
   constexpr double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1, p2 = -7.500855792314704667340e1,
                    p3 = -1.228866684490136173410e2, p4 = -6.485021904942025371773e1;
   constexpr double q0 = 2.485846490142306297962e1, q1 = 1.650270098316988542046e2, q2 = 4.328810604912902668951e2,
                    q3 = 4.853903996359136964868e2, q4 = 1.945506571482613964425e2;
   constexpr double tan_3pi_8 = 2.41421356237309504880, more_bits = 6.123233995736765886130e-17;
-  double base = 0.0, extra = 0.0;
-  if (x > tan_3pi_8) {
+  double base = 0.0, extra = 0.0, r;
+  if (num > tan_3pi_8 * den) {
     base = std::numbers::pi / 2;
     extra = more_bits;
-    x = -1.0 / x;
-  } else if (x > 0.66) {
+    r = -den / num;
+  } else if (num > 0.66 * den) {
     base = std::numbers::pi / 4;
     extra = 0.5 * more_bits;
-    x = (x - 1.0) / (x + 1.0);
+    r = (num - den) / (num + den);
+  } else {
+    r = num / den;
   }
-  const double z = x * x;
+  const double z = r * r;
   const double p = (((p0 * z + p1) * z + p2) * z + p3) * z + p4;
   const double q = ((((z + q0) * z + q1) * z + q2) * z + q3) * z + q4;
-  return base + ((x * (z * p / q) + x) + extra);
+  return base + ((r * (z * p / q) + r) + extra);
 }
 
 /// atan2(y, x) in [-pi, pi], within about one ulp of std::atan2 but built from +, -, *, / only, so
 /// it gives the same bits on every IEEE-754 machine and C library (and is about 4 times faster).
 inline double atan2_det(double y, double x) {
   if (x == 0.0) return y > 0.0 ? std::numbers::pi / 2 : y < 0.0 ? -std::numbers::pi / 2 : 0.0;
-  const double t = y / x;
-  const double a = t < 0.0 ? -atan_nonnegative(-t) : atan_nonnegative(t);
-  if (x > 0.0) return a;
-  return y >= 0.0 ? a + std::numbers::pi : a - std::numbers::pi;
+  const double u = atan_ratio(y < 0.0 ? -y : y, x < 0.0 ? -x : x);  // in [0, pi/2]
+  if (x > 0.0) return y < 0.0 ? -u : u;
+  return y >= 0.0 ? std::numbers::pi - u : u - std::numbers::pi;
 }
 
 /// Wraps an angle difference to (-pi, pi].
