@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -121,22 +122,22 @@ struct QuadOperands {
 };
 
 /// Writes back a block of four-particle constraints: each lane whose constraint is valid (ok) takes
-/// its new multiplier and moves its movable particles by w_k dlambda grad_k C.
+/// its new multiplier and moves its movable particles from p_k (where the block read them) by
+/// w_k dlambda grad_k C. A constraint's four particles are distinct and a colour's lanes share no
+/// movable particle, so each new position is computed in registers and stored, not read again.
 template <class T, class M>
-EMBRA_ALWAYS_INLINE void scatter4(const int32_t* ids, M ok, T lam_new, const T wk[4], T dl, const lanes::V3<T> g[4],
-                                  double* lambda, double* x) {
+EMBRA_ALWAYS_INLINE void scatter4(const int32_t* ids, M ok, T lam_new, const lanes::V3<T> p[4], const T wk[4], T dl,
+                                  const lanes::V3<T> g[4], double* lambda, double* x) {
   using L = lanes::Lanes<T>;
-  alignas(32) double step[4][L::count][4];  // particle k's move in lane l: (w_k dlambda) grad_k C
-  for (int k = 0; k < 4; ++k) lanes::transpose((wk[k] * dl) * g[k], step[k]);
+  alignas(32) double to[4][L::count][4];  // particle k's new position in lane l
+  for (int k = 0; k < 4; ++k) lanes::transpose(p[k] + (wk[k] * dl) * g[k], to[k]);
   for (int l = 0; l < L::count; ++l) {
     if (!L::on(ok, l)) continue;
     lambda[l] = L::get(lam_new, l);
     for (int k = 0; k < 4; ++k) {
+      // An immovable particle is not written: colours ignore them, so lanes may share one.
       if (L::get(wk[k], l) == 0.0) continue;
-      double* q = x + 3 * static_cast<int64_t>(ids[4 * l + k]);
-      q[0] += step[k][l][0];
-      q[1] += step[k][l][1];
-      q[2] += step[k][l][2];
+      std::memcpy(x + 3 * static_cast<int64_t>(ids[4 * l + k]), to[k][l], 3 * sizeof(double));
     }
   }
 }
@@ -175,7 +176,7 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   const auto ok = valid & (denom > 0.0);
   const T dl = (-c - alpha * lam) / denom;
   const V3<T> g[4] = {g0, g1, g2, g3};
-  scatter4<T>(ids, ok, lam + dl, wk, dl, g, lambda, x);
+  scatter4<T>(ids, ok, lam + dl, p, wk, dl, g, lambda, x);
 }
 
 /// Quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2, x3)) or plane
@@ -216,7 +217,7 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   for (int k = 0; k < 4; ++k) denom = denom + wk[k] * dot(g[k], g[k]);
   const auto ok = valid & (denom > 0.0);
   const T dl = (-(value - r) - alpha * lam) / denom;
-  scatter4<T>(ids, ok, lam + dl, wk, dl, g, lambda, x);
+  scatter4<T>(ids, ok, lam + dl, p, wk, dl, g, lambda, x);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };
