@@ -300,11 +300,15 @@ inline void chain_sweep(SolverArray& a, size_t c, double inv_h2, double* x, cons
 
 /// The chain step for the chains c0 .. c0 + count - 1 of one colour, side by side, one per lane
 /// (they share no particle; lanes past `count` idle). Chains are longest first within a colour, so
-/// lane 0's is the longest; a lane whose chain has ended idles. `scratch`: 10 lanes-wide values per
-/// constraint of the longest chain, plus 3 for its last particle; `index_scratch`: 3 lanes-wide.
+/// lane 0's is the longest; a lane whose chain has ended idles. `scratch`: kChainScratch lanes-wide
+/// values per constraint of the longest chain, plus kChainScratch for its last particle.
+///
+/// The forward sweep reads each particle, multiplier, rest length and compliance once and keeps
+/// them in `scratch` for the backward sweep and the residual after the step: x is not written
+/// until a lane's step is accepted, so the copies are exact.
 template <class T>
 EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, double inv_h2, double* x, const double* w,
-                                      double* scratch, int32_t* index_scratch) {
+                                      double* scratch) {
   using namespace lanes;
   using L = Lanes<T>;
   constexpr int N = L::count;
@@ -320,44 +324,56 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     P[l] = &a.chain_part[first + static_cast<int32_t>(c)];
   }
   const int32_t M = m[0];
-  double* const n = scratch;          // per constraint: direction (3 N)
-  double* const up = n + 3 * N * M;   // super-diagonal (N)
-  double* const inv = up + N * M;     // 1 / eliminated diagonal (N)
-  double* const rhs = inv + N * M;    // eliminated right-hand side, then dlambda (N)
-  double* const moved = rhs + N * M;  // per particle: the position the step gives (3 N), M + 1 of them
-  // Per constraint k, lane by lane: its two particles and its slot (an idle lane repeats its last).
-  int32_t* const ids = index_scratch;
-  double* const on_d = moved + 3 * N * (M + 1);  // 1 where the lane's chain has constraint k, else 0
-  for (int32_t k = 0; k < M; ++k)
-    for (int l = 0; l < N; ++l) {
-      const int32_t kk = std::min(k, last[l]);
-      ids[3 * N * k + l] = P[l][kk], ids[3 * N * k + N + l] = P[l][kk + 1], ids[3 * N * k + 2 * N + l] = E[l][kk];
-      on_d[N * k + l] = k < m[l] ? 1.0 : 0.0;
-    }
-  const int32_t *i0 = nullptr, *i1 = nullptr, *ie = nullptr;
-  auto indices = [&](int32_t k) {
-    i0 = ids + 3 * N * k;
-    i1 = i0 + N;
-    ie = i1 + N;
-  };
+  // Per constraint k (N lanes each): direction (3), super-diagonal, 1 / eliminated diagonal,
+  // eliminated right-hand side then dlambda, alpha~, rest length, multiplier before the step, and
+  // 1 where the lane's chain has constraint k (else 0). Per particle j (M + 1 of them): position as
+  // read, then as the step moves it (3), and inverse mass.
+  double* const n = scratch;
+  double* const up = n + 3 * N * M;
+  double* const inv = up + N * M;
+  double* const rhs = inv + N * M;
+  double* const alpha_k = rhs + N * M;
+  double* const rest_k = alpha_k + N * M;
+  double* const lambda_k = rest_k + N * M;
+  double* const on_k = lambda_k + N * M;
+  double* const moved = on_k + N * M;
+  double* const w_j = moved + 3 * N * (M + 1);
+  auto point = [](const double* at) { return V3<T>{L::make(at), L::make(at + N), L::make(at + 2 * N)}; };
+  auto keep = [](double* at, const V3<T>& v) { store(at, v.x), store(at + N, v.y), store(at + 2 * N, v.z); };
   // Forward: directions, the system, and elimination as it is built; the residual before.
   T merit = splat<T>(0.0), prev_inv = splat<T>(0.0), prev_rhs = splat<T>(0.0);
   T reach = splat<T>(0.0);  // the chain's longest rest length
   V3<T> prev_n{splat<T>(0.0), splat<T>(0.0), splat<T>(0.0)};
+  int32_t id[N], edge[N];
+  for (int l = 0; l < N; ++l) id[l] = P[l][0];
+  V3<T> p0 = load_point<T>(x, id, 1);
+  T w0 = load_value<T>(w, id, 1);
+  keep(moved, p0);
+  store(w_j, w0);
   for (int32_t k = 0; k < M; ++k) {
-    indices(k);
-    const auto on = L::make(on_d + N * k) > 0.0;
-    const V3<T> p0 = load_point<T>(x, i0, 1), p1 = load_point<T>(x, i1, 1);
-    const T w0 = load_value<T>(w, i0, 1), w1 = load_value<T>(w, i1, 1);
-    const T alpha = load_value<T>(a.compliance.data(), ie, 1) * inv_h2;
+    double on_d[N];
+    for (int l = 0; l < N; ++l) {  // an idle lane repeats its last particle: a zero-length, masked link
+      const int32_t kk = std::min(k, last[l]);
+      id[l] = P[l][kk + 1], edge[l] = E[l][kk], on_d[l] = k < m[l] ? 1.0 : 0.0;
+    }
+    const T on_v = L::make(on_d);
+    const auto on = on_v > 0.0;
+    const V3<T> p1 = load_point<T>(x, id, 1);
+    const T w1 = load_value<T>(w, id, 1);
+    keep(moved + 3 * N * (k + 1), p1);
+    store(w_j + N * (k + 1), w1);
+    const T alpha = load_value<T>(a.compliance.data(), edge, 1) * inv_h2;
+    const T rest = load_value<T>(a.rest.data(), edge, 1);
+    const T lam = load_value<T>(a.lambda.data(), edge, 1);
+    store(alpha_k + N * k, alpha), store(rest_k + N * k, rest), store(lambda_k + N * k, lam);
+    store(on_k + N * k, on_v);
     const V3<T> d = p1 - p0;
     const T len = lanes::sqrt(dot(d, d));
     const auto valid = on & (len > 1e-300);
     const T il = select(valid, 1.0 / len, splat<T>(0.0));
     const V3<T> nk = il * d;
     T dk = select(on, w0 + w1 + alpha, splat<T>(0.0));
-    const T rest = load_value<T>(a.rest.data(), ie, 1);
-    T rk = select(valid, -(len - rest) - alpha * load_value<T>(a.lambda.data(), ie, 1), splat<T>(0.0));
+    T rk = select(valid, -(len - rest) - alpha * lam, splat<T>(0.0));
     merit = merit + select(dk > 0.0, rk * rk, splat<T>(0.0));
     reach = select(on & (rest > reach), rest, reach);
     if (k > 0) {  // couple to constraint k - 1 through their shared particle
@@ -372,50 +388,40 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     prev_n = nk;
     store(inv + N * k, prev_inv);
     store(rhs + N * k, rk);
-    store(n + 3 * N * k, nk.x), store(n + 3 * N * k + N, nk.y), store(n + 3 * N * k + 2 * N, nk.z);
+    keep(n + 3 * N * k, nk);
+    p0 = p1, w0 = w1;
   }
   // Backward: dlambda, and the moved positions (particle k + 1 once dlambda k and k + 1 are known).
   T next = splat<T>(0.0), farthest = splat<T>(0.0);  // the largest squared move of a particle
   V3<T> next_n{splat<T>(0.0), splat<T>(0.0), splat<T>(0.0)};
   for (int32_t k = M - 1; k >= 0; --k) {
-    indices(k);
     const T upk = k + 1 < M ? L::make(up + N * k) : splat<T>(0.0);
     const T dl = (L::make(rhs + N * k) - upk * next) * L::make(inv + N * k);
     store(rhs + N * k, dl);
-    const V3<T> nk{L::make(n + 3 * N * k), L::make(n + 3 * N * k + N), L::make(n + 3 * N * k + 2 * N)};
-    const V3<T> q = load_point<T>(x, i1, 1);
-    const T wq = load_value<T>(w, i1, 1);
-    const V3<T> step = wq * (dl * nk - next * next_n);
+    const V3<T> nk = point(n + 3 * N * k);
+    double* mv = moved + 3 * N * (k + 1);
+    const V3<T> step = L::make(w_j + N * (k + 1)) * (dl * nk - next * next_n);
     const T step2 = dot(step, step);
     farthest = select(step2 > farthest, step2, farthest);
-    const V3<T> to = q + step;
-    double* mv = moved + 3 * N * (k + 1);
-    store(mv, to.x), store(mv + N, to.y), store(mv + 2 * N, to.z);
+    keep(mv, point(mv) + step);
     next = dl;
     next_n = nk;
   }
-  indices(0);
   {
-    const V3<T> q = load_point<T>(x, i0, 1);
-    const V3<T> step = -(load_value<T>(w, i0, 1) * (next * next_n));
+    const V3<T> step = -(L::make(w_j) * (next * next_n));
     const T step2 = dot(step, step);
     farthest = select(step2 > farthest, step2, farthest);
-    const V3<T> to = q + step;
-    store(moved, to.x), store(moved + N, to.y), store(moved + 2 * N, to.z);
+    keep(moved, point(moved) + step);
   }
   // The residual after the step.
   T after = splat<T>(0.0);
   for (int32_t k = 0; k < M; ++k) {
-    indices(k);
-    const auto on = L::make(on_d + N * k) > 0.0;
-    const double* m0 = moved + 3 * N * k;
-    const double* m1 = m0 + 3 * N;
-    const V3<T> d = V3<T>{L::make(m1), L::make(m1 + N), L::make(m1 + 2 * N)} -
-                    V3<T>{L::make(m0), L::make(m0 + N), L::make(m0 + 2 * N)};
-    const T alpha = load_value<T>(a.compliance.data(), ie, 1) * inv_h2;
-    const T dk = load_value<T>(w, i0, 1) + load_value<T>(w, i1, 1) + alpha;
-    const T r = lanes::sqrt(dot(d, d)) - load_value<T>(a.rest.data(), ie, 1) +
-                alpha * (load_value<T>(a.lambda.data(), ie, 1) + L::make(rhs + N * k));
+    const auto on = L::make(on_k + N * k) > 0.0;
+    const V3<T> d = point(moved + 3 * N * (k + 1)) - point(moved + 3 * N * k);
+    const T alpha = L::make(alpha_k + N * k);
+    const T dk = L::make(w_j + N * k) + L::make(w_j + N * (k + 1)) + alpha;
+    const T r =
+        lanes::sqrt(dot(d, d)) - L::make(rest_k + N * k) + alpha * (L::make(lambda_k + N * k) + L::make(rhs + N * k));
     after = after + select(on & (dk > 0.0), r * r, splat<T>(0.0));
   }
   // Each lane keeps its step if the step lowered its residual and moved no particle further than half
@@ -441,8 +447,7 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
 /// The chain pass: colour by colour, bundles of T's lanes within each colour (single chains for the
 /// shared tail, whose chains may overlap).
 template <class T>
-EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch,
-                                    int32_t* index_scratch) {
+EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) {
   constexpr int lanes_n = lanes::Lanes<T>::count;
   const size_t colours = a.chain_colour_start.empty() ? 0 : a.chain_colour_start.size() - 1;
   for (size_t c = 0; c < colours; ++c) {
@@ -450,32 +455,30 @@ EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, co
     const size_t end = static_cast<size_t>(a.chain_colour_start[c + 1]);
     if (!(a.chain_shared_tail && c + 1 == colours))
       for (; i < end; i += lanes_n)
-        chain_bundle<T>(a, i, static_cast<int>(std::min<size_t>(lanes_n, end - i)), inv_h2, x, w, scratch,
-                        index_scratch);
-    for (; i < end; ++i) chain_bundle<double>(a, i, 1, inv_h2, x, w, scratch, index_scratch);
+        chain_bundle<T>(a, i, static_cast<int>(std::min<size_t>(lanes_n, end - i)), inv_h2, x, w, scratch);
+    for (; i < end; ++i) chain_bundle<double>(a, i, 1, inv_h2, x, w, scratch);
   }
 }
 
 /// The passes for one lane type, compiled for one instruction set (ATTR).
-#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                           \
-  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) {             \
-    pass<T, Op::distance>(a, inv_h2, x, w);                                                          \
-  }                                                                                                  \
-  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {               \
-    pass<T, Op::tether>(a, inv_h2, x, w);                                                            \
-  }                                                                                                  \
-  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) {             \
-    pass<T, Op::dihedral>(a, inv_h2, x, w);                                                          \
-  }                                                                                                  \
-  ATTR void NAME##_planarity(SolverArray& a, double inv_h2, double* x, const double* w) {            \
-    pass<T, Op::planarity>(a, inv_h2, x, w);                                                         \
-  }                                                                                                  \
-  ATTR void NAME##_plane_offset(SolverArray& a, double inv_h2, double* x, const double* w) {         \
-    pass<T, Op::plane_offset>(a, inv_h2, x, w);                                                      \
-  }                                                                                                  \
-  ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch, \
-                         int32_t* index_scratch) {                                                   \
-    chain_pass<T>(a, inv_h2, x, w, scratch, index_scratch);                                          \
+#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                             \
+  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) {               \
+    pass<T, Op::distance>(a, inv_h2, x, w);                                                            \
+  }                                                                                                    \
+  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {                 \
+    pass<T, Op::tether>(a, inv_h2, x, w);                                                              \
+  }                                                                                                    \
+  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) {               \
+    pass<T, Op::dihedral>(a, inv_h2, x, w);                                                            \
+  }                                                                                                    \
+  ATTR void NAME##_planarity(SolverArray& a, double inv_h2, double* x, const double* w) {              \
+    pass<T, Op::planarity>(a, inv_h2, x, w);                                                           \
+  }                                                                                                    \
+  ATTR void NAME##_plane_offset(SolverArray& a, double inv_h2, double* x, const double* w) {           \
+    pass<T, Op::plane_offset>(a, inv_h2, x, w);                                                        \
+  }                                                                                                    \
+  ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
+    chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
   }
 
 struct Kernels {
@@ -484,7 +487,7 @@ struct Kernels {
   void (*dihedral)(SolverArray&, double, double*, const double*);
   void (*planarity)(SolverArray&, double, double*, const double*);
   void (*plane_offset)(SolverArray&, double, double*, const double*);
-  void (*chain)(SolverArray&, double, double*, const double*, double*, int32_t*);
+  void (*chain)(SolverArray&, double, double*, const double*, double*);
   const char* name;
 };
 
@@ -1059,7 +1062,7 @@ void World::project_group(Group& g, double h) {
   if (distance.chain_start.empty() || !first_projection_ || settings_.realign_passes > 0)
     k.distance(distance, inv_h2, x, w);
   else
-    k.chain(distance, inv_h2, x, w, chain_scratch_.data(), chain_index_scratch_.data());
+    k.chain(distance, inv_h2, x, w, chain_scratch_.data());
   k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
   if (settings_.realign_passes > 0)
     k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers

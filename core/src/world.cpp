@@ -1189,8 +1189,7 @@ void World::rebuild_solver() {
       t.lambda.assign(t.size(), 0.0);
     }
   }
-  chain_scratch_.assign(40 * (longest + 2), 0.0);
-  chain_index_scratch_.assign(12 * (longest + 1), 0);
+  chain_scratch_.assign(kChainScratch * (longest + 1), 0.0);
   solver_dirty_ = false;
   refresh_rest();
 }

@@ -532,10 +532,12 @@ class World {
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
-  bool first_projection_ = false;             // the group now projected has not been projected this substep
-  std::vector<Vec3> detected_;                // positions when this substep's contacts were found
-  std::vector<double> chain_scratch_;         // Settings::chain_solve: 40 per constraint of the longest chain, + 80
-  std::vector<int32_t> chain_index_scratch_;  // and 12 per constraint, + 12
+  bool first_projection_ = false;  // the group now projected has not been projected this substep
+  std::vector<Vec3> detected_;     // positions when this substep's contacts were found
+  /// Settings::chain_solve's scratch: per link of the longest chain, 10 values for each of (at most)
+  /// 4 lanes, and per particle 4 for each lane (the chain step, solver.cpp).
+  static constexpr size_t kChainScratch = 56;
+  std::vector<double> chain_scratch_;                 // kChainScratch per link of the longest chain, + 1
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
                                            // bodies changed: rebuild the solver arrays
