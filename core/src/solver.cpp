@@ -460,6 +460,37 @@ EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, co
   }
 }
 
+/// The function values alone (no gradients, no writes) of a whole solver array, into out[0 ..
+/// size): the distance |x0 - x1| or the dihedral angle, exactly as the projection kernels compute
+/// them. The residual measurement's share of the lanes.
+template <class T, Op kOp>
+EMBRA_ALWAYS_INLINE T value_block(const int32_t* ids, const double* x) {
+  using namespace lanes;
+  if constexpr (kOp == Op::dihedral) {
+    const V3<T> p0 = load_point<T>(x, ids, 4), p1 = load_point<T>(x, ids + 1, 4);
+    const V3<T> p2 = load_point<T>(x, ids + 2, 4), p3 = load_point<T>(x, ids + 3, 4);
+    const V3<T> edge = p1 - p0;
+    const V3<T> n1 = cross(edge, p2 - p0), n2 = cross(p3 - p0, edge);
+    return lanes::atan2(dot(cross(n1, n2), edge), dot(n1, n2) * lanes::sqrt(dot(edge, edge)));
+  } else {
+    const V3<T> d = load_point<T>(x, ids, 2) - load_point<T>(x, ids + 1, 2);
+    return lanes::sqrt(dot(d, d));
+  }
+}
+
+template <class T, Op kOp>
+EMBRA_ALWAYS_INLINE void values(const SolverArray& a, const double* x, double* out) {
+  constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
+  constexpr size_t arity = kOp == Op::dihedral ? 4 : 2;
+  const size_t n = a.size();
+  size_t i = 0;
+  for (; i + lanes_n <= n; i += lanes_n) {
+    const T v = value_block<T, kOp>(&a.ids[arity * i], x);
+    std::memcpy(out + i, &v, sizeof v);
+  }
+  for (; i < n; ++i) out[i] = value_block<double, kOp>(&a.ids[arity * i], x);
+}
+
 /// The passes for one lane type, compiled for one instruction set (ATTR).
 #define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                             \
   ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) {               \
@@ -479,6 +510,12 @@ EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, co
   }                                                                                                    \
   ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
     chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
+  }                                                                                                    \
+  ATTR void NAME##_distance_values(const SolverArray& a, const double* x, double* out) {               \
+    values<T, Op::distance>(a, x, out);                                                                \
+  }                                                                                                    \
+  ATTR void NAME##_dihedral_values(const SolverArray& a, const double* x, double* out) {               \
+    values<T, Op::dihedral>(a, x, out);                                                                \
   }
 
 struct Kernels {
@@ -488,6 +525,8 @@ struct Kernels {
   void (*planarity)(SolverArray&, double, double*, const double*);
   void (*plane_offset)(SolverArray&, double, double*, const double*);
   void (*chain)(SolverArray&, double, double*, const double*, double*);
+  void (*distance_values)(const SolverArray&, const double*, double*);
+  void (*dihedral_values)(const SolverArray&, const double*, double*);
   const char* name;
 };
 
@@ -504,18 +543,20 @@ EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels() {
   static const Kernels chosen = [] {
-    const Kernels scalar{scalar_distance,     scalar_tether, scalar_dihedral, scalar_planarity,
-                         scalar_plane_offset, scalar_chain,  "scalar"};
+    const Kernels scalar{scalar_distance,        scalar_tether,          scalar_dihedral,
+                         scalar_planarity,       scalar_plane_offset,    scalar_chain,
+                         scalar_distance_values, scalar_dihedral_values, "scalar"};
     const char* forced = std::getenv("EMBRA_KERNELS");
     const std::string want = forced ? forced : "";
     if (want == "scalar") return scalar;
 #if EMBRA_LANES_VECTOR
-    const Kernels vec2{vec2_distance,     vec2_tether, vec2_dihedral, vec2_planarity,
-                       vec2_plane_offset, vec2_chain,  "vec2"};
+    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity, vec2_plane_offset,
+                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, "vec2"};
     if (want == "vec2") return vec2;
 #if defined(EMBRA_HAVE_AVX2_KERNELS)
     if (__builtin_cpu_supports("avx2"))
-      return Kernels{avx2_distance, avx2_tether, avx2_dihedral, avx2_planarity, avx2_plane_offset, avx2_chain, "avx2"};
+      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity, avx2_plane_offset,
+                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, "avx2"};
 #endif
     return vec2;
 #else
@@ -691,27 +732,25 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
 
 // --- residuals ---------------------------------------------------------------------------------
 
-/// The constraint function's value alone (no gradient), as the projection kernels compute it.
-template <Kind K>
-double value_of(const int32_t* p, const std::vector<Vec3>& x) {
-  if constexpr (K == Kind::distance || K == Kind::tether) {
-    return (x[p[0]] - x[p[1]]).norm();
-  } else if constexpr (K == Kind::dihedral) {
-    const Vec3 edge = x[p[1]] - x[p[0]];
-    const Vec3 n1 = edge.cross(x[p[2]] - x[p[0]]);
-    const Vec3 n2 = (x[p[3]] - x[p[0]]).cross(edge);
-    return dihedral_angle(n1, n2, edge, std::sqrt(edge.squaredNorm()));
-  } else {
-    return evaluate<K>(p, x).value;
-  }
-}
-
 /// XPBD residual |C + alpha~ lambda| (for a tether only while it pulls or is overstretched).
+/// Distances and dihedral angles are evaluated by the kernels' value passes into `values`.
 template <Kind K>
-void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq) {
+void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq,
+               std::vector<double>& values) {
   constexpr int N = arity_of<K>();
+  constexpr bool kLanes = K == Kind::distance || K == Kind::tether || K == Kind::dihedral;
+  if constexpr (kLanes) {
+    values.resize(a.size());
+    const Kernels& k = kernels();
+    (K == Kind::dihedral ? k.dihedral_values : k.distance_values)(a, x.data()->data(), values.data());
+  }
   for (size_t i = 0; i < a.size(); ++i) {
-    const double c = deviation<K>(value_of<K>(&a.ids[i * N], x), a.rest[i]);
+    double value;
+    if constexpr (kLanes)
+      value = values[i];
+    else
+      value = evaluate<K>(&a.ids[i * N], x).value;
+    const double c = deviation<K>(value, a.rest[i]);
     double r = c + a.compliance[i] * inv_h2 * a.lambda[i];
     if constexpr (K == Kind::tether)
       if (a.lambda[i] == 0.0) r = std::max(c, 0.0);
@@ -1251,13 +1290,13 @@ void World::measure() {
     Group& g = groups_[slot];
     double max = 0.0, sq = 0.0;
     int64_t n = 0;
-    residuals<Kind::distance>(g.solve[0], inv_h2, x_, max, sq);
-    residuals<Kind::edge_angle>(g.solve[1], inv_h2, x_, max, sq);
-    residuals<Kind::dihedral>(g.solve[2], inv_h2, x_, max, sq);
-    residuals<Kind::tet_volume>(g.solve[3], inv_h2, x_, max, sq);
-    residuals<Kind::tether>(g.solve[5], inv_h2, x_, max, sq);
-    residuals<Kind::planarity>(g.solve[6], inv_h2, x_, max, sq);
-    residuals<Kind::plane_offset>(g.solve[7], inv_h2, x_, max, sq);
+    residuals<Kind::distance>(g.solve[0], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::edge_angle>(g.solve[1], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::dihedral>(g.solve[2], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::tet_volume>(g.solve[3], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::tether>(g.solve[5], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::planarity>(g.solve[6], inv_h2, x_, max, sq, measure_values_);
+    residuals<Kind::plane_offset>(g.solve[7], inv_h2, x_, max, sq, measure_values_);
     for (const SolverArray& a : g.solve) n += static_cast<int64_t>(a.size());
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {

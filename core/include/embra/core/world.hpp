@@ -537,6 +537,7 @@ class World {
   /// Settings::chain_solve's scratch: per link of the longest chain, 10 values for each of (at most)
   /// 4 lanes, and per particle 4 for each lane (the chain step, solver.cpp).
   static constexpr size_t kChainScratch = 56;
+  std::vector<double> measure_values_;                // measure(): one array's constraint values
   std::vector<double> chain_scratch_;                 // kChainScratch per link of the longest chain, + 1
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
