@@ -492,22 +492,16 @@ EMBRA_ALWAYS_INLINE void values(const SolverArray& a, const double* x, double* o
 }
 
 /// The passes for one lane type, compiled for one instruction set (ATTR).
+#define EMBRA_DEFINE_PASS(NAME, T, ATTR, OP)                                         \
+  ATTR void NAME##_##OP(SolverArray& a, double inv_h2, double* x, const double* w) { \
+    pass<T, Op::OP>(a, inv_h2, x, w);                                                \
+  }
 #define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                             \
-  ATTR void NAME##_distance(SolverArray& a, double inv_h2, double* x, const double* w) {               \
-    pass<T, Op::distance>(a, inv_h2, x, w);                                                            \
-  }                                                                                                    \
-  ATTR void NAME##_tether(SolverArray& a, double inv_h2, double* x, const double* w) {                 \
-    pass<T, Op::tether>(a, inv_h2, x, w);                                                              \
-  }                                                                                                    \
-  ATTR void NAME##_dihedral(SolverArray& a, double inv_h2, double* x, const double* w) {               \
-    pass<T, Op::dihedral>(a, inv_h2, x, w);                                                            \
-  }                                                                                                    \
-  ATTR void NAME##_planarity(SolverArray& a, double inv_h2, double* x, const double* w) {              \
-    pass<T, Op::planarity>(a, inv_h2, x, w);                                                           \
-  }                                                                                                    \
-  ATTR void NAME##_plane_offset(SolverArray& a, double inv_h2, double* x, const double* w) {           \
-    pass<T, Op::plane_offset>(a, inv_h2, x, w);                                                        \
-  }                                                                                                    \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, distance)                                                           \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, tether)                                                             \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                           \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                          \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                       \
   ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
     chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
   }                                                                                                    \
