@@ -300,8 +300,9 @@ inline void chain_sweep(SolverArray& a, size_t c, double inv_h2, double* x, cons
 
 /// The chain step for the chains c0 .. c0 + count - 1 of one colour, side by side, one per lane
 /// (they share no particle; lanes past `count` idle). Chains are longest first within a colour, so
-/// lane 0's is the longest; a lane whose chain has ended idles. `scratch`: kChainScratch lanes-wide
-/// values per constraint of the longest chain, plus kChainScratch for its last particle.
+/// lane 0's is the longest; a lane whose chain has ended idles. `scratch`: World::kChainScratch
+/// doubles per constraint of the longest chain, plus as many again (10 per constraint and lane, 4
+/// per particle and lane, up to 4 lanes).
 ///
 /// The forward sweep reads each particle, multiplier, rest length and compliance once and keeps
 /// them in `scratch` for the backward sweep and the residual after the step: x is not written
