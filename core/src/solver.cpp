@@ -1091,17 +1091,21 @@ void World::project_group(Group& g, double h) {
   // before it, 2.9 %.
   project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
   k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
+  // Tethers before stretching too: a tether pulls each particle on its own toward its anchor, and
+  // during a whip that squeezes the edges between neighbours it pulls unequally; the stretch pass
+  // after it takes that back (the 64 x 64 cloth after 200 frames: 2.05 % -> 1.16 %, 32 x 32: 2.77 %
+  // -> 1.03 %).
+  k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
+  if (settings_.realign_passes > 0)
+    k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers
+  else
+    project_tether_runs(g.tethers, x_, w_);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
   if (distance.chain_start.empty() || !first_projection_ || settings_.realign_passes > 0)
     k.distance(distance, inv_h2, x, w);
   else
     k.chain(distance, inv_h2, x, w, chain_scratch_.data());
-  k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
-  if (settings_.realign_passes > 0)
-    k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers
-  else
-    project_tether_runs(g.tethers, x_, w_);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   k.planarity(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   k.plane_offset(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);

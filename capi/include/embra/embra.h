@@ -250,7 +250,9 @@ EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra
  * Every constraint belongs to a group. In each substep the groups are projected in increasing
  * `order` (ties in creation order), each `weight` times in a row, and that whole pass is repeated
  * `iterations` times. Put collisions last so they take precedence (the contact group's order is
- * 1000); give a group a higher weight to make it win over the others.
+ * 1000); give a group a higher weight to make it win over the others. Within one group the kinds
+ * go in a fixed order: soft pins, welds, bending (edge angle, dihedral), tethers, stretch
+ * (distance), volume, panels (planarity, offsets), contacts; a later kind has the final word.
  * ------------------------------------------------------------------------------------------- */
 
 #define EMBRA_GROUP_DEF_VERSION 1
