@@ -346,19 +346,21 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   T reach = splat<T>(0.0);  // the chain's longest rest length
   V3<T> prev_n{splat<T>(0.0), splat<T>(0.0), splat<T>(0.0)};
   int32_t id[N], edge[N];
-  for (int l = 0; l < N; ++l) id[l] = P[l][0];
+  double links_d[N];  // the lane's constraint count
+  for (int l = 0; l < N; ++l) id[l] = P[l][0], links_d[l] = m[l];
+  const T links = L::make(links_d);
   V3<T> p0 = load_point<T>(x, id, 1);
   T w0 = load_value<T>(w, id, 1);
   keep(moved, p0);
   store(w_j, w0);
   for (int32_t k = 0; k < M; ++k) {
-    double on_d[N];
     for (int l = 0; l < N; ++l) {  // an idle lane repeats its last particle: a zero-length, masked link
       const int32_t kk = std::min(k, last[l]);
-      id[l] = P[l][kk + 1], edge[l] = E[l][kk], on_d[l] = k < m[l] ? 1.0 : 0.0;
+      id[l] = P[l][kk + 1], edge[l] = E[l][kk];
     }
-    const T on_v = L::make(on_d);
-    const auto on = on_v > 0.0;
+    // Compared in registers: four scalar flags stored and read back as a vector stall the load.
+    const auto on = splat<T>(static_cast<double>(k)) < links;
+    const T on_v = select(on, splat<T>(1.0), splat<T>(0.0));
     const V3<T> p1 = load_point<T>(x, id, 1);
     const T w1 = load_value<T>(w, id, 1);
     keep(moved + 3 * N * (k + 1), p1);
