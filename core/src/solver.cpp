@@ -142,6 +142,13 @@ EMBRA_ALWAYS_INLINE void scatter4(const int32_t* ids, M ok, T lam_new, const lan
   }
 }
 
+/// The signed angle from n1 to n2 about `edge` (length le): dihedral_angle (constraint_math.hpp)
+/// lane by lane, shared by the projection and the residual measurement so both see the same bits.
+template <class T>
+EMBRA_ALWAYS_INLINE T hinge_angle(const lanes::V3<T>& n1, const lanes::V3<T>& n2, const lanes::V3<T>& edge, T le) {
+  return lanes::atan2(dot(cross(n1, n2), edge), dot(n1, n2) * le);
+}
+
 /// Dihedral angle across the edge x0-x1 of triangles (x0, x1, x2) and (x1, x0, x3) = rest: the
 /// function and gradients of eval_dihedral (constraint_math.hpp), written out flat:
 ///   grad2 = -le / |n1|^2 n1, grad3 = -le / |n2|^2 n2, grad1 = -(s1 grad2 + s2 grad3),
@@ -160,7 +167,7 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   const T le2 = dot(edge, edge), n1sq = dot(n1, n1), n2sq = dot(n2, n2);
   const T le = lanes::sqrt(le2);
   const auto valid = (le > 1e-300) & (n1sq > 1e-300) & (n2sq > 1e-300);
-  T c = lanes::atan2(dot(cross(n1, n2), edge), dot(n1, n2) * le) - r;
+  T c = hinge_angle(n1, n2, edge, le) - r;
   if (!all_within_pi(c)) {  // wrap to (-pi, pi]: rarely needed
     double v[L::count];
     for (int l = 0; l < L::count; ++l) v[l] = wrap_angle(L::get(c, l));
@@ -301,7 +308,7 @@ inline void chain_sweep(SolverArray& a, size_t c, double inv_h2, double* x, cons
 /// The chain step for the chains c0 .. c0 + count - 1 of one colour, side by side, one per lane
 /// (they share no particle; lanes past `count` idle). Chains are longest first within a colour, so
 /// lane 0's is the longest; a lane whose chain has ended idles. `scratch`: World::kChainScratch
-/// doubles per constraint of the longest chain, plus as many again (10 per constraint and lane, 4
+/// doubles per constraint of the longest chain, plus as many again (9 per constraint and lane, 4
 /// per particle and lane, up to 4 lanes).
 ///
 /// The forward sweep reads each particle, multiplier, rest length and compliance once and keeps
@@ -326,9 +333,9 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   }
   const int32_t M = m[0];
   // Per constraint k (N lanes each): direction (3), super-diagonal, 1 / eliminated diagonal,
-  // eliminated right-hand side then dlambda, alpha~, rest length, multiplier before the step, and
-  // 1 where the lane's chain has constraint k (else 0). Per particle j (M + 1 of them): position as
-  // read, then as the step moves it (3), and inverse mass.
+  // eliminated right-hand side then dlambda, alpha~, rest length and multiplier before the step.
+  // Per particle j (M + 1 of them): position as read, then as the step moves it (3), and inverse
+  // mass.
   double* const n = scratch;
   double* const up = n + 3 * N * M;
   double* const inv = up + N * M;
@@ -336,8 +343,7 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   double* const alpha_k = rhs + N * M;
   double* const rest_k = alpha_k + N * M;
   double* const lambda_k = rest_k + N * M;
-  double* const on_k = lambda_k + N * M;
-  double* const moved = on_k + N * M;
+  double* const moved = lambda_k + N * M;
   double* const w_j = moved + 3 * N * (M + 1);
   auto point = [](const double* at) { return V3<T>{L::make(at), L::make(at + N), L::make(at + 2 * N)}; };
   auto keep = [](double* at, const V3<T>& v) { store(at, v.x), store(at + N, v.y), store(at + 2 * N, v.z); };
@@ -360,7 +366,6 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     }
     // Compared in registers: four scalar flags stored and read back as a vector stall the load.
     const auto on = splat<T>(static_cast<double>(k)) < links;
-    const T on_v = select(on, splat<T>(1.0), splat<T>(0.0));
     const V3<T> p1 = load_point<T>(x, id, 1);
     const T w1 = load_value<T>(w, id, 1);
     keep(moved + 3 * N * (k + 1), p1);
@@ -369,7 +374,6 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     const T rest = load_value<T>(a.rest.data(), edge, 1);
     const T lam = load_value<T>(a.lambda.data(), edge, 1);
     store(alpha_k + N * k, alpha), store(rest_k + N * k, rest), store(lambda_k + N * k, lam);
-    store(on_k + N * k, on_v);
     const V3<T> d = p1 - p0;
     const T len = lanes::sqrt(dot(d, d));
     const auto valid = on & (len > 1e-300);
@@ -419,7 +423,7 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
   // The residual after the step.
   T after = splat<T>(0.0);
   for (int32_t k = 0; k < M; ++k) {
-    const auto on = L::make(on_k + N * k) > 0.0;
+    const auto on = splat<T>(static_cast<double>(k)) < links;
     const V3<T> d = point(moved + 3 * N * (k + 1)) - point(moved + 3 * N * k);
     const T alpha = L::make(alpha_k + N * k);
     const T dk = L::make(w_j + N * k) + L::make(w_j + N * (k + 1)) + alpha;
@@ -474,7 +478,7 @@ EMBRA_ALWAYS_INLINE T value_block(const int32_t* ids, const double* x) {
     const V3<T> p2 = load_point<T>(x, ids + 2, 4), p3 = load_point<T>(x, ids + 3, 4);
     const V3<T> edge = p1 - p0;
     const V3<T> n1 = cross(edge, p2 - p0), n2 = cross(p3 - p0, edge);
-    return lanes::atan2(dot(cross(n1, n2), edge), dot(n1, n2) * lanes::sqrt(dot(edge, edge)));
+    return hinge_angle(n1, n2, edge, lanes::sqrt(dot(edge, edge)));
   } else {
     const V3<T> d = load_point<T>(x, ids, 2) - load_point<T>(x, ids + 1, 2);
     return lanes::sqrt(dot(d, d));

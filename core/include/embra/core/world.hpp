@@ -534,9 +534,9 @@ class World {
   SelfCollisionCache self_cache_;
   bool first_projection_ = false;  // the group now projected has not been projected this substep
   std::vector<Vec3> detected_;     // positions when this substep's contacts were found
-  /// Settings::chain_solve's scratch: per link of the longest chain, 10 values for each of (at most)
+  /// Settings::chain_solve's scratch: per link of the longest chain, 9 values for each of (at most)
   /// 4 lanes, and per particle 4 for each lane (the chain step, solver.cpp).
-  static constexpr size_t kChainScratch = 56;
+  static constexpr size_t kChainScratch = 52;
   std::vector<double> measure_values_;                // measure(): one array's constraint values
   std::vector<double> chain_scratch_;                 // kChainScratch per link of the longest chain, + 1
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
