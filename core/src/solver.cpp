@@ -21,6 +21,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 namespace embra {
 
@@ -225,6 +226,223 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   const auto ok = valid & (denom > 0.0);
   const T dl = (-(value - r) - alpha * lam) / denom;
   scatter4<T>(ids, ok, lam + dl, p, wk, dl, g, lambda, x);
+}
+
+/// Whether p lies inside the ball of radius r about c, to rounding (a tether's reach is a sum of
+/// edge lengths: two tethers that just meet, as along a cloth's edge pinned at both ends at exactly
+/// its length, meet at a point only to rounding).
+bool within(const Vec3& p, const Vec3& c, double r) {
+  return (p - c).squaredNorm() <= r * r * (1.0 + 1e-10);
+}
+
+/// The point nearest y on the circle where the spheres about c0 and c1 (radii r0, r1) meet; false
+/// if they do not meet (beyond rounding) or share their centre.
+bool nearest_on_circle(const Vec3& y, const Vec3& c0, double r0, const Vec3& c1, double r1, Vec3& out) {
+  const Vec3 axis = c1 - c0;
+  const double d = axis.norm();
+  if (!(d > 0.0)) return false;
+  const Vec3 u = axis / d;
+  const double a = (d * d + r0 * r0 - r1 * r1) / (2.0 * d);  // the circle's centre, from c0 along u
+  double rho2 = r0 * r0 - a * a;
+  if (rho2 < 0.0) {
+    if (rho2 < -1e-10 * r0 * r0) return false;
+    rho2 = 0.0;  // the spheres touch: the circle is a point
+  }
+  const Vec3 m = c0 + a * u;
+  Vec3 q = (y - m) - (y - m).dot(u) * u;  // y's offset from the circle's centre, in the circle's plane
+  double qn = q.norm();
+  if (!(qn > 0.0)) {  // y on the axis: every point of the circle is as near; take a fixed one
+    q = u.unitOrthogonal();
+    qn = 1.0;
+  }
+  out = m + (std::sqrt(rho2) / qn) * q;
+  return true;
+}
+
+/// Automatic tethers (Settings::tethers), the run r of one particle: the particle goes to the point
+/// nearest it inside all of its tethers at once, the intersection of the balls about its anchors,
+/// rather than inside each in turn. In turn, the last tether of a particle would always have the
+/// final word: along the top edge of a cloth pinned at both ends at exactly its length, where the
+/// balls about the two pins only touch, the particles left of the middle (whose last tether is the
+/// right pin's) were pulled right by every substep's sag and those right of it left, and the edge
+/// across the middle ended squeezed by 2.5 % (the 128 x 128 acceptance cloth at 20 substeps).
+///
+/// The nearest point of the intersection lies on one sphere (the nearest point of that ball, if
+/// inside all the others) or on the circle where two meet (the nearest such point inside all the
+/// others). Where there is none (the anchors are further apart than the tethers reach, or three or
+/// more tethers meet at the answer), the particle goes to the mean of its nearest points on the
+/// tethers it is outside of: a compromise that favours no anchor. Anchors never move (they are the
+/// immovable particles the tethers were made for); a particle that became immovable is left alone.
+/// The multipliers are not kept: automatic tethers have no compliance and report no force. Runs of
+/// exactly two tethers (the default) go through tether_pairs, lanes side by side with the same bits.
+void project_tether_run(const SolverArray& t, size_t r, Vec3* x, const double* w) {
+  constexpr int kMostPairs = 8;  // past this many tethers in play, the compromise
+  const int32_t* entry = &t.run_entry[t.run_start[r]];
+  const int32_t m = t.run_start[r + 1] - t.run_start[r];
+  const int32_t p = t.ids[2 * entry[0]];
+  if (w[p] == 0.0) return;
+  const Vec3 y = x[p];
+  auto anchor = [&](int32_t k) -> const Vec3& { return x[t.ids[2 * entry[k] + 1]]; };
+  auto reach = [&](int32_t k) { return t.rest[entry[k]]; };
+  auto inside_all = [&](const Vec3& q) {
+    for (int32_t k = 0; k < m; ++k)
+      if (!within(q, anchor(k), reach(k))) return false;
+    return true;
+  };
+  auto nearest_on = [&](int32_t k, const Vec3& q) {
+    const Vec3 d = q - anchor(k);
+    const double len = d.norm();
+    return len > reach(k) ? Vec3(anchor(k) + (reach(k) / len) * d) : q;
+  };
+  // In play: the tethers y is outside of, and those a nearest point on one of them is outside of.
+  uint64_t outside = 0, in_play = 0;
+  for (int32_t k = 0; k < m; ++k)
+    if (!within(y, anchor(k), reach(k))) outside |= uint64_t{1} << k;
+  if (outside == 0) return;
+  for (int32_t k = 0; k < m; ++k) {
+    if (!(outside >> k & 1)) continue;
+    in_play |= uint64_t{1} << k;
+    const Vec3 q = nearest_on(k, y);
+    bool done = true;
+    for (int32_t j = 0; j < m; ++j)
+      if (!within(q, anchor(j), reach(j))) done = false, in_play |= uint64_t{1} << j;
+    if (done) {
+      x[p] = q;
+      return;
+    }
+  }
+  double best = std::numeric_limits<double>::infinity();
+  Vec3 answer = y;
+  if (std::popcount(in_play) <= kMostPairs)
+    for (int32_t i = 0; i < m; ++i) {
+      if (!(in_play >> i & 1)) continue;
+      for (int32_t j = i + 1; j < m; ++j) {
+        Vec3 q;
+        if (!(in_play >> j & 1) || !nearest_on_circle(y, anchor(i), reach(i), anchor(j), reach(j), q)) continue;
+        const double dist = (q - y).squaredNorm();
+        if (dist < best && inside_all(q)) best = dist, answer = q;
+      }
+    }
+  if (best == std::numeric_limits<double>::infinity()) {
+    Vec3 sum = Vec3::Zero();
+    for (int32_t k = 0; k < m; ++k)
+      if (outside >> k & 1) sum += nearest_on(k, y);
+    answer = sum / std::popcount(outside);
+  }
+  x[p] = answer;
+}
+
+/// Whether any lane of mask m is set.
+template <class M>
+EMBRA_ALWAYS_INLINE bool any(M m) {
+  if constexpr (std::is_arithmetic_v<M>) {
+    return m != 0;
+  } else {
+    for (int l = 0; l < static_cast<int>(sizeof m / sizeof m[0]); ++l)
+      if (m[l]) return true;
+    return false;
+  }
+}
+
+/// Lane-wise m ? a : b of points.
+template <class M, class T>
+EMBRA_ALWAYS_INLINE lanes::V3<T> select3(M m, const lanes::V3<T>& a, const lanes::V3<T>& b) {
+  return {lanes::select(m, a.x, b.x), lanes::select(m, a.y, b.y), lanes::select(m, a.z, b.z)};
+}
+
+/// lanes::dot(q - c, q - c) <= r^2 (1 + 1e-10): within(), lane by lane.
+template <class T>
+EMBRA_ALWAYS_INLINE auto within_lanes(const lanes::V3<T>& q, const lanes::V3<T>& c, T r) {
+  const lanes::V3<T> d = q - c;
+  return dot(d, d) <= r * r * (1.0 + 1e-10);
+}
+
+/// project_tether_run for Lanes<T>::count particles of exactly two tethers each (the default,
+/// Settings::tethers = 2), side by side: the same operations in the same order, every branch taken
+/// in every lane and the answer selected, so the bits are those of the one-at-a-time run. A lane
+/// whose circle is degenerate (anchors at one point, or the particle on their axis) is left to
+/// project_tether_run.
+template <class T>
+EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* runs, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  constexpr int N = L::count;
+  int32_t pid[N], a0[N], a1[N];
+  double r0d[N], r1d[N];
+  for (int l = 0; l < N; ++l) {
+    const int32_t* e = &t.run_entry[t.run_start[runs[l]]];
+    pid[l] = t.ids[2 * e[0]], a0[l] = t.ids[2 * e[0] + 1], a1[l] = t.ids[2 * e[1] + 1];
+    r0d[l] = t.rest[e[0]], r1d[l] = t.rest[e[1]];
+  }
+  const V3<T> y = load_point<T>(x, pid, 1), c0 = load_point<T>(x, a0, 1), c1 = load_point<T>(x, a1, 1);
+  const T r0 = L::make(r0d), r1 = L::make(r1d), wp = load_value<T>(w, pid, 1);
+  const auto out0 = !within_lanes(y, c0, r0), out1 = !within_lanes(y, c1, r1);
+  const auto moved = (out0 | out1) & (wp != 0.0);
+  if (!any(moved)) return;
+  // The nearest point of each sphere (used only where y is outside it, so len > r).
+  const V3<T> d0 = y - c0, d1 = y - c1;
+  const V3<T> q0 = c0 + (r0 / lanes::sqrt(dot(d0, d0))) * d0;
+  const V3<T> q1 = c1 + (r1 / lanes::sqrt(dot(d1, d1))) * d1;
+  const auto q0_in0 = within_lanes(q0, c0, r0), q0_in1 = within_lanes(q0, c1, r1);
+  const auto q1_in0 = within_lanes(q1, c0, r0), q1_in1 = within_lanes(q1, c1, r1);
+  const auto done0 = out0 & q0_in0 & q0_in1;
+  const auto done1 = out1 & q1_in0 & q1_in1;
+  V3<T> to = select3(done0, q0, q1);
+  auto open = moved & (!(done0 | done1));  // lanes with no answer yet
+  auto degenerate = open & (!open);        // lanes left to project_tether_run
+  if (any(open)) {
+    // Both tethers in play: the circle where the spheres meet (nearest_on_circle).
+    const auto play0 = out0 | (out1 & (!q1_in0)), play1 = (out0 & (!q0_in1)) | out1;
+    const auto circle = open & play0 & play1;
+    if (any(circle)) {
+      const V3<T> axis = c1 - c0;
+      const T d = lanes::sqrt(dot(axis, axis));
+      const V3<T> u = {axis.x / d, axis.y / d, axis.z / d};
+      const T a = (d * d + r0 * r0 - r1 * r1) / (2.0 * d);
+      const T rho2 = r0 * r0 - a * a;
+      const auto meet = circle & (d > 0.0) & (!(rho2 < -1e-10 * r0 * r0));
+      const V3<T> m = c0 + a * u;
+      const V3<T> ym = y - m;
+      const V3<T> q = ym - dot(ym, u) * u;
+      const T qn = lanes::sqrt(dot(q, q));
+      const V3<T> qc = m + (lanes::sqrt(select(rho2 < 0.0, splat<T>(0.0), rho2)) / qn) * q;
+      const V3<T> dc = qc - y;
+      const auto found = meet & (dot(dc, dc) < std::numeric_limits<double>::infinity()) & within_lanes(qc, c0, r0) &
+                         within_lanes(qc, c1, r1);
+      degenerate = meet & (!(qn > 0.0));
+      to = select3(found, qc, to);
+      open = open & (!found);
+    }
+    if (any(open)) {
+      // Otherwise the mean of the nearest points of the spheres y is outside of.
+      const T zero = splat<T>(0.0);
+      V3<T> sum = {zero, zero, zero};
+      sum = select3(out0, sum + q0, sum);
+      sum = select3(out1, sum + q1, sum);
+      const T count = select(out0, splat<T>(1.0), zero) + select(out1, splat<T>(1.0), zero);
+      to = select3(open, V3<T>{sum.x / count, sum.y / count, sum.z / count}, to);
+    }
+  }
+  for (int l = 0; l < N; ++l) {
+    if (!L::on(moved, l)) continue;
+    if (L::on(degenerate, l)) {
+      project_tether_run(t, static_cast<size_t>(runs[l]), reinterpret_cast<Vec3*>(x), w);
+      continue;
+    }
+    double* xp = x + 3 * static_cast<int64_t>(pid[l]);
+    xp[0] = L::get(to.x, l), xp[1] = L::get(to.y, l), xp[2] = L::get(to.z, l);
+  }
+}
+
+/// The automatic tethers' runs of exactly two tethers (SolverArray::pair_runs), a block of lanes at
+/// a time; the rest one at a time.
+template <class T>
+EMBRA_ALWAYS_INLINE void tether_pairs(const SolverArray& t, double* x, const double* w) {
+  constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
+  const size_t n = t.pair_runs.size();
+  size_t i = 0;
+  for (; i + lanes_n <= n; i += lanes_n) tether_pair_block<T>(t, &t.pair_runs[i], x, w);
+  for (; i < n; ++i) tether_pair_block<double>(t, &t.pair_runs[i], x, w);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };
@@ -509,6 +727,9 @@ EMBRA_ALWAYS_INLINE void values(const SolverArray& a, const double* x, double* o
   EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                           \
   EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                          \
   EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                       \
+  ATTR void NAME##_tether_pairs(const SolverArray& t, double* x, const double* w) {                    \
+    tether_pairs<T>(t, x, w);                                                                          \
+  }                                                                                                    \
   ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
     chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
   }                                                                                                    \
@@ -528,6 +749,7 @@ struct Kernels {
   void (*chain)(SolverArray&, double, double*, const double*, double*);
   void (*distance_values)(const SolverArray&, const double*, double*);
   void (*dihedral_values)(const SolverArray&, const double*, double*);
+  void (*tether_pairs)(const SolverArray&, double*, const double*);
   const char* name;
 };
 
@@ -544,20 +766,20 @@ EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels() {
   static const Kernels chosen = [] {
-    const Kernels scalar{scalar_distance,        scalar_tether,          scalar_dihedral,
-                         scalar_planarity,       scalar_plane_offset,    scalar_chain,
-                         scalar_distance_values, scalar_dihedral_values, "scalar"};
+    const Kernels scalar{scalar_distance,     scalar_tether, scalar_dihedral,        scalar_planarity,
+                         scalar_plane_offset, scalar_chain,  scalar_distance_values, scalar_dihedral_values,
+                         scalar_tether_pairs, "scalar"};
     const char* forced = std::getenv("EMBRA_KERNELS");
     const std::string want = forced ? forced : "";
     if (want == "scalar") return scalar;
 #if EMBRA_LANES_VECTOR
-    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity, vec2_plane_offset,
-                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, "vec2"};
+    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,    vec2_plane_offset,
+                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_pairs, "vec2"};
     if (want == "vec2") return vec2;
 #if defined(EMBRA_HAVE_AVX2_KERNELS)
     if (__builtin_cpu_supports("avx2"))
-      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity, avx2_plane_offset,
-                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, "avx2"};
+      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,    avx2_plane_offset,
+                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_pairs, "avx2"};
 #endif
     return vec2;
 #else
@@ -579,110 +801,6 @@ void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std
     for (int k = 0; k < 3; ++k) a.lambda[3 * i + k] += dl[k];
     x[p0] += w[p0] * dl;
     x[p1] -= w[p1] * dl;
-  }
-}
-
-/// Whether p lies inside the ball of radius r about c, to rounding (a tether's reach is a sum of
-/// edge lengths: two tethers that just meet, as along a cloth's edge pinned at both ends at exactly
-/// its length, meet at a point only to rounding).
-bool within(const Vec3& p, const Vec3& c, double r) {
-  return (p - c).squaredNorm() <= r * r * (1.0 + 1e-10);
-}
-
-/// The point nearest y on the circle where the spheres about c0 and c1 (radii r0, r1) meet; false
-/// if they do not meet (beyond rounding) or share their centre.
-bool nearest_on_circle(const Vec3& y, const Vec3& c0, double r0, const Vec3& c1, double r1, Vec3& out) {
-  const Vec3 axis = c1 - c0;
-  const double d = axis.norm();
-  if (!(d > 0.0)) return false;
-  const Vec3 u = axis / d;
-  const double a = (d * d + r0 * r0 - r1 * r1) / (2.0 * d);  // the circle's centre, from c0 along u
-  double rho2 = r0 * r0 - a * a;
-  if (rho2 < 0.0) {
-    if (rho2 < -1e-10 * r0 * r0) return false;
-    rho2 = 0.0;  // the spheres touch: the circle is a point
-  }
-  const Vec3 m = c0 + a * u;
-  Vec3 q = (y - m) - (y - m).dot(u) * u;  // y's offset from the circle's centre, in the circle's plane
-  double qn = q.norm();
-  if (!(qn > 0.0)) {  // y on the axis: every point of the circle is as near; take a fixed one
-    q = u.unitOrthogonal();
-    qn = 1.0;
-  }
-  out = m + (std::sqrt(rho2) / qn) * q;
-  return true;
-}
-
-/// Automatic tethers (Settings::tethers), a particle at a time: each particle goes to the point
-/// nearest it inside all of its tethers at once, the intersection of the balls about its anchors,
-/// rather than inside each in turn. In turn, the last tether of a particle would always have the
-/// final word: along the top edge of a cloth pinned at both ends at exactly its length, where the
-/// balls about the two pins only touch, the particles left of the middle (whose last tether is the
-/// right pin's) were pulled right by every substep's sag and those right of it left, and the edge
-/// across the middle ended squeezed by 2.5 % (the 128 x 128 acceptance cloth at 20 substeps).
-///
-/// The nearest point of the intersection lies on one sphere (the nearest point of that ball, if
-/// inside all the others) or on the circle where two meet (the nearest such point inside all the
-/// others). Where there is none (the anchors are further apart than the tethers reach, or three or
-/// more tethers meet at the answer), the particle goes to the mean of its nearest points on the
-/// tethers it is outside of: a compromise that favours no anchor. Anchors never move (they are the
-/// immovable particles the tethers were made for); a particle that became immovable is left alone.
-/// The multipliers are not kept: automatic tethers have no compliance and report no force.
-void project_tether_runs(const SolverArray& t, std::vector<Vec3>& x, const std::vector<double>& w) {
-  constexpr int kMostPairs = 8;  // past this many tethers in play, the compromise
-  for (size_t r = 0; r + 1 < t.run_start.size(); ++r) {
-    const int32_t* entry = &t.run_entry[t.run_start[r]];
-    const int32_t m = t.run_start[r + 1] - t.run_start[r];
-    const int32_t p = t.ids[2 * entry[0]];
-    if (w[p] == 0.0) continue;
-    const Vec3 y = x[p];
-    auto anchor = [&](int32_t k) -> const Vec3& { return x[t.ids[2 * entry[k] + 1]]; };
-    auto reach = [&](int32_t k) { return t.rest[entry[k]]; };
-    auto inside_all = [&](const Vec3& q) {
-      for (int32_t k = 0; k < m; ++k)
-        if (!within(q, anchor(k), reach(k))) return false;
-      return true;
-    };
-    auto nearest_on = [&](int32_t k, const Vec3& q) {
-      const Vec3 d = q - anchor(k);
-      const double len = d.norm();
-      return len > reach(k) ? Vec3(anchor(k) + (reach(k) / len) * d) : q;
-    };
-    // In play: the tethers y is outside of, and those a nearest point on one of them is outside of.
-    uint64_t outside = 0, in_play = 0;
-    for (int32_t k = 0; k < m; ++k)
-      if (!within(y, anchor(k), reach(k))) outside |= uint64_t{1} << k;
-    if (outside == 0) continue;
-    bool done = false;
-    for (int32_t k = 0; k < m && !done; ++k) {
-      if (!(outside >> k & 1)) continue;
-      in_play |= uint64_t{1} << k;
-      const Vec3 q = nearest_on(k, y);
-      done = true;
-      for (int32_t j = 0; j < m; ++j)
-        if (!within(q, anchor(j), reach(j))) done = false, in_play |= uint64_t{1} << j;
-      if (done) x[p] = q;
-    }
-    if (done) continue;
-    double best = std::numeric_limits<double>::infinity();
-    Vec3 answer = y;
-    if (std::popcount(in_play) <= kMostPairs)
-      for (int32_t i = 0; i < m; ++i) {
-        if (!(in_play >> i & 1)) continue;
-        for (int32_t j = i + 1; j < m; ++j) {
-          Vec3 q;
-          if (!(in_play >> j & 1) || !nearest_on_circle(y, anchor(i), reach(i), anchor(j), reach(j), q)) continue;
-          const double dist = (q - y).squaredNorm();
-          if (dist < best && inside_all(q)) best = dist, answer = q;
-        }
-      }
-    if (best == std::numeric_limits<double>::infinity()) {
-      Vec3 sum = Vec3::Zero();
-      for (int32_t k = 0; k < m; ++k)
-        if (outside >> k & 1) sum += nearest_on(k, y);
-      answer = sum / std::popcount(outside);
-    }
-    x[p] = answer;
   }
 }
 
@@ -1104,8 +1222,10 @@ void World::project_group(Group& g, double h) {
   k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
   if (settings_.realign_passes > 0)
     k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers
-  else
-    project_tether_runs(g.tethers, x_, w_);
+  else {
+    k.tether_pairs(g.tethers, x, w);
+    for (int32_t r : g.tethers.other_runs) project_tether_run(g.tethers, static_cast<size_t>(r), x_.data(), w);
+  }
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
   if (distance.chain_start.empty() || !first_projection_ || settings_.realign_passes > 0)

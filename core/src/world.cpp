@@ -1185,6 +1185,9 @@ void World::rebuild_solver() {
         sorted.run_entry[i] = position[i];
       }
       sorted.run_start.push_back(static_cast<int32_t>(order.size()));
+      for (size_t r = 0; r + 1 < sorted.run_start.size(); ++r)
+        (sorted.run_start[r + 1] - sorted.run_start[r] == 2 ? sorted.pair_runs : sorted.other_runs)
+            .push_back(static_cast<int32_t>(r));
       t = std::move(sorted);
       t.lambda.assign(t.size(), 0.0);
     }

@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # The solver's kernel sets (scalar, 2-wide SSE2, 4-wide AVX2; chosen at run time, EMBRA_KERNELS
-# forces one) compute the same bits: a cloth (distance, dihedral and tether kernels) and a panel
-# mesh (distance, planarity and plane-offset kernels) stepped with each set end in byte-identical
-# final.json files.
+# forces one) compute the same bits: a draped cloth (distance and dihedral kernels), a pinned cloth
+# (chain, dihedral and automatic tether kernels) and a panel mesh (distance, planarity and
+# plane-offset kernels) stepped with each set end in byte-identical final.json files.
 #
 # usage: kernels_same_bits.sh EMBRA_CLI SOURCE_DIR WORK_DIR
 set -u
 cli=$1 source=$2 work=$3
 mkdir -p "$work"
 fail=0
-for scene in examples/cloth_drape.json:60 examples/large/poq_drape_16.json:40; do
+for scene in examples/cloth_drape.json:60 tests/scenes/kernels/pinned_cloth.json:90 examples/large/poq_drape_16.json:40; do
   path=$source/${scene%%:*} frames=${scene##*:} name=$(basename "${scene%%:*}" .json)
   first=""
   for set in scalar vec2 avx2; do

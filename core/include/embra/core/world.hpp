@@ -252,6 +252,8 @@ struct SolverArray {
   // run_entry[run_start[r] .. run_start[r + 1]) of this (colour-ordered) array, all pulling the same
   // particle towards immovable anchors; runs share no particle.
   std::vector<int32_t> run_start, run_entry;
+  // The runs of exactly two tethers (projected side by side, a block of lanes at a time) and the others.
+  std::vector<int32_t> pair_runs, other_runs;
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
 };
