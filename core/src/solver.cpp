@@ -1333,7 +1333,7 @@ void World::settle_contacts_on_surface() {
   }
 }
 
-void World::update_velocities(double h) {
+int32_t World::update_velocities(double h) {
   // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
   // it is below mu_s times the normal push, else reduced by mu_k times it.
   Group& g = groups_[settings_.contact_group.index];
@@ -1393,17 +1393,18 @@ void World::update_velocities(double h) {
   }
   settle_contacts_on_surface();
   const double inv_h = 1.0 / h;
+  int32_t bad = -1;
+  double rate_before = 0.0, decay = 1.0;  // exp(-rate h), computed again only when the rate changes
   for (size_t i = 0; i < x_.size(); ++i) {
     v_[i] = (x_[i] - x_prev_[i]) * inv_h;
     const double rate = settings_.damping + damping_[i];
-    if (rate > 0.0) v_[i] *= std::exp(-rate * h);
+    if (rate > 0.0) {
+      if (rate != rate_before) rate_before = rate, decay = std::exp(-rate * h);
+      v_[i] *= decay;
+    }
+    if (bad < 0 && !(x_[i].allFinite() && v_[i].allFinite())) bad = static_cast<int32_t>(i);
   }
-}
-
-int32_t World::first_non_finite() const {
-  for (size_t i = 0; i < x_.size(); ++i)
-    if (!x_[i].allFinite() || !v_[i].allFinite()) return static_cast<int32_t>(i);
-  return -1;
+  return bad;
 }
 
 void World::measure() {
@@ -1525,8 +1526,7 @@ void World::step() {
       }
     }
     catch_late_contacts();
-    update_velocities(h);
-    const int32_t bad = first_non_finite();
+    const int32_t bad = update_velocities(h);
     if (bad >= 0) {
       x_ = x0;
       v_ = v0;

@@ -498,9 +498,8 @@ class World {
   void realign(const std::vector<Vec3>& predicted);
   void project_group(Group& g, double h);
   void project_contacts(Group& g, double h);
-  void update_velocities(double h);
+  int32_t update_velocities(double h);  // the first particle left with a non-finite x or v, or -1
   void measure();
-  int32_t first_non_finite() const;
   void apply_fields(double h, double time);  // fields.cpp: field forces into v_ (movable particles)
   void project_volumes(double h);            // fields.cpp: the pressure fields' volume constraints
 
