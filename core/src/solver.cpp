@@ -435,14 +435,17 @@ EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* 
 }
 
 /// The automatic tethers' runs of exactly two tethers (SolverArray::pair_runs), a block of lanes at
-/// a time; the rest one at a time.
+/// a time, the remainder one at a time. The scalar kernel set takes them all one at a time
+/// (project_tether_run), so comparing kernel sets (EMBRA_KERNELS, scenes.kernels_same_bits) checks
+/// the lanes against the one-at-a-time projection.
 template <class T>
 EMBRA_ALWAYS_INLINE void tether_pairs(const SolverArray& t, double* x, const double* w) {
   constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
   const size_t n = t.pair_runs.size();
   size_t i = 0;
-  for (; i + lanes_n <= n; i += lanes_n) tether_pair_block<T>(t, &t.pair_runs[i], x, w);
-  for (; i < n; ++i) tether_pair_block<double>(t, &t.pair_runs[i], x, w);
+  if constexpr (lanes_n > 1)
+    for (; i + lanes_n <= n; i += lanes_n) tether_pair_block<T>(t, &t.pair_runs[i], x, w);
+  for (; i < n; ++i) project_tether_run(t, static_cast<size_t>(t.pair_runs[i]), reinterpret_cast<Vec3*>(x), w);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };
