@@ -360,7 +360,7 @@ EMBRA_ALWAYS_INLINE auto within_lanes(const lanes::V3<T>& q, const lanes::V3<T>&
 /// project_tether_run for Lanes<T>::count particles of exactly two tethers each (the default,
 /// Settings::tethers = 2), side by side: the same operations in the same order, every branch taken
 /// in every lane and the answer selected, so the bits are those of the one-at-a-time run. A lane
-/// whose circle is degenerate (anchors at one point, or the particle on their axis) is left to
+/// whose particle lies on the anchors' axis (every point of the circle equally near) is left to
 /// project_tether_run.
 template <class T>
 EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* runs, double* x, const double* w) {
@@ -387,9 +387,9 @@ EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* 
   const auto q1_in0 = within_lanes(q1, c0, r0), q1_in1 = within_lanes(q1, c1, r1);
   const auto done0 = out0 & q0_in0 & q0_in1;
   const auto done1 = out1 & q1_in0 & q1_in1;
-  V3<T> to = select3(done0, q0, q1);
+  V3<T> to = select3(done0, q0, q1);       // the first sphere's answer if it has one, else the second's
   auto open = moved & (!(done0 | done1));  // lanes with no answer yet
-  auto degenerate = open & (!open);        // lanes left to project_tether_run
+  auto degenerate = open & (!open);        // lanes left to project_tether_run (none yet)
   if (any(open)) {
     // Both tethers in play: the circle where the spheres meet (nearest_on_circle).
     const auto play0 = out0 | (out1 & (!q1_in0)), play1 = (out0 & (!q0_in1)) | out1;
