@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <numbers>
+#include <type_traits>
 
 #if defined(__GNUC__) || defined(__clang__)
 // The vector types only ever live inside always-inlined code of one function; no ABI is involved.
@@ -119,6 +120,24 @@ EMBRA_ALWAYS_INLINE V3<T> cross(const V3<T>& a, const V3<T>& b) {
 template <class T>
 EMBRA_ALWAYS_INLINE T dot(const V3<T>& a, const V3<T>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+/// Whether any lane of mask m is set.
+template <class M>
+EMBRA_ALWAYS_INLINE bool any(M m) {
+  if constexpr (std::is_arithmetic_v<M>) {
+    return m != 0;
+  } else {
+    for (int l = 0; l < static_cast<int>(sizeof m / sizeof m[0]); ++l)
+      if (m[l]) return true;
+    return false;
+  }
+}
+
+/// Lane-wise m ? a : b of points.
+template <class M, class T>
+EMBRA_ALWAYS_INLINE V3<T> select3(M m, const V3<T>& a, const V3<T>& b) {
+  return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
 }
 
 /// Lane l takes the point x + 3 ids[l * stride] (packed xyz triples).

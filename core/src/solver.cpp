@@ -21,7 +21,6 @@
 #include <cstring>
 #include <limits>
 #include <string>
-#include <type_traits>
 
 namespace embra {
 
@@ -274,7 +273,7 @@ bool nearest_on_circle(const Vec3& y, const Vec3& c0, double r0, const Vec3& c1,
 /// tethers it is outside of: a compromise that favours no anchor. Anchors never move (they are the
 /// immovable particles the tethers were made for); a particle that became immovable is left alone.
 /// The multipliers are not kept: automatic tethers have no compliance and report no force. Runs of
-/// exactly two tethers (the default) go through tether_pairs, lanes side by side with the same bits.
+/// exactly two tethers (the default) go side by side in lanes, with the same bits (tether_runs).
 void project_tether_run(const SolverArray& t, size_t r, Vec3* x, const double* w) {
   constexpr int kMostPairs = 8;  // past this many tethers in play, the compromise
   const int32_t* entry = &t.run_entry[t.run_start[r]];
@@ -332,24 +331,6 @@ void project_tether_run(const SolverArray& t, size_t r, Vec3* x, const double* w
   x[p] = answer;
 }
 
-/// Whether any lane of mask m is set.
-template <class M>
-EMBRA_ALWAYS_INLINE bool any(M m) {
-  if constexpr (std::is_arithmetic_v<M>) {
-    return m != 0;
-  } else {
-    for (int l = 0; l < static_cast<int>(sizeof m / sizeof m[0]); ++l)
-      if (m[l]) return true;
-    return false;
-  }
-}
-
-/// Lane-wise m ? a : b of points.
-template <class M, class T>
-EMBRA_ALWAYS_INLINE lanes::V3<T> select3(M m, const lanes::V3<T>& a, const lanes::V3<T>& b) {
-  return {lanes::select(m, a.x, b.x), lanes::select(m, a.y, b.y), lanes::select(m, a.z, b.z)};
-}
-
 /// lanes::dot(q - c, q - c) <= r^2 (1 + 1e-10): within(), lane by lane.
 template <class T>
 EMBRA_ALWAYS_INLINE auto within_lanes(const lanes::V3<T>& q, const lanes::V3<T>& c, T r) {
@@ -389,7 +370,7 @@ EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* 
   const auto done1 = out1 & q1_in0 & q1_in1;
   V3<T> to = select3(done0, q0, q1);       // the first sphere's answer if it has one, else the second's
   auto open = moved & (!(done0 | done1));  // lanes with no answer yet
-  auto degenerate = open & (!open);        // lanes left to project_tether_run (none yet)
+  decltype(open) degenerate{};             // lanes left to project_tether_run (none yet)
   if (any(open)) {
     // Both tethers in play: the circle where the spheres meet (nearest_on_circle).
     const auto play0 = out0 | (out1 & (!q1_in0)), play1 = (out0 & (!q0_in1)) | out1;
@@ -434,18 +415,20 @@ EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* 
   }
 }
 
-/// The automatic tethers' runs of exactly two tethers (SolverArray::pair_runs), a block of lanes at
-/// a time, the remainder one at a time. The scalar kernel set takes them all one at a time
-/// (project_tether_run), so comparing kernel sets (EMBRA_KERNELS, scenes.kernels_same_bits) checks
-/// the lanes against the one-at-a-time projection.
+/// Every automatic tether run: those of exactly two tethers (SolverArray::pair_runs) a block of
+/// lanes at a time, their remainder and the other runs one at a time. The scalar kernel set takes
+/// them all one at a time (project_tether_run), so comparing kernel sets (EMBRA_KERNELS,
+/// scenes.kernels_same_bits) checks the lanes against the one-at-a-time projection.
 template <class T>
-EMBRA_ALWAYS_INLINE void tether_pairs(const SolverArray& t, double* x, const double* w) {
+EMBRA_ALWAYS_INLINE void tether_runs(const SolverArray& t, double* x, const double* w) {
   constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
   const size_t n = t.pair_runs.size();
   size_t i = 0;
   if constexpr (lanes_n > 1)
     for (; i + lanes_n <= n; i += lanes_n) tether_pair_block<T>(t, &t.pair_runs[i], x, w);
-  for (; i < n; ++i) project_tether_run(t, static_cast<size_t>(t.pair_runs[i]), reinterpret_cast<Vec3*>(x), w);
+  Vec3* const points = reinterpret_cast<Vec3*>(x);
+  for (; i < n; ++i) project_tether_run(t, static_cast<size_t>(t.pair_runs[i]), points, w);
+  for (int32_t r : t.other_runs) project_tether_run(t, static_cast<size_t>(r), points, w);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };
@@ -730,8 +713,8 @@ EMBRA_ALWAYS_INLINE void values(const SolverArray& a, const double* x, double* o
   EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                           \
   EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                          \
   EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                       \
-  ATTR void NAME##_tether_pairs(const SolverArray& t, double* x, const double* w) {                    \
-    tether_pairs<T>(t, x, w);                                                                          \
+  ATTR void NAME##_tether_runs(const SolverArray& t, double* x, const double* w) {                     \
+    tether_runs<T>(t, x, w);                                                                           \
   }                                                                                                    \
   ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
     chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
@@ -752,7 +735,7 @@ struct Kernels {
   void (*chain)(SolverArray&, double, double*, const double*, double*);
   void (*distance_values)(const SolverArray&, const double*, double*);
   void (*dihedral_values)(const SolverArray&, const double*, double*);
-  void (*tether_pairs)(const SolverArray&, double*, const double*);
+  void (*tether_runs)(const SolverArray&, double*, const double*);
   const char* name;
 };
 
@@ -771,18 +754,18 @@ const Kernels& kernels() {
   static const Kernels chosen = [] {
     const Kernels scalar{scalar_distance,     scalar_tether, scalar_dihedral,        scalar_planarity,
                          scalar_plane_offset, scalar_chain,  scalar_distance_values, scalar_dihedral_values,
-                         scalar_tether_pairs, "scalar"};
+                         scalar_tether_runs,  "scalar"};
     const char* forced = std::getenv("EMBRA_KERNELS");
     const std::string want = forced ? forced : "";
     if (want == "scalar") return scalar;
 #if EMBRA_LANES_VECTOR
-    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,    vec2_plane_offset,
-                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_pairs, "vec2"};
+    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,   vec2_plane_offset,
+                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_runs, "vec2"};
     if (want == "vec2") return vec2;
 #if defined(EMBRA_HAVE_AVX2_KERNELS)
     if (__builtin_cpu_supports("avx2"))
-      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,    avx2_plane_offset,
-                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_pairs, "avx2"};
+      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,   avx2_plane_offset,
+                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_runs, "avx2"};
 #endif
     return vec2;
 #else
@@ -1225,10 +1208,8 @@ void World::project_group(Group& g, double h) {
   k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
   if (settings_.realign_passes > 0)
     k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers
-  else {
-    k.tether_pairs(g.tethers, x, w);
-    for (int32_t r : g.tethers.other_runs) project_tether_run(g.tethers, static_cast<size_t>(r), x_.data(), w);
-  }
+  else
+    k.tether_runs(g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
   if (distance.chain_start.empty() || !first_projection_ || settings_.realign_passes > 0)
