@@ -2,10 +2,12 @@
 // status code and a thread-local message; nothing unwinds into the host.
 #include "embra/embra.h"
 
+#include "embra/core/limits.hpp"
 #include "embra/core/panels.hpp"
 #include "embra/core/world.hpp"
 #include "embra/io/scene.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -13,11 +15,16 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <thread>
 #include <vector>
 
 struct embra_world {
   embra::World world;
   embra::io::SceneMeta meta;  // names, actions and tolerances of a scene; empty for an API-built world
+  /// Held by the call in progress (guard): a second concurrent call gets EMBRA_ERROR_LOCKED.
+  mutable std::atomic<bool> busy{false};
+  /// embra_world_cancel: set by any thread, consumed by the step that sees it.
+  std::atomic<bool> cancel{false};
 };
 
 namespace {
@@ -54,6 +61,8 @@ embra_status map(embra::ErrorCode code) {
       return EMBRA_ERROR_NUMERICAL;
     case embra::ErrorCode::internal:
       return EMBRA_ERROR_INTERNAL;
+    case embra::ErrorCode::cancelled:
+      return EMBRA_ERROR_CANCELLED;
   }
   return EMBRA_ERROR_INTERNAL;
 }
@@ -88,6 +97,32 @@ embra_status guard(const char* function, F&& body) noexcept {
 template <class T>
 void need(const T* p, const char* name) {
   if (p == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(name) + " is NULL");
+}
+
+/// One call at a time on a world: held for the call's duration, refused (never waited for) when
+/// another call holds it.
+class WorldLock {
+ public:
+  explicit WorldLock(const embra_world& world) : busy_(world.busy) {
+    if (busy_.exchange(true, std::memory_order_acquire))
+      refuse(EMBRA_ERROR_LOCKED, "the world is in use by a call in progress on another thread (one call at a time)");
+  }
+  ~WorldLock() { busy_.store(false, std::memory_order_release); }
+  WorldLock(const WorldLock&) = delete;
+  WorldLock& operator=(const WorldLock&) = delete;
+
+ private:
+  std::atomic<bool>& busy_;
+};
+
+/// guard() for a call on a world: the world must be non-null and not in use by another call.
+template <class W, class F>
+embra_status guard(const char* function, W* world, F&& body) noexcept {
+  return guard(function, [&] {
+    need(world, "world");
+    const WorldLock lock(*world);
+    body();
+  });
 }
 
 void need_version(int32_t got, int32_t want, const char* def) {
@@ -213,6 +248,16 @@ auto live_generation(const std::vector<T>& slots) {
 
 }  // namespace
 
+// The header's numbers are the core's (limits.hpp): a drift is a compile error.
+static_assert(EMBRA_MAX_ABS_VALUE == embra::limits::kMaxAbsValue);
+static_assert(EMBRA_MIN_POSITIVE == embra::limits::kMinPositive);
+static_assert(EMBRA_MAX_DT == embra::limits::kMaxDt);
+static_assert(EMBRA_MAX_UNIT_SCALE == embra::limits::kMaxUnitScale);
+static_assert(EMBRA_MAX_PARTICLES == embra::limits::kMaxParticles);
+static_assert(EMBRA_MAX_CONSTRAINTS == embra::limits::kMaxConstraints);
+static_assert(EMBRA_MAX_PASSES_PER_STEP == embra::limits::kMaxPassesPerStep);
+static_assert(EMBRA_MAX_OBJ_BYTES == embra::limits::kMaxObjBytes);
+
 extern "C" {
 
 const char* embra_last_error_message(void) {
@@ -239,6 +284,8 @@ const char* embra_status_name(embra_status status) {
       return "EMBRA_ERROR_NUMERICAL";
     case EMBRA_ERROR_INTERNAL:
       return "EMBRA_ERROR_INTERNAL";
+    case EMBRA_ERROR_CANCELLED:
+      return "EMBRA_ERROR_CANCELLED";
     default:
       return "EMBRA_UNKNOWN_STATUS";
   }
@@ -279,12 +326,15 @@ embra_status embra_world_create(embra_world** out_world, const embra_solver_def*
 }
 
 void embra_world_destroy(embra_world* world) {
+  if (world == nullptr) return;
+  // A call still running on another thread finishes first (destroying under it would free what it
+  // uses); later calls with this pointer are the host's use after free.
+  while (world->busy.exchange(true, std::memory_order_acquire)) std::this_thread::yield();
   delete world;
 }
 
 embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* out_def) {
-  return guard("embra_world_get_solver", [&] {
-    need(world, "world");
+  return guard("embra_world_get_solver", world, [&] {
     need(out_def, "out_def");
     const embra_solver_def d = from_settings(world->world.settings());
     *out_def = d;
@@ -292,8 +342,7 @@ embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* 
 }
 
 embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* def) {
-  return guard("embra_world_set_solver", [&] {
-    need(world, "world");
+  return guard("embra_world_set_solver", world, [&] {
     need(def, "def");
     need_version(def->version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
     world->world.set_settings(to_settings(*def));
@@ -301,8 +350,7 @@ embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* 
 }
 
 embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]) {
-  return guard("embra_world_set_gravity", [&] {
-    need(world, "world");
+  return guard("embra_world_set_gravity", world, [&] {
     need(gravity, "gravity");
     world->world.set_gravity(vec(gravity));
     drop_actions(world->meta, embra::io::Action::Type::gravity, embra::Id{});
@@ -310,8 +358,7 @@ embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]
 }
 
 embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts) {
-  return guard("embra_world_get_counts", [&] {
-    need(world, "world");
+  return guard("embra_world_get_counts", world, [&] {
     need(out_counts, "out_counts");
     const embra::World& w = world->world;
     embra_world_counts c{};
@@ -327,8 +374,7 @@ embra_status embra_world_get_counts(const embra_world* world, embra_world_counts
 
 embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out, int32_t capacity,
                                     int32_t* out_count) {
-  return guard("embra_world_get_bodies", [&] {
-    need(world, "world");
+  return guard("embra_world_get_bodies", world, [&] {
     // Bodies are never destroyed: each keeps generation 1.
     list_ids(
         world->world.body_count(), [](size_t) { return 1u; }, out, capacity, out_count);
@@ -337,23 +383,20 @@ embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out
 
 embra_status embra_world_get_groups(const embra_world* world, embra_group_id* out, int32_t capacity,
                                     int32_t* out_count) {
-  return guard("embra_world_get_groups", [&] {
-    need(world, "world");
+  return guard("embra_world_get_groups", world, [&] {
     list_ids(world->world.groups().size(), live_generation(world->world.groups()), out, capacity, out_count);
   });
 }
 
 embra_status embra_world_get_pins(const embra_world* world, embra_pin_id* out, int32_t capacity, int32_t* out_count) {
-  return guard("embra_world_get_pins", [&] {
-    need(world, "world");
+  return guard("embra_world_get_pins", world, [&] {
     list_ids(world->world.pins().size(), live_generation(world->world.pins()), out, capacity, out_count);
   });
 }
 
 embra_status embra_world_get_colliders(const embra_world* world, embra_collider_id* out, int32_t capacity,
                                        int32_t* out_count) {
-  return guard("embra_world_get_colliders", [&] {
-    need(world, "world");
+  return guard("embra_world_get_colliders", world, [&] {
     list_ids(world->world.colliders().size(), live_generation(world->world.colliders()), out, capacity, out_count);
   });
 }
@@ -369,8 +412,7 @@ embra_group_def embra_default_group_def(void) {
 }
 
 embra_status embra_group_create(embra_world* world, const embra_group_def* def, embra_group_id* out_group) {
-  return guard("embra_group_create", [&] {
-    need(world, "world");
+  return guard("embra_group_create", world, [&] {
     need(def, "def");
     need(out_group, "out_group");
     need_version(def->version, EMBRA_GROUP_DEF_VERSION, "embra_group_def");
@@ -382,45 +424,33 @@ embra_status embra_group_create(embra_world* world, const embra_group_def* def, 
 }
 
 embra_status embra_group_destroy(embra_world* world, embra_group_id group) {
-  return guard("embra_group_destroy", [&] {
-    need(world, "world");
-    world->world.destroy_group(to_id(group));
-  });
+  return guard("embra_group_destroy", world, [&] { world->world.destroy_group(to_id(group)); });
 }
 
 embra_status embra_group_set_order(embra_world* world, embra_group_id group, int32_t order) {
-  return guard("embra_group_set_order", [&] {
-    need(world, "world");
-    world->world.set_group_order(to_id(group), order);
-  });
+  return guard("embra_group_set_order", world, [&] { world->world.set_group_order(to_id(group), order); });
 }
 
 embra_status embra_group_set_weight(embra_world* world, embra_group_id group, int32_t weight) {
-  return guard("embra_group_set_weight", [&] {
-    need(world, "world");
-    world->world.set_group_weight(to_id(group), weight);
-  });
+  return guard("embra_group_set_weight", world, [&] { world->world.set_group_weight(to_id(group), weight); });
 }
 
 embra_status embra_world_default_group(const embra_world* world, embra_group_id* out_group) {
-  return guard("embra_world_default_group", [&] {
-    need(world, "world");
+  return guard("embra_world_default_group", world, [&] {
     need(out_group, "out_group");
     *out_group = from_id<embra_group_id>(world->world.default_group());
   });
 }
 
 embra_status embra_world_contact_group(const embra_world* world, embra_group_id* out_group) {
-  return guard("embra_world_contact_group", [&] {
-    need(world, "world");
+  return guard("embra_world_contact_group", world, [&] {
     need(out_group, "out_group");
     *out_group = from_id<embra_group_id>(world->world.contact_group());
   });
 }
 
 embra_status embra_group_get_report(const embra_world* world, embra_group_id group, embra_group_report* out_report) {
-  return guard("embra_group_get_report", [&] {
-    need(world, "world");
+  return guard("embra_group_get_report", world, [&] {
     need(out_report, "out_report");
     const embra::GroupReport& r = world->world.group(to_id(group)).report;
     *out_report = embra_group_report{r.count, r.residual_max, r.residual_rms};
@@ -455,8 +485,7 @@ embra_body_def embra_default_body_def(void) {
 
 embra_status embra_body_create(embra_world* world, const embra_body_def* def, embra_body_id* out_body,
                                int32_t* out_first_particle) {
-  return guard("embra_body_create", [&] {
-    need(world, "world");
+  return guard("embra_body_create", world, [&] {
     need(def, "def");
     need(out_body, "out_body");
     need_version(def->version, EMBRA_BODY_DEF_VERSION, "embra_body_def");
@@ -487,8 +516,7 @@ embra_status embra_body_create(embra_world* world, const embra_body_def* def, em
 
 embra_status embra_body_get_particles(const embra_world* world, embra_body_id body, int32_t* out_first,
                                       int32_t* out_count) {
-  return guard("embra_body_get_particles", [&] {
-    need(world, "world");
+  return guard("embra_body_get_particles", world, [&] {
     need(out_first, "out_first");
     need(out_count, "out_count");
     const embra::BodyInfo& b = world->world.body(to_id(body));
@@ -499,8 +527,7 @@ embra_status embra_body_get_particles(const embra_world* world, embra_body_id bo
 
 embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, double scale, double scale_u,
                                        double scale_v) {
-  return guard("embra_body_set_rest_scale", [&] {
-    need(world, "world");
+  return guard("embra_body_set_rest_scale", world, [&] {
     world->world.set_rest_scale(to_id(body), scale, scale_u, scale_v);
     drop_actions(world->meta, embra::io::Action::Type::rest_scale, to_id(body));
   });
@@ -522,8 +549,7 @@ embra_constraint_def embra_default_constraint_def(void) {
 }
 
 embra_status embra_constraint_add(embra_world* world, const embra_constraint_def* def) {
-  return guard("embra_constraint_add", [&] {
-    need(world, "world");
+  return guard("embra_constraint_add", world, [&] {
     need(def, "def");
     need_version(def->version, EMBRA_CONSTRAINT_DEF_VERSION, "embra_constraint_def");
     const int32_t n = embra_constraint_arity(def->kind);
@@ -548,8 +574,7 @@ embra_constraint_batch_def embra_default_constraint_batch_def(void) {
 }
 
 embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def) {
-  return guard("embra_constraints_add", [&] {
-    need(world, "world");
+  return guard("embra_constraints_add", world, [&] {
     need(def, "def");
     need_version(def->version, EMBRA_CONSTRAINT_BATCH_DEF_VERSION, "embra_constraint_batch_def");
     const int32_t n = embra_constraint_arity(def->kind);
@@ -575,8 +600,7 @@ embra_pin_def embra_default_pin_def(void) {
 }
 
 embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin) {
-  return guard("embra_pin_create", [&] {
-    need(world, "world");
+  return guard("embra_pin_create", world, [&] {
     need(def, "def");
     need(out_pin, "out_pin");
     need_version(def->version, EMBRA_PIN_DEF_VERSION, "embra_pin_def");
@@ -590,16 +614,14 @@ embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embr
 }
 
 embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
-  return guard("embra_pin_destroy", [&] {
-    need(world, "world");
+  return guard("embra_pin_destroy", world, [&] {
     world->world.destroy_pin(to_id(pin));
     drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
   });
 }
 
 embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]) {
-  return guard("embra_pin_set_target", [&] {
-    need(world, "world");
+  return guard("embra_pin_set_target", world, [&] {
     need(target, "target");
     world->world.set_pin_target(to_id(pin), vec(target));
     drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
@@ -607,8 +629,7 @@ embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const do
 }
 
 embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]) {
-  return guard("embra_pin_get_target", [&] {
-    need(world, "world");
+  return guard("embra_pin_get_target", world, [&] {
     need(out_target, "out_target");
     const embra::Vec3& t = world->world.pin(to_id(pin)).target;
     for (int k = 0; k < 3; ++k) out_target[k] = t[k];
@@ -616,8 +637,7 @@ embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, do
 }
 
 embra_status embra_pin_get_particle(const embra_world* world, embra_pin_id pin, int32_t* out_particle) {
-  return guard("embra_pin_get_particle", [&] {
-    need(world, "world");
+  return guard("embra_pin_get_particle", world, [&] {
     need(out_particle, "out_particle");
     *out_particle = world->world.pin(to_id(pin)).particle;
   });
@@ -647,8 +667,7 @@ Eigen::Quaterniond quat(const double* wxyz) {
 }  // namespace
 
 embra_status embra_collider_create(embra_world* world, const embra_collider_def* def, embra_collider_id* out_collider) {
-  return guard("embra_collider_create", [&] {
-    need(world, "world");
+  return guard("embra_collider_create", world, [&] {
     need(def, "def");
     need(out_collider, "out_collider");
     need_version(def->version, EMBRA_COLLIDER_DEF_VERSION, "embra_collider_def");
@@ -685,8 +704,7 @@ embra_status embra_collider_create(embra_world* world, const embra_collider_def*
 }
 
 embra_status embra_collider_destroy(embra_world* world, embra_collider_id collider) {
-  return guard("embra_collider_destroy", [&] {
-    need(world, "world");
+  return guard("embra_collider_destroy", world, [&] {
     world->world.destroy_collider(to_id(collider));
     drop_actions(world->meta, embra::io::Action::Type::collider_pose, to_id(collider));
   });
@@ -694,8 +712,7 @@ embra_status embra_collider_destroy(embra_world* world, embra_collider_id collid
 
 embra_status embra_collider_set_transform(embra_world* world, embra_collider_id collider, const double position[3],
                                           const double rotation[4]) {
-  return guard("embra_collider_set_transform", [&] {
-    need(world, "world");
+  return guard("embra_collider_set_transform", world, [&] {
     need(position, "position");
     need(rotation, "rotation");
     world->world.set_collider_transform(to_id(collider), vec(position), quat(rotation));
@@ -705,8 +722,7 @@ embra_status embra_collider_set_transform(embra_world* world, embra_collider_id 
 
 embra_status embra_collider_get_transform(const embra_world* world, embra_collider_id collider, double out_position[3],
                                           double out_rotation[4]) {
-  return guard("embra_collider_get_transform", [&] {
-    need(world, "world");
+  return guard("embra_collider_get_transform", world, [&] {
     need(out_position, "out_position");
     need(out_rotation, "out_rotation");
     const embra::ColliderDesc& d = world->world.collider(to_id(collider)).desc;
@@ -721,17 +737,28 @@ embra_status embra_collider_get_transform(const embra_world* world, embra_collid
 // --- stepping ----------------------------------------------------------------------------------
 
 embra_status embra_world_step(embra_world* world) {
-  return guard("embra_world_step", [&] {
-    need(world, "world");
+  const embra_status status = guard("embra_world_step", world, [&] {
+    embra::StepControl control;
     if (!world->meta.actions.empty())
-      embra::io::apply_actions(world->world, world->meta, world->world.report().frame + 1);
-    world->world.step();
+      control.before_frame = [world](embra::World& w) {
+        embra::io::apply_actions(w, world->meta, w.report().frame + 1);
+      };
+    control.cancel = &world->cancel;
+    world->world.step(control);
+  });
+  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+  return status;
+}
+
+embra_status embra_world_cancel(embra_world* world) {
+  return guard("embra_world_cancel", [&] {
+    need(world, "world");
+    world->cancel.store(true, std::memory_order_relaxed);
   });
 }
 
 embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report) {
-  return guard("embra_world_get_report", [&] {
-    need(world, "world");
+  return guard("embra_world_get_report", world, [&] {
     need(out_report, "out_report");
     const embra::StepReport& r = world->world.report();
     embra_step_report o{};
@@ -749,8 +776,7 @@ embra_status embra_world_get_report(const embra_world* world, embra_step_report*
 }
 
 embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
-  return guard("embra_world_get_warning", [&] {
-    need(world, "world");
+  return guard("embra_world_get_warning", world, [&] {
     need(out_warning, "out_warning");
     const embra::Warning& w = world->world.warning();
     *out_warning = embra_warning{w.frame, w.particle, 0};
@@ -759,8 +785,7 @@ embra_status embra_world_get_warning(const embra_world* world, embra_warning* ou
 
 embra_status embra_world_get_positions(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
                                        int32_t count) {
-  return guard("embra_world_get_positions", [&] {
-    need(world, "world");
+  return guard("embra_world_get_positions", world, [&] {
     read_range(world->world, capacity, first, count, out_xyz);
     const auto& x = world->world.positions();
     for (int32_t i = 0; i < count; ++i)
@@ -770,8 +795,7 @@ embra_status embra_world_get_positions(const embra_world* world, double* out_xyz
 
 embra_status embra_world_get_velocities(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
                                         int32_t count) {
-  return guard("embra_world_get_velocities", [&] {
-    need(world, "world");
+  return guard("embra_world_get_velocities", world, [&] {
     read_range(world->world, capacity, first, count, out_xyz);
     const auto& v = world->world.velocities();
     for (int32_t i = 0; i < count; ++i)
@@ -780,16 +804,14 @@ embra_status embra_world_get_velocities(const embra_world* world, double* out_xy
 }
 
 embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count) {
-  return guard("embra_world_set_positions", [&] {
-    need(world, "world");
+  return guard("embra_world_set_positions", world, [&] {
     need_count(count, "count");
     world->world.set_positions(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
   });
 }
 
 embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count) {
-  return guard("embra_world_set_velocities", [&] {
-    need(world, "world");
+  return guard("embra_world_set_velocities", world, [&] {
     need_count(count, "count");
     world->world.set_velocities(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
   });
@@ -799,8 +821,7 @@ embra_status embra_world_set_velocities(embra_world* world, const double* xyz, i
 
 embra_status embra_body_get_triangles(const embra_world* world, embra_body_id body, int32_t* out, int64_t capacity,
                                       int64_t* out_count) {
-  return guard("embra_body_get_triangles", [&] {
-    need(world, "world");
+  return guard("embra_body_get_triangles", world, [&] {
     need(out_count, "out_count");
     const std::vector<int32_t>& t = world->world.body(to_id(body)).triangles;
     const int64_t n = static_cast<int64_t>(t.size());
@@ -835,8 +856,7 @@ embra_panel_mesh_def embra_default_panel_mesh_def(void) {
 
 embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_def* def, embra_body_id* out_body,
                                      int32_t* out_first_particle) {
-  return guard("embra_panel_mesh_create", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_create", world, [&] {
     need(def, "def");
     need(out_body, "out_body");
     need_version(def->version, EMBRA_PANEL_MESH_DEF_VERSION, "embra_panel_mesh_def");
@@ -902,15 +922,16 @@ embra_tolerances from_tolerances(const embra::Tolerances& t) {
 
 void check_tolerances(const embra_tolerances& t) {
   need_version(t.version, EMBRA_TOLERANCES_VERSION, "embra_tolerances");
-  if (!std::isfinite(t.unit_scale) || !(t.unit_scale > 0.0))
-    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "tolerances.unit_scale must be finite and > 0");
+  if (!(t.unit_scale >= embra::limits::kMinPositive && t.unit_scale <= embra::limits::kMaxUnitScale))
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "tolerances.unit_scale must be in [1e-300, 1e12]");
   const std::pair<const char*, embra_tolerance> all[] = {{"planarity", t.planarity},
                                                          {"planarity_distance", t.planarity_distance},
                                                          {"thickness", t.thickness},
                                                          {"miter", t.miter}};
   for (const auto& [name, v] : all) {
-    if (!std::isfinite(v.target) || !std::isfinite(v.max) || v.target < 0.0 || v.max < 0.0)
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("tolerances.") + name + " must be finite and >= 0");
+    if (!(v.target >= 0.0 && v.target <= embra::limits::kMaxAbsValue && v.max >= 0.0 &&
+          v.max <= embra::limits::kMaxAbsValue))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("tolerances.") + name + " must be finite and in [0, 1e300]");
     if (v.target > v.max)
       refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("tolerances.") + name + ".target is above its max");
   }
@@ -937,8 +958,7 @@ void write_text(const std::string& text, char* out, int64_t capacity, int64_t* o
 }  // namespace
 
 embra_status embra_panel_mesh_get_panel_count(const embra_world* world, embra_body_id body, int32_t* out_count) {
-  return guard("embra_panel_mesh_get_panel_count", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_get_panel_count", world, [&] {
     need(out_count, "out_count");
     *out_count = layout_of(world, body).panel_count();
   });
@@ -949,16 +969,14 @@ embra_tolerances embra_default_tolerances(void) {
 }
 
 embra_status embra_world_get_tolerances(const embra_world* world, embra_tolerances* out_tolerances) {
-  return guard("embra_world_get_tolerances", [&] {
-    need(world, "world");
+  return guard("embra_world_get_tolerances", world, [&] {
     need(out_tolerances, "out_tolerances");
     *out_tolerances = from_tolerances(embra::io::parse_tolerances(world->meta.tolerances));
   });
 }
 
 embra_status embra_world_set_tolerances(embra_world* world, const embra_tolerances* tolerances) {
-  return guard("embra_world_set_tolerances", [&] {
-    need(world, "world");
+  return guard("embra_world_set_tolerances", world, [&] {
     need(tolerances, "tolerances");
     check_tolerances(*tolerances);
     world->meta.tolerances = embra::io::tolerances_json(to_tolerances(*tolerances));
@@ -967,8 +985,7 @@ embra_status embra_world_set_tolerances(embra_world* world, const embra_toleranc
 
 embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_id body,
                                           const embra_tolerances* tolerances, embra_panel_metrics* out_metrics) {
-  return guard("embra_panel_mesh_get_metrics", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_get_metrics", world, [&] {
     need(out_metrics, "out_metrics");
     const embra::PanelLayout& l = layout_of(world, body);
     embra::Tolerances t;
@@ -997,8 +1014,7 @@ embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_i
 
 embra_status embra_panel_mesh_get_corner_gap(const embra_world* world, embra_body_id body,
                                              embra_metric_summary* out_summary) {
-  return guard("embra_panel_mesh_get_corner_gap", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_get_corner_gap", world, [&] {
     need(out_summary, "out_summary");
     const embra::PanelLayout& l = layout_of(world, body);
     const embra::PanelReport r = embra::report_panels(embra::measure_panels(l, world->world.positions()), {});
@@ -1008,8 +1024,7 @@ embra_status embra_panel_mesh_get_corner_gap(const embra_world* world, embra_bod
 
 embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_body_id body, int32_t metric,
                                                 double* out, int64_t capacity, int64_t* out_count) {
-  return guard("embra_panel_mesh_get_vertex_errors", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_get_vertex_errors", world, [&] {
     need(out_count, "out_count");
     const embra::PanelLayout& l = layout_of(world, body);
     if (metric < 0 || metric >= embra::kPanelMetricCount)
@@ -1031,8 +1046,7 @@ embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_
 
 embra_status embra_panel_mesh_export_cuts(const embra_world* world, embra_body_id body, int32_t format, char* out,
                                           int64_t capacity, int64_t* out_length) {
-  return guard("embra_panel_mesh_export_cuts", [&] {
-    need(world, "world");
+  return guard("embra_panel_mesh_export_cuts", world, [&] {
     need(out_length, "out_length");
     const embra::PanelLayout& l = layout_of(world, body);
     if (format != EMBRA_CUTS_JSON && format != EMBRA_CUTS_CSV)
@@ -1046,10 +1060,16 @@ embra_status embra_panel_mesh_export_cuts(const embra_world* world, embra_body_i
 // --- JSON scenes -------------------------------------------------------------------------------
 
 namespace {
-embra_world* load(std::string_view text, const std::string& base_dir) {
+embra_world* load_with(std::string_view text, const embra::io::LoadOptions& options) {
   embra::io::SceneMeta meta;
-  std::unique_ptr<embra::World> w = embra::io::load_scene(text, base_dir, meta);
+  std::unique_ptr<embra::World> w = embra::io::load_scene(text, options, meta);
   return new embra_world{std::move(*w), std::move(meta)};
+}
+
+embra_world* load(std::string_view text, const std::string& base_dir) {
+  embra::io::LoadOptions options;
+  options.base_dir = base_dir;
+  return load_with(text, options);
 }
 
 std::string folder_of(const std::string& path) {
@@ -1065,6 +1085,30 @@ embra_status embra_world_load_json(embra_world** out_world, const char* json, in
     need(json, "json");
     need_count(length, "length");
     *out_world = load(std::string_view(json, static_cast<size_t>(length)), base_dir ? base_dir : ".");
+  });
+}
+
+embra_load_options embra_default_load_options(void) {
+  embra_load_options o{};
+  o.version = EMBRA_LOAD_OPTIONS_VERSION;
+  return o;
+}
+
+embra_status embra_world_load_json_with_options(embra_world** out_world, const char* json, int64_t length,
+                                                const embra_load_options* options) {
+  if (out_world != nullptr) *out_world = nullptr;
+  return guard("embra_world_load_json_with_options", [&] {
+    need(out_world, "out_world");
+    need(json, "json");
+    need_count(length, "length");
+    need(options, "options");
+    need_version(options->version, EMBRA_LOAD_OPTIONS_VERSION, "embra_load_options");
+    if (options->allow_paths_outside_base != 0 && options->allow_paths_outside_base != 1)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "options.allow_paths_outside_base must be 0 or 1");
+    embra::io::LoadOptions o;
+    o.base_dir = options->base_dir ? options->base_dir : ".";
+    o.allow_paths_outside_base = options->allow_paths_outside_base == 1;
+    *out_world = load_with(std::string_view(json, static_cast<size_t>(length)), o);
   });
 }
 
@@ -1094,8 +1138,7 @@ embra_status embra_world_load_file(embra_world** out_world, const char* path) {
 }
 
 embra_status embra_world_save_json(const embra_world* world, char* out, int64_t capacity, int64_t* out_length) {
-  return guard("embra_world_save_json", [&] {
-    need(world, "world");
+  return guard("embra_world_save_json", world, [&] {
     need(out_length, "out_length");
     const std::string text = embra::io::save_scene(world->world, world->meta);
     const int64_t n = static_cast<int64_t>(text.size()) + 1;
@@ -1114,8 +1157,7 @@ embra_status embra_world_save_json(const embra_world* world, char* out, int64_t 
 }
 
 embra_status embra_world_save_file(const embra_world* world, const char* path) {
-  return guard("embra_world_save_file", [&] {
-    need(world, "world");
+  return guard("embra_world_save_file", world, [&] {
     need(path, "path");
     const std::string text = embra::io::save_scene(world->world, world->meta);
     const std::string tmp = std::string(path) + ".tmp";
@@ -1134,8 +1176,7 @@ embra_status embra_world_save_file(const embra_world* world, const char* path) {
 }
 
 embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out_frames) {
-  return guard("embra_world_get_scene_frames", [&] {
-    need(world, "world");
+  return guard("embra_world_get_scene_frames", world, [&] {
     need(out_frames, "out_frames");
     *out_frames = world->meta.frames;
   });
@@ -1173,8 +1214,7 @@ embra_wind_def embra_default_wind_def(void) {
 }
 
 embra_status embra_wind_create(embra_world* world, const embra_wind_def* def, embra_field_id* out_field) {
-  return guard("embra_wind_create", [&] {
-    need(world, "world");
+  return guard("embra_wind_create", world, [&] {
     need(def, "def");
     need(out_field, "out_field");
     need_version(def->version, EMBRA_WIND_DEF_VERSION, "embra_wind_def");
@@ -1203,8 +1243,7 @@ embra_pressure_def embra_default_pressure_def(void) {
 }
 
 embra_status embra_pressure_create(embra_world* world, const embra_pressure_def* def, embra_field_id* out_field) {
-  return guard("embra_pressure_create", [&] {
-    need(world, "world");
+  return guard("embra_pressure_create", world, [&] {
     need(def, "def");
     need(out_field, "out_field");
     need_version(def->version, EMBRA_PRESSURE_DEF_VERSION, "embra_pressure_def");
@@ -1231,8 +1270,7 @@ embra_surface_tension_def embra_default_surface_tension_def(void) {
 
 embra_status embra_surface_tension_create(embra_world* world, const embra_surface_tension_def* def,
                                           embra_field_id* out_field) {
-  return guard("embra_surface_tension_create", [&] {
-    need(world, "world");
+  return guard("embra_surface_tension_create", world, [&] {
     need(def, "def");
     need(out_field, "out_field");
     need_version(def->version, EMBRA_SURFACE_TENSION_DEF_VERSION, "embra_surface_tension_def");
@@ -1262,8 +1300,7 @@ embra_vortex_def embra_default_vortex_def(void) {
 }
 
 embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def, embra_field_id* out_field) {
-  return guard("embra_vortex_create", [&] {
-    need(world, "world");
+  return guard("embra_vortex_create", world, [&] {
     need(def, "def");
     need(out_field, "out_field");
     need_version(def->version, EMBRA_VORTEX_DEF_VERSION, "embra_vortex_def");
@@ -1282,16 +1319,14 @@ embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def
 }
 
 embra_status embra_field_destroy(embra_world* world, embra_field_id field) {
-  return guard("embra_field_destroy", [&] {
-    need(world, "world");
+  return guard("embra_field_destroy", world, [&] {
     world->world.destroy_field(to_id(field));
     world->meta.field_names.erase(field.index);
   });
 }
 
 embra_status embra_world_get_field_count(const embra_world* world, int32_t* out_count) {
-  return guard("embra_world_get_field_count", [&] {
-    need(world, "world");
+  return guard("embra_world_get_field_count", world, [&] {
     need(out_count, "out_count");
     *out_count = static_cast<int32_t>(world->world.field_count());
   });

@@ -1,5 +1,6 @@
 #include "collider_shapes.hpp"
 
+#include "check.hpp"
 #include "self_collision.hpp"
 
 #include <algorithm>
@@ -14,11 +15,11 @@ namespace embra {
 namespace {
 
 [[noreturn]] void refuse(const std::string& message) {
-  throw Error(ErrorCode::invalid_argument, message);
+  invalid(message);
 }
 
 void finite(double v, const std::string& what) {
-  if (!std::isfinite(v)) refuse(what + " is not a finite number");
+  check_finite(v, what);
 }
 
 /// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection 5.1.5) and the

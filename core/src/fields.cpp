@@ -4,6 +4,8 @@
 // groups in every pass.
 #include "embra/core/world.hpp"
 
+#include "check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -13,19 +15,6 @@
 namespace embra {
 
 namespace {
-
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::invalid_argument, message);
-}
-
-void check_finite(double value, const std::string& what) {
-  if (!std::isfinite(value)) invalid(what + " is not a finite number");
-}
-
-void check_non_negative(double value, const std::string& what) {
-  check_finite(value, what);
-  if (value < 0.0) invalid(what + " must be >= 0");
-}
 
 void check_vec(const Vec3& v, const std::string& what) {
   for (int k = 0; k < 3; ++k) check_finite(v[k], what);

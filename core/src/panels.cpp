@@ -1,6 +1,8 @@
 // Panel meshes (Planar Offset Quads): the builder, the metrics and the cut list. See panels.hpp.
 #include "embra/core/panels.hpp"
 
+#include "check.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -13,19 +15,6 @@
 namespace embra {
 
 namespace {
-
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::invalid_argument, message);
-}
-
-void check_finite(double v, const char* what) {
-  if (!std::isfinite(v)) invalid(std::string(what) + " must be finite");
-}
-
-void check_non_negative(double v, const char* what) {
-  check_finite(v, what);
-  if (v < 0.0) invalid(std::string(what) + " must be >= 0");
-}
 
 Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 n = (b - a).cross(c - a);
@@ -374,6 +363,9 @@ std::string panel_cuts_csv(const std::vector<PanelCut>& cuts) {
 void panel_grid(int32_t n, int32_t m, double size, const Vec3& origin, std::vector<double>& out_positions,
                 std::vector<int32_t>& out_quads) {
   if (n < 1 || m < 1 || n > 4096 || m > 4096) invalid("panel grid must have 1 to 4096 panels each way");
+  if (8 * int64_t{n} * m > limits::kMaxParticles)
+    invalid("a panel grid of " + std::to_string(n) + " x " + std::to_string(m) +
+            " panels needs more than the 2097152 particles a world holds (8 per panel)");
   check_finite(size, "panel size");
   if (!(size > 0.0)) invalid("panel size must be > 0");
   for (int c = 0; c < 3; ++c) check_finite(origin[c], "panel grid origin");
@@ -397,12 +389,14 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     invalid("panel mesh quads must be a non-empty array of 4 indices per quad");
   const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
   const int64_t np = static_cast<int64_t>(d.quads.size() / 4);
-  if (8 * np + world.particle_count() > INT32_MAX / 4) invalid("too many panels");
+  if (8 * np + world.particle_count() > limits::kMaxParticles)
+    invalid("a world holds at most 2097152 particles; " + std::to_string(np) +
+            " panels (8 particles each) would make " + std::to_string(8 * np + world.particle_count()));
   for (double c : d.positions) check_finite(c, "panel mesh vertex coordinate");
   check_finite(d.thickness, "panel thickness");
   if (!(d.thickness > 0.0)) invalid("panel thickness must be > 0");
-  check_non_negative(d.mass, "panel mesh mass");
-  check_non_negative(d.density, "panel mesh density");
+  check_zero_or_positive(d.mass, "panel mesh mass");
+  check_zero_or_positive(d.density, "panel mesh density");
   if (d.mass == 0.0 && d.density == 0.0) invalid("panel mesh needs a mass or a density > 0");
   check_non_negative(d.damping, "panel mesh damping");
   check_non_negative(d.friction_static, "panel mesh friction_static");

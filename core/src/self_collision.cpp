@@ -92,14 +92,21 @@ class Grid {
  private:
   static constexpr int64_t kMaxCells = 512;
 
+  /// The cell of a coordinate, clamped to +-1e15 cells; NaN (a step about to fail) goes to -1e15.
   int64_t coord(double v) const {
     const double c = std::floor(v * inv_cell_);
-    return static_cast<int64_t>(std::clamp(c, -1e15, 1e15));
+    if (!(c > -1e15)) return -1000000000000000;
+    if (!(c < 1e15)) return 1000000000000000;
+    return static_cast<int64_t>(c);
   }
+  /// Cells a box covers, or kMaxCells + 1 for more (or for a box whose corners are not ordered,
+  /// which only non-finite coordinates make).
   int64_t cells(const Box& b) const {
     int64_t n = 1;
     for (int a = 0; a < 3; ++a) {
-      n *= coord(b.hi[a]) - coord(b.lo[a]) + 1;
+      const int64_t span = coord(b.hi[a]) - coord(b.lo[a]) + 1;
+      if (span < 1 || span > kMaxCells) return kMaxCells + 1;
+      n *= span;
       if (n > kMaxCells) return kMaxCells + 1;
     }
     return n;
@@ -136,7 +143,7 @@ double mean_extent(std::span<const Box> boxes) {
   double sum = 0.0;
   for (const Box& b : boxes) sum += b.extent();
   const double mean = boxes.empty() ? 0.0 : sum / static_cast<double>(boxes.size());
-  return mean > 0.0 ? mean : 1.0;
+  return mean > 0.0 && std::isfinite(mean) ? mean : 1.0;
 }
 
 Box box_of(std::initializer_list<Vec3> points, double grow) {

@@ -26,6 +26,14 @@ namespace embra {
 
 namespace {
 
+/// The coordinates of a position array as one array of doubles (x0 y0 z0 x1 ...); null when empty.
+double* coords(std::vector<Vec3>& x) {
+  return x.empty() ? nullptr : x.front().data();
+}
+const double* coords(const std::vector<Vec3>& x) {
+  return x.empty() ? nullptr : x.front().data();
+}
+
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are packed xyz triples");
 
 template <Kind K>
@@ -847,7 +855,7 @@ void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, 
   if constexpr (kLanes) {
     values.resize(a.size());
     const Kernels& k = kernels();
-    (K == Kind::dihedral ? k.dihedral_values : k.distance_values)(a, x.data()->data(), values.data());
+    (K == Kind::dihedral ? k.dihedral_values : k.distance_values)(a, coords(x), values.data());
   }
   for (size_t i = 0; i < a.size(); ++i) {
     double value;
@@ -1189,7 +1197,7 @@ void World::project_group(Group& g, double h) {
     p.lambda += dl;
     x_[p.particle] += w * dl;
   }
-  double* x = x_.data()->data();
+  double* x = coords(x_);
   const double* w = w_.data();
   project_weld(g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
   const Kernels& k = kernels();
@@ -1468,64 +1476,108 @@ void World::measure() {
   report_.settled = report_.max_speed <= settings_.settle_speed;
 }
 
-void World::step() {
-  if (solver_dirty_)
-    rebuild_solver();
-  else if (rest_dirty_)
-    refresh_rest();
-  // Kept to restore on a numerical failure: the call must leave the world as it found it. (The
-  // constraints' multipliers live in the solver arrays during the step and are only copied back to
-  // the constraint arrays once the frame has succeeded.)
-  const std::vector<Vec3> x0 = x_, v0 = v_;
-  std::vector<Vec3> pin_lambda0;
-  for (const Pin& p : pins_) pin_lambda0.push_back(p.lambda);
+World::FrameStart World::frame_start() const {
+  FrameStart f;
+  f.x = x_;
+  f.v = v_;
+  for (const Pin& p : pins_) {
+    f.pin_lambda.push_back(p.lambda);
+    f.pin_target.push_back(p.target);
+  }
+  for (const Collider& c : colliders_) {
+    f.collider_position.push_back(c.desc.position);
+    f.collider_rotation.push_back(c.desc.rotation);
+  }
+  for (const BodyInfo& b : bodies_) f.rest_scale.push_back({b.rest_scale, b.rest_scale_u, b.rest_scale_v});
+  f.gravity = settings_.gravity;
+  return f;
+}
 
-  const int substeps = settings_.substeps;
-  const double h = settings_.dt / substeps;
-  for (int s = 0; s < substeps; ++s) {
-    const double alpha = static_cast<double>(s + 1) / substeps;
-    move_colliders(alpha);
-    predict(h, alpha);
-    find_contacts();
-    find_self_contacts();
-    find_face_contacts();
-    reset_multipliers();
-    if (settings_.realign_passes > 0) predicted_ = x_;
-    for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
-      if (pass > 0) realign(predicted_);
-      // Chebyshev acceleration acts on iterations 2 .. iterations - 2 (chebyshev_step): none below 4.
-      const double rho = settings_.iterations > 3 ? settings_.chebyshev_rho_milli / 1000.0 : 0.0;
-      double omega = 1.0;
-      for (int it = 0; it < settings_.iterations; ++it) {
-        if (rho > 0.0) chebyshev_now_ = x_;
-        project_volumes(h);  // fields.cpp
-        for (int32_t slot : order_) {
-          Group& g = groups_[slot];
-          for (int k = 0; k < g.desc.weight; ++k) {
-            first_projection_ = it == 0 && k == 0;  // the chain solve's turn (chain_pass)
-            project_group(g, h);
+void World::restore(const FrameStart& f) {
+  x_ = f.x;
+  v_ = f.v;
+  x_prev_ = f.x;
+  for (size_t i = 0; i < pins_.size(); ++i) {
+    pins_[i].lambda = f.pin_lambda[i];
+    pins_[i].target = f.pin_target[i];
+  }
+  for (size_t i = 0; i < colliders_.size(); ++i) {
+    Collider& c = colliders_[i];
+    c.desc.position = f.collider_position[i];
+    c.desc.rotation = f.collider_rotation[i];
+    c.position = c.position_prev = c.frame_position;
+    c.rotation = c.rotation_prev = c.frame_rotation;
+  }
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    BodyInfo& b = bodies_[i];
+    if (b.rest_scale != f.rest_scale[i][0] || b.rest_scale_u != f.rest_scale[i][1] ||
+        b.rest_scale_v != f.rest_scale[i][2]) {
+      b.rest_scale = f.rest_scale[i][0];
+      b.rest_scale_u = f.rest_scale[i][1];
+      b.rest_scale_v = f.rest_scale[i][2];
+      rest_dirty_ = true;
+    }
+  }
+  settings_.gravity = f.gravity;
+}
+
+void World::step(const StepControl& control) {
+  // Kept to restore a frame that does not complete: the call must leave the world as it found it.
+  // (The constraints' multipliers live in the solver arrays during the step and are only copied
+  // back to the constraint arrays once the frame has succeeded.)
+  const FrameStart start = frame_start();
+  const auto cancelled = [&] { return control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed); };
+  try {
+    if (control.before_frame) control.before_frame(*this);
+    if (solver_dirty_)
+      rebuild_solver();
+    else if (rest_dirty_)
+      refresh_rest();
+    const int substeps = settings_.substeps;
+    const double h = settings_.dt / substeps;
+    for (int s = 0; s < substeps; ++s) {
+      const double alpha = static_cast<double>(s + 1) / substeps;
+      move_colliders(alpha);
+      predict(h, alpha);
+      find_contacts();
+      find_self_contacts();
+      find_face_contacts();
+      reset_multipliers();
+      if (settings_.realign_passes > 0) predicted_ = x_;
+      for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
+        if (pass > 0) realign(predicted_);
+        // Chebyshev acceleration acts on iterations 2 .. iterations - 2 (chebyshev_step): none below 4.
+        const double rho = settings_.iterations > 3 ? settings_.chebyshev_rho_milli / 1000.0 : 0.0;
+        double omega = 1.0;
+        for (int it = 0; it < settings_.iterations; ++it) {
+          if (cancelled())
+            throw Error(ErrorCode::cancelled, "the step was cancelled in frame " + std::to_string(report_.frame) +
+                                                  "; the world was restored to the start of the frame");
+          if (rho > 0.0) chebyshev_now_ = x_;
+          project_volumes(h);  // fields.cpp
+          for (int32_t slot : order_) {
+            Group& g = groups_[slot];
+            for (int k = 0; k < g.desc.weight; ++k) {
+              first_projection_ = it == 0 && k == 0;  // the chain solve's turn (chain_pass)
+              project_group(g, h);
+            }
           }
+          if (rho > 0.0) chebyshev_step(it, rho, omega);
         }
-        if (rho > 0.0) chebyshev_step(it, rho, omega);
+      }
+      catch_late_contacts();
+      const int32_t bad = update_velocities(h);
+      if (bad >= 0) {
+        warning_.frame = report_.frame;
+        warning_.particle = bad;
+        warning_.message = "non-finite position or velocity at particle " + std::to_string(bad) + " in frame " +
+                           std::to_string(report_.frame) + "; the world was restored to the start of the frame";
+        throw Error(ErrorCode::numerical, warning_.message);
       }
     }
-    catch_late_contacts();
-    const int32_t bad = update_velocities(h);
-    if (bad >= 0) {
-      x_ = x0;
-      v_ = v0;
-      x_prev_ = x0;
-      for (size_t i = 0; i < pins_.size(); ++i) pins_[i].lambda = pin_lambda0[i];
-      for (Collider& c : colliders_) {
-        c.position = c.position_prev = c.frame_position;
-        c.rotation = c.rotation_prev = c.frame_rotation;
-      }
-      warning_.frame = report_.frame;
-      warning_.particle = bad;
-      warning_.message = "non-finite position or velocity at particle " + std::to_string(bad) + " in frame " +
-                         std::to_string(report_.frame) + "; the world was restored to the start of the frame";
-      throw Error(ErrorCode::numerical, warning_.message);
-    }
+  } catch (...) {
+    restore(start);
+    throw;
   }
   for (Group& g : groups_)
     for (int k = 0; k < kKindCount; ++k) {

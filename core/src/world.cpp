@@ -2,6 +2,7 @@
 // validates everything first and only then changes the world.
 #include "embra/core/world.hpp"
 
+#include "check.hpp"
 #include "collider_shapes.hpp"
 
 #include <algorithm>
@@ -22,22 +23,9 @@ namespace {
   throw Error(code, message);
 }
 
-[[noreturn]] void invalid(const std::string& message) {
-  fail(ErrorCode::invalid_argument, message);
-}
-
-void check_finite(double value, const char* what) {
-  if (!std::isfinite(value)) invalid(std::string(what) + " is not a finite number");
-}
-
-void check_non_negative(double value, const char* what) {
-  check_finite(value, what);
-  if (value < 0.0) invalid(std::string(what) + " must be >= 0");
-}
-
 void check_material(const Material& m) {
-  check_non_negative(m.mass, "material.mass");
-  check_non_negative(m.density, "material.density");
+  check_zero_or_positive(m.mass, "material.mass");
+  check_zero_or_positive(m.density, "material.density");
   check_non_negative(m.stretch_compliance, "material.stretch_compliance");
   check_non_negative(m.shear_compliance, "material.shear_compliance");
   check_non_negative(m.bend_compliance, "material.bend_compliance");
@@ -136,10 +124,12 @@ World::World(const Settings& settings) {
 }
 
 void World::set_settings(const Settings& s) {
-  check_finite(s.dt, "settings.dt");
-  if (s.dt <= 0.0) invalid("settings.dt must be > 0");
+  check_positive(s.dt, "settings.dt");
+  if (s.dt > limits::kMaxDt) invalid("settings.dt must be <= 1e6 s");
   if (s.substeps < 1 || s.substeps > 10000) invalid("settings.substeps must be in [1, 10000]");
   if (s.iterations < 1 || s.iterations > 10000) invalid("settings.iterations must be in [1, 10000]");
+  if (int64_t{s.substeps} * s.iterations > limits::kMaxPassesPerStep)
+    invalid("settings.substeps x settings.iterations must be <= 100000 (passes per step)");
   if (s.tethers < 0 || s.tethers > 64) invalid("settings.tethers must be in [0, 64]");
   if (s.realign_passes < 0 || s.realign_passes > 100) invalid("settings.realign_passes must be in [0, 100]");
   if (s.chebyshev_rho_milli < 0 || s.chebyshev_rho_milli > 990)
@@ -214,6 +204,22 @@ void World::destroy_group(Id id) {
   if (id == default_group_ || id == settings_.contact_group)
     invalid("the default and contact groups cannot be destroyed");
   if (!g.soft_pins.empty()) invalid("group still holds soft pins; destroy them first");
+  // A body names a group for each kind it generates; bodies are never destroyed, so a group holding
+  // a body's generated constraints stays. A body that names it for a kind it does not generate
+  // names the default group instead (what a zeroed id means).
+  static constexpr std::array<std::pair<uint32_t, const char*>, 4> kGenerated = {
+      {{generate_stretch, "stretch"}, {generate_shear, "shear"}, {generate_bend, "bend"}, {generate_volume, "volume"}}};
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const BodyInfo& b = bodies_[i];
+    const std::array<Id, 4> named = {b.stretch_group, b.shear_group, b.bend_group, b.volume_group};
+    for (size_t k = 0; k < named.size(); ++k)
+      if (named[k] == id && (b.generate & kGenerated[k].first))
+        invalid("group holds the " + std::string(kGenerated[k].second) + " constraints body " + std::to_string(i) +
+                " generated (bodies are never destroyed)");
+  }
+  for (BodyInfo& b : bodies_)
+    for (Id* named : {&b.stretch_group, &b.shear_group, &b.bend_group, &b.volume_group})
+      if (*named == id) *named = Id{};
   const uint32_t generation = g.generation;
   g = Group{};
   g.generation = generation;
@@ -335,6 +341,9 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     invalid(std::string("particle array length is not a multiple of ") + std::to_string(n) + " (the arity of " +
             kind_name(desc.kind) + ")");
   const size_t count = desc.particles.size() / n;
+  if (constraint_count() + static_cast<int64_t>(count) > limits::kMaxConstraints)
+    invalid("a world holds at most 16777216 constraints; these would make " +
+            std::to_string(constraint_count() + static_cast<int64_t>(count)));
   if (!desc.rest.empty() && desc.rest.size() != count) invalid("rest array length differs from the constraint count");
   if (!desc.compliance.empty() && desc.compliance.size() != count)
     invalid("compliance array length differs from the constraint count");
@@ -411,16 +420,23 @@ Id World::create_body(const BodyDesc& d) {
   if (d.positions.empty() || d.positions.size() % 3 != 0)
     invalid("body positions must be a non-empty array of 3 numbers per vertex");
   const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
-  if (nv + particle_count() > INT32_MAX / 4) invalid("too many particles");
+  if (nv + particle_count() > limits::kMaxParticles)
+    invalid("a world holds at most 2097152 particles; this body would make " + std::to_string(nv + particle_count()));
   for (double c : d.positions) check_finite(c, "body vertex coordinate");
   if (!d.masses.empty()) {
     if (static_cast<int64_t>(d.masses.size()) != nv) invalid("body masses must have one value per vertex");
-    for (double m : d.masses) check_non_negative(m, "body vertex mass");
+    for (double m : d.masses) check_zero_or_positive(m, "body vertex mass");
   }
   if (!d.uvs.empty()) {
     if (static_cast<int64_t>(d.uvs.size()) != 2 * nv) invalid("body uvs must have two values per vertex");
     for (double c : d.uvs) check_finite(c, "body uv coordinate");
   }
+  // Generated constraints, at most: one per edge (a triangle's edges when none are given), a shear
+  // and a bend per triangle edge, one per tetrahedron.
+  const int64_t elements = static_cast<int64_t>(d.edges.size() / 2 + 6 * (d.triangles.size() / 3) + d.tets.size() / 4);
+  if (constraint_count() + elements > limits::kMaxConstraints)
+    invalid("a world holds at most 16777216 constraints; this body's elements could generate " +
+            std::to_string(elements) + " beside the " + std::to_string(constraint_count()) + " there are");
   check_elements(d.edges, 2, nv, "edge");
   check_elements(d.triangles, 3, nv, "triangle");
   check_elements(d.tets, 4, nv, "tetrahedron");
@@ -441,6 +457,13 @@ Id World::create_body(const BodyDesc& d) {
     hi = hi.cwiseMax(at(d.positions, i));
   }
   const double diag = std::max((hi - lo).norm(), 1e-300);
+  // Element measures take powers of lengths (an edge's squared length, a tetrahedron's triple
+  // product, a triangle's squared cross product): a body whose elements are too large for that in
+  // double precision is refused here rather than stepped into infinities. Free points have none.
+  const int power = !d.triangles.empty() ? 4 : !d.tets.empty() ? 3 : !d.edges.empty() ? 2 : 0;
+  if (power > 0 && !in_range(std::pow(diag, power)))
+    invalid("the body is too large: its bounding box diagonal (" + std::to_string(diag) + " m) to the power " +
+            std::to_string(power) + " overflows double precision (its elements' measures would)");
   const double eps_len = 1e-12 * diag;
   auto P = [&](int32_t i) { return at(d.positions, i); };
   std::vector<double> weight(nv, 0.0);
@@ -489,6 +512,10 @@ Id World::create_body(const BodyDesc& d) {
     for (int64_t i = 0; i < nv; ++i)
       mass[i] = d.material.mass > 0.0 ? d.material.mass * weight[i] / total : d.material.density * weight[i];
   }
+  for (int64_t i = 0; i < nv; ++i)
+    if (mass[i] != 0.0 && !(mass[i] >= limits::kMinPositive && mass[i] <= limits::kMaxAbsValue))
+      invalid("vertex " + std::to_string(i) + " gets a mass of " + std::to_string(mass[i]) +
+              " kg from the material and the geometry: outside [1e-300, 1e300], so its inverse is not finite");
 
   // Unique edges from the explicit list, the triangles and the tetrahedra.
   std::vector<std::pair<int32_t, int32_t>> edges;

@@ -2,6 +2,7 @@
  * may be used from different threads at once (each giving what it gives on one thread). */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
+#include <sched.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -188,8 +189,170 @@ static void test_worlds_in_parallel(void) {
   CHECK(memcmp(alone[0].x, alone[1].x, sizeof alone[0].x) != 0);
 }
 
+/* --- one world, two threads -------------------------------------------------------------------
+ * Two threads step and read the same world as fast as they can: every call returns EMBRA_OK or
+ * EMBRA_ERROR_LOCKED (never a crash, never another status), some calls do meet the lock, and the
+ * frames that succeeded add up. */
+
+enum { SHARED_CALLS = 400 };
+
+typedef struct {
+  embra_world* world;
+  int32_t count;
+  int ok, locked, other;
+  pthread_barrier_t* start;
+} shared_run;
+
+static void* hammer(void* arg) {
+  shared_run* r = (shared_run*)arg;
+  double x[3 * GRID * GRID];
+  int k;
+  pthread_barrier_wait(r->start);
+  for (k = 0; k < SHARED_CALLS; ++k) {
+    embra_status st;
+    if (k % 2 == 0) {
+      st = embra_world_step(r->world);
+    } else {
+      st = embra_world_get_positions(r->world, x, 3 * GRID * GRID, 0, r->count);
+    }
+    if (st == EMBRA_OK)
+      r->ok += k % 2 == 0;
+    else if (st == EMBRA_ERROR_LOCKED)
+      ++r->locked;
+    else
+      ++r->other;
+  }
+  return NULL;
+}
+
+static embra_world* small_cloth_world(int32_t iterations) {
+  double xyz[3 * GRID * GRID];
+  int32_t tris[3 * 2 * (GRID - 1) * (GRID - 1)];
+  embra_world* w = NULL;
+  embra_solver_def sd = embra_default_solver_def();
+  embra_body_def bd = embra_default_body_def();
+  embra_body_id body;
+  int i, j, t = 0;
+  for (i = 0; i < GRID; ++i)
+    for (j = 0; j < GRID; ++j) {
+      xyz[3 * (i * GRID + j)] = 0.2 * j;
+      xyz[3 * (i * GRID + j) + 1] = 0.2 * i;
+      xyz[3 * (i * GRID + j) + 2] = 0.0;
+    }
+  for (i = 0; i + 1 < GRID; ++i)
+    for (j = 0; j + 1 < GRID; ++j) {
+      const int32_t v = i * GRID + j;
+      tris[t++] = v, tris[t++] = v + 1, tris[t++] = v + GRID + 1;
+      tris[t++] = v, tris[t++] = v + GRID + 1, tris[t++] = v + GRID;
+    }
+  sd.iterations = iterations;
+  if (embra_world_create(&w, &sd) != EMBRA_OK) return NULL;
+  bd.vertex_count = GRID * GRID;
+  bd.positions = xyz;
+  bd.triangle_count = 2 * (GRID - 1) * (GRID - 1);
+  bd.triangles = tris;
+  bd.material.mass = 0.1;
+  if (embra_body_create(w, &bd, &body, NULL) != EMBRA_OK) {
+    embra_world_destroy(w);
+    return NULL;
+  }
+  return w;
+}
+
+static void test_one_world_two_threads(void) {
+  embra_world* w = small_cloth_world(20);
+  shared_run runs[2];
+  pthread_t threads[2];
+  pthread_barrier_t start;
+  embra_step_report report;
+  int i, locked = 0;
+  CHECK(w != NULL);
+  if (w == NULL) return;
+  pthread_barrier_init(&start, NULL, 2);
+  memset(runs, 0, sizeof runs);
+  for (i = 0; i < 2; ++i) {
+    runs[i].world = w;
+    runs[i].count = GRID * GRID;
+    runs[i].start = &start;
+    CHECK_INT(pthread_create(&threads[i], NULL, hammer, &runs[i]), 0);
+  }
+  for (i = 0; i < 2; ++i) CHECK_INT(pthread_join(threads[i], NULL), 0);
+  for (i = 0; i < 2; ++i) {
+    CAPI_CONTEXT("thread %d", i);
+    CHECK_INT(runs[i].other, 0);
+    locked += runs[i].locked;
+  }
+  CHECK_MSG(locked > 0, "no call met the lock in %d calls on two threads", 4 * SHARED_CALLS);
+  CHECK_OK(embra_world_get_report(w, &report));
+  CHECK_INT(report.frame, runs[0].ok + runs[1].ok);
+  pthread_barrier_destroy(&start);
+  embra_world_destroy(w);
+}
+
+/* --- cancelling a long step from another thread -----------------------------------------------
+ * A step of 16 x 6,000 iterations (about a second) on one thread; the main thread cancels it once it
+ * is under way: the step returns EMBRA_ERROR_CANCELLED well before it would have finished, and the
+ * world saves to the same bytes as before the step. */
+
+typedef struct {
+  embra_world* world;
+  embra_status status;
+  int finished; /* read and written with __atomic builtins */
+} long_step;
+
+static void* step_once(void* arg) {
+  long_step* r = (long_step*)arg;
+  r->status = embra_world_step(r->world);
+  __atomic_store_n(&r->finished, 1, __ATOMIC_RELEASE);
+  return NULL;
+}
+
+static char* saved(const embra_world* w) {
+  int64_t n = 0;
+  char* text = NULL;
+  if (embra_world_save_json(w, NULL, 0, &n) != EMBRA_OK) return NULL;
+  text = (char*)malloc((size_t)n);
+  if (text != NULL && embra_world_save_json(w, text, n, &n) != EMBRA_OK) {
+    free(text);
+    text = NULL;
+  }
+  return text;
+}
+
+static void test_cancel_from_another_thread(void) {
+  embra_world* w = small_cloth_world(6000);
+  long_step r;
+  pthread_t thread;
+  char* before;
+  char* after;
+  embra_status st;
+  CHECK(w != NULL);
+  if (w == NULL) return;
+  before = saved(w);
+  memset(&r, 0, sizeof r);
+  r.world = w;
+  CHECK_INT(pthread_create(&thread, NULL, step_once, &r), 0);
+  /* Until the step holds the world, a call from here gets EMBRA_OK; then the lock. */
+  do {
+    embra_step_report report;
+    st = embra_world_get_report(w, &report);
+    if (st == EMBRA_OK) sched_yield();
+  } while (st == EMBRA_OK && !__atomic_load_n(&r.finished, __ATOMIC_ACQUIRE));
+  CHECK_INT(st, EMBRA_ERROR_LOCKED);
+  CHECK_OK(embra_world_cancel(w));
+  CHECK_INT(pthread_join(thread, NULL), 0);
+  CHECK_INT(r.status, EMBRA_ERROR_CANCELLED);
+  after = saved(w);
+  CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+  embra_world_destroy(w);
+}
+
 int main(void) {
   RUN(test_last_error_is_per_thread);
   RUN(test_worlds_in_parallel);
+  RUN(test_one_world_two_threads);
+  RUN(test_cancel_from_another_thread);
   return capi_test_finish();
 }

@@ -43,9 +43,20 @@
  *   (a non-finite position) restores the world to its state before the step, returns
  *   EMBRA_ERROR_NUMERICAL and records an embra_warning.
  *
+ * RANGES AND LIMITS
+ *   Every number a world accepts is finite and within +-EMBRA_MAX_ABS_VALUE (1e300); values that
+ *   must be positive (dt, densities, sizes) are at least EMBRA_MIN_POSITIVE (1e-300), and masses
+ *   are 0 (immovable, where allowed) or at least EMBRA_MIN_POSITIVE, so every inverse is finite.
+ *   These are the scene schema's ranges too: whatever the C API accepts, embra_world_save_json
+ *   writes and embra_world_load_json reads back. A world holds at most EMBRA_MAX_PARTICLES
+ *   particles and EMBRA_MAX_CONSTRAINTS constraints; a step does at most EMBRA_MAX_PASSES_PER_STEP
+ *   substeps x iterations; dt is at most EMBRA_MAX_DT seconds. Beyond them: INVALID_ARGUMENT.
+ *
  * THREADING
- *   One thread at a time per world. Different worlds may be used from different threads at once.
- *   The last-error message is per thread.
+ *   One call at a time per world, enforced: a call made while another thread's call on the same
+ *   world is in progress returns EMBRA_ERROR_LOCKED and changes nothing (it never waits). The
+ *   one exception is embra_world_cancel, which any thread may call at any time. Different worlds
+ *   may be used from different threads at once. The last-error message is per thread.
  *
  * IDS AND INDICES
  *   Groups, pins and colliders are small value ids {index, generation}: a destroyed object's id
@@ -91,8 +102,19 @@ enum {
   EMBRA_ERROR_VERSION = -5,          /* header and library (or a def's version) disagree */
   EMBRA_ERROR_LOCKED = -6,           /* the world is in use by a call in progress */
   EMBRA_ERROR_NUMERICAL = -7,        /* the step produced a non-finite state; world restored */
-  EMBRA_ERROR_INTERNAL = -8          /* a bug in embra, or out of memory; message says which */
+  EMBRA_ERROR_INTERNAL = -8,         /* a bug in embra, or out of memory; message says which */
+  EMBRA_ERROR_CANCELLED = -9         /* embra_world_cancel stopped the step; world restored */
 };
+
+/* The ranges and limits above (the scene schema states the same numbers; a test compares them). */
+#define EMBRA_MAX_ABS_VALUE 1e300
+#define EMBRA_MIN_POSITIVE 1e-300
+#define EMBRA_MAX_DT 1e6
+#define EMBRA_MAX_UNIT_SCALE 1e12
+#define EMBRA_MAX_PARTICLES 2097152
+#define EMBRA_MAX_CONSTRAINTS 16777216
+#define EMBRA_MAX_PASSES_PER_STEP 100000
+#define EMBRA_MAX_OBJ_BYTES 268435456
 
 /* The message of the last failed call on this thread ("" if none). Never NULL; valid until the
  * next embra call on this thread. */
@@ -494,9 +516,16 @@ EMBRA_API embra_status embra_collider_get_transform(const embra_world* world, em
  * Stepping and reading back
  * ------------------------------------------------------------------------------------------- */
 
-/* Advances one frame (solver dt). EMBRA_ERROR_NUMERICAL: the state went non-finite; the world is
- * as before the call and embra_world_get_warning says where. */
+/* Advances one frame (solver dt). A frame that does not complete leaves the world exactly as
+ * before the call, the scene actions applied for that frame included: EMBRA_ERROR_NUMERICAL when
+ * the state went non-finite (embra_world_get_warning says where), EMBRA_ERROR_CANCELLED when
+ * embra_world_cancel stopped it. */
 EMBRA_API embra_status embra_world_step(embra_world* world);
+/* Asks the step in progress on another thread to stop: it checks between iterations, restores the
+ * world and returns EMBRA_ERROR_CANCELLED. The only call that may overlap another call on the same
+ * world (from any thread). A request is consumed by the step it stops; one made while no step
+ * runs stops the next step before its first iteration. */
+EMBRA_API embra_status embra_world_cancel(embra_world* world);
 
 typedef struct embra_step_report {
   int64_t frame;         /* frames stepped since the world was created */
@@ -720,11 +749,25 @@ EMBRA_API embra_status embra_panel_mesh_export_cuts(const embra_world* world, em
  * ------------------------------------------------------------------------------------------- */
 
 /* Builds a world from scene JSON text of `length` bytes. `base_dir` (nullable: ".") resolves
- * relative OBJ paths. On failure *out_world is NULL. */
+ * relative OBJ paths; an OBJ path must be relative and stay inside base_dir (no absolute path,
+ * no ".." or symbolic link leading out), name a regular file (no device, pipe or folder) and be
+ * at most EMBRA_MAX_OBJ_BYTES. On failure *out_world is NULL. */
 EMBRA_API embra_status embra_world_load_json(embra_world** out_world, const char* json, int64_t length,
                                              const char* base_dir);
-/* Same, from a file (relative paths resolve against the file's folder). */
+/* Same, from a file (relative paths resolve against the file's folder, and stay inside it). */
 EMBRA_API embra_status embra_world_load_file(embra_world** out_world, const char* path);
+
+#define EMBRA_LOAD_OPTIONS_VERSION 1
+typedef struct embra_load_options {
+  int32_t version;                  /* EMBRA_LOAD_OPTIONS_VERSION */
+  int32_t allow_paths_outside_base; /* 1: OBJ paths may be absolute or lead out of base_dir; 0 */
+  const char* base_dir;             /* relative OBJ paths resolve here; NULL: "." */
+} embra_load_options;
+EMBRA_API embra_load_options embra_default_load_options(void);
+/* embra_world_load_json with options: for a host that lets a scene read OBJ files anywhere
+ * (scenes it trusts), or names the folder. */
+EMBRA_API embra_status embra_world_load_json_with_options(embra_world** out_world, const char* json, int64_t length,
+                                                          const embra_load_options* options);
 /* Writes the world as scene JSON (UTF-8, NUL-terminated) into out. *out_length (required)
  * receives the size in bytes including the terminating NUL; call with out NULL and capacity 0 to
  * learn it. Too small a buffer: EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. */

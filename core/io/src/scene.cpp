@@ -850,6 +850,13 @@ std::string_view scene_schema() {
 }
 
 std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta) {
+  LoadOptions options;
+  options.base_dir = base_dir;
+  return load_scene(text, options, out_meta);
+}
+
+std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& options, SceneMeta& out_meta) {
+  const std::string& base_dir = options.base_dir;
   const json doc = parse(text);
   // What the document is comes first: the schema alone would only say a `const` did not match.
   auto shown = [](const json& v) {

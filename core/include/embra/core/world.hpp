@@ -10,7 +10,10 @@
 #include "embra/core/constraint_math.hpp"
 #include "embra/core/fields.hpp"
 
+#include <array>
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -28,6 +31,7 @@ enum class ErrorCode : int32_t {
   buffer_too_small = 3,
   numerical = 4,
   internal = 5,
+  cancelled = 6,
 };
 
 class Error : public std::runtime_error {
@@ -180,6 +184,19 @@ struct StepReport {
   int64_t constraint_count = 0;
   int64_t contact_count = 0;
   bool settled = false;
+};
+
+class World;
+
+/// What a caller hands World::step beyond the world itself.
+struct StepControl {
+  /// Run once at the start of the frame, after the restore point is taken: changes it makes (a
+  /// scene's actions: pin targets, collider poses, gravity, rest scales) are undone with the frame
+  /// when it fails.
+  std::function<void(World&)> before_frame;
+  /// Checked between iterations: when set, the frame stops, the world is restored and step throws
+  /// Error(cancelled). Another thread may set it while the step runs.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct Warning {
@@ -464,9 +481,11 @@ class World {
   size_t field_count() const;
 
   // --- stepping --------------------------------------------------------------------------------
-  /// Advances one frame of settings().dt. On a non-finite state the world returns to the state it
-  /// had before the call, records a Warning and throws Error(numerical).
-  void step();
+  /// Advances one frame of settings().dt. A frame that does not complete leaves the world as the
+  /// call found it, including what `control.before_frame` changed: on a non-finite state it records
+  /// a Warning and throws Error(numerical); when `*control.cancel` is found set (between
+  /// iterations) it throws Error(cancelled); any other exception passes through the same way.
+  void step(const StepControl& control = {});
   const StepReport& report() const { return report_; }
   const Warning& warning() const { return warning_; }
 
@@ -500,6 +519,18 @@ class World {
   void project_contacts(Group& g, double h);
   int32_t update_velocities(double h);  // the first particle left with a non-finite x or v, or -1
   void measure();
+  /// What a frame that does not complete restores (step): the state, and the pin targets,
+  /// collider poses, gravity and rest scales that StepControl::before_frame may change.
+  struct FrameStart {
+    std::vector<Vec3> x, v;
+    std::vector<Vec3> pin_lambda, pin_target;
+    std::vector<Vec3> collider_position;
+    std::vector<Eigen::Quaterniond> collider_rotation;
+    std::vector<std::array<double, 3>> rest_scale;
+    Vec3 gravity = Vec3::Zero();
+  };
+  FrameStart frame_start() const;
+  void restore(const FrameStart& start);
   void apply_fields(double h, double time);  // fields.cpp: field forces into v_ (movable particles)
   void project_volumes(double h);            // fields.cpp: the pressure fields' volume constraints
 

@@ -47,8 +47,14 @@ struct SceneMeta {
   std::map<uint32_t, std::string> field_names;  // by field slot (fields without a name are not listed)
 };
 
-/// Parses, validates and builds a scene. `base_dir` resolves relative paths (OBJ meshes).
-/// Throws SceneError; nothing is returned on failure.
+/// How a scene may reach outside its own text.
+struct LoadOptions {
+  std::string base_dir = ".";             // relative OBJ paths resolve here
+  bool allow_paths_outside_base = false;  // true: OBJ paths may be absolute or lead out of base_dir
+};
+/// Parses, validates and builds a scene. Throws SceneError; nothing is returned on failure.
+std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& options, SceneMeta& out_meta);
+/// load_scene with OBJ paths confined to `base_dir`.
 std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta);
 
 /// Writes the complete world and its meta as a scene document (floats round-trip exactly).
