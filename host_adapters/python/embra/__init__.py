@@ -12,13 +12,14 @@ is optional: when installed, arrays go to and from C without copies.
 """
 
 from . import _capi
-from ._capi import (ABI_VERSION, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    GroupId, GroupReport, Material, MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId,
-                    PressureDef, SolverDef, StepReport, SurfaceTensionDef, Tolerance, Tolerances, VortexDef, WindDef,
-                    WorldCounts, library_path)
+from ._capi import (ABI_VERSION, MAX_ABS_VALUE, MAX_CONSTRAINTS, MAX_DT, MAX_OBJ_BYTES, MAX_PARTICLES,
+                    MAX_PASSES_PER_STEP, MAX_UNIT_SCALE, MIN_POSITIVE, BodyId, ColliderDef, ColliderId,
+                    ConstraintBatchDef, ConstraintDef, FieldId, GroupDef, GroupId, GroupReport, LoadOptions, Material,
+                    MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId, PressureDef, SolverDef, StepReport,
+                    SurfaceTensionDef, Tolerance, Tolerances, VortexDef, WindDef, WorldCounts, library_path)
 from ._capi import Warning as StepWarning
 from ._buffers import have_numpy
-from .errors import (BufferTooSmallError, EmbraError, InternalError, InvalidArgumentError, LockedError,
+from .errors import (BufferTooSmallError, CancelledError, EmbraError, InternalError, InvalidArgumentError, LockedError,
                      NumericalError, SchemaError, StaleIdError, VersionError, check)
 from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_METRICS, PANEL_PINS, SHAPES, Body, World, as_dict
 
@@ -89,6 +90,12 @@ def default_vortex_def():
     return _lib.embra_default_vortex_def()
 
 
+def default_load_options():
+    """embra_default_load_options(): OBJ paths confined to the scene's folder (World.load_json and
+    World.load_file take the same choice as their allow_paths_outside_base keyword)."""
+    return _lib.embra_default_load_options()
+
+
 check_abi()  # these bindings and the loaded library must agree before anything else
 
 __version__ = version_string()
@@ -96,12 +103,14 @@ __all__ = [
     "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
     "last_error_message", "constraint_arity", "default_solver_def", "default_material", "default_panel_mesh_def",
     "default_tolerances", "default_wind_def", "default_pressure_def", "default_surface_tension_def",
-    "default_vortex_def", "have_numpy", "library_path", "ABI_VERSION", "EmbraError", "InvalidArgumentError",
-    "StaleIdError", "BufferTooSmallError", "SchemaError", "VersionError", "LockedError", "NumericalError",
-    "InternalError", "SolverDef", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef",
-    "ColliderDef", "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "WindDef", "PressureDef",
-    "SurfaceTensionDef", "VortexDef", "StepReport",
-    "GroupReport", "StepWarning", "WorldCounts", "GroupId", "BodyId", "PinId", "ColliderId", "FieldId",
-    "SHAPES", "KINDS",
-    "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
+    "default_vortex_def", "default_load_options", "have_numpy", "library_path", "ABI_VERSION",
+    "EmbraError", "InvalidArgumentError", "StaleIdError", "BufferTooSmallError", "SchemaError", "VersionError",
+    "LockedError", "NumericalError", "CancelledError", "InternalError",
+    "MAX_ABS_VALUE", "MIN_POSITIVE", "MAX_DT", "MAX_UNIT_SCALE", "MAX_PARTICLES", "MAX_CONSTRAINTS",
+    "MAX_PASSES_PER_STEP", "MAX_OBJ_BYTES",
+    "SolverDef", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef", "ColliderDef",
+    "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "WindDef", "PressureDef",
+    "SurfaceTensionDef", "VortexDef", "LoadOptions", "StepReport", "GroupReport", "StepWarning", "WorldCounts",
+    "GroupId", "BodyId", "PinId", "ColliderId", "FieldId",
+    "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
 ]

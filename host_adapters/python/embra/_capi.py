@@ -23,6 +23,17 @@ ERROR_VERSION = -5
 ERROR_LOCKED = -6
 ERROR_NUMERICAL = -7
 ERROR_INTERNAL = -8
+ERROR_CANCELLED = -9
+
+# --- ranges and limits (EMBRA_MAX_*, EMBRA_MIN_POSITIVE: what a world accepts; beyond: refused) -----
+MAX_ABS_VALUE = 1e300
+MIN_POSITIVE = 1e-300
+MAX_DT = 1e6
+MAX_UNIT_SCALE = 1e12
+MAX_PARTICLES = 2097152
+MAX_CONSTRAINTS = 16777216
+MAX_PASSES_PER_STEP = 100000
+MAX_OBJ_BYTES = 268435456
 
 # --- enums -----------------------------------------------------------------------------------
 GENERATE_STRETCH = 1
@@ -74,6 +85,7 @@ WIND_DEF_VERSION = 1
 PRESSURE_DEF_VERSION = 1
 SURFACE_TENSION_DEF_VERSION = 1
 VORTEX_DEF_VERSION = 1
+LOAD_OPTIONS_VERSION = 1
 
 _d3 = c_double * 3
 _d4 = c_double * 4
@@ -232,6 +244,10 @@ class VortexDef(ctypes.Structure):
                 ("start_time", c_double)]
 
 
+class LoadOptions(ctypes.Structure):
+    _fields_ = [("version", c_int32), ("allow_paths_outside_base", c_int32), ("base_dir", c_char_p)]
+
+
 class Warning(ctypes.Structure):  # noqa: A001 - the C name (embra_warning)
     _fields_ = [("frame", c_int64), ("particle", c_int32), ("reserved0", c_int32)]
 
@@ -310,6 +326,7 @@ PROTOTYPES = {
     "embra_collider_get_transform": (_status, [_world, ColliderId, _pd, _pd]),
     # stepping and reading back
     "embra_world_step": (_status, [_world]),
+    "embra_world_cancel": (_status, [_world]),
     "embra_world_get_report": (_status, [_world, _P(StepReport)]),
     "embra_group_get_report": (_status, [_world, GroupId, _P(GroupReport)]),
     "embra_world_get_warning": (_status, [_world, _P(Warning)]),
@@ -320,6 +337,8 @@ PROTOTYPES = {
     # JSON scenes
     "embra_world_load_json": (_status, [_world_out, c_char_p, c_int64, c_char_p]),
     "embra_world_load_file": (_status, [_world_out, c_char_p]),
+    "embra_default_load_options": (LoadOptions, []),
+    "embra_world_load_json_with_options": (_status, [_world_out, c_char_p, c_int64, _P(LoadOptions)]),
     "embra_world_save_json": (_status, [_world, _P(c_char), c_int64, _P(c_int64)]),
     "embra_world_save_file": (_status, [_world, c_char_p]),
     "embra_world_get_scene_frames": (_status, [_world, _P(c_int64)]),

@@ -50,7 +50,9 @@ class VersionError(EmbraError, RuntimeError):
 
 
 class LockedError(EmbraError, RuntimeError):
-    """EMBRA_ERROR_LOCKED: the world is in use by a call in progress (on another thread)."""
+    """EMBRA_ERROR_LOCKED: the world is in use by a call in progress on another thread; this call
+    changed nothing and did not wait. A World's own methods take turns (its lock), so this comes from
+    calls made on the same embra_world* outside the World (another binding, raw ctypes calls)."""
     status = _capi.ERROR_LOCKED
 
 
@@ -59,13 +61,19 @@ class NumericalError(EmbraError, ArithmeticError):
     status = _capi.ERROR_NUMERICAL
 
 
+class CancelledError(EmbraError, RuntimeError):
+    """EMBRA_ERROR_CANCELLED: World.cancel() stopped the step; the world is as before that frame."""
+    status = _capi.ERROR_CANCELLED
+
+
 class InternalError(EmbraError, RuntimeError):
     """EMBRA_ERROR_INTERNAL: a bug in embra, or out of memory."""
     status = _capi.ERROR_INTERNAL
 
 
 _BY_STATUS = {cls.status: cls for cls in (InvalidArgumentError, StaleIdError, BufferTooSmallError, SchemaError,
-                                          VersionError, LockedError, NumericalError, InternalError)}
+                                          VersionError, LockedError, NumericalError, CancelledError,
+                                          InternalError)}
 
 
 def error_for(status, message=None):

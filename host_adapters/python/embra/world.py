@@ -2,12 +2,15 @@
 
 A refused call raises the exception of its status (see :mod:`embra.errors`) with the C library's
 message and leaves the world unchanged, exactly as the C function does. The C library takes one
-thread at a time per world; a World holds a lock around each call, so threads sharing one World
-take turns (and close() waits for a call in progress) instead of racing. Different Worlds step on
-different threads at once: ctypes releases the GIL for every call into libembra.
+call at a time per world and refuses a second concurrent one (EMBRA_ERROR_LOCKED); a World holds a
+lock around each call, so threads sharing one World take turns (and close() waits for a call in
+progress) instead of being refused. cancel() is the exception: it takes no turn, so another thread
+can stop a long step in progress. Different Worlds step on different threads at once: ctypes
+releases the GIL for every call into libembra.
 """
 
 import ctypes
+import os
 import threading
 from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 
@@ -71,6 +74,20 @@ def _fill(struct, fields, what):
     return struct
 
 
+def _flag(value, name):
+    """A yes/no option: only True or False (a security choice is not guessed from a truthy value)."""
+    if not isinstance(value, bool):
+        raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
+    return value
+
+
+def _load_options(base_dir, allow_paths_outside_base):
+    o = lib.embra_default_load_options()
+    o.allow_paths_outside_base = 1 if _flag(allow_paths_outside_base, "allow_paths_outside_base") else 0
+    o.base_dir = None if base_dir is None else os.fsencode(base_dir)
+    return o
+
+
 def _id(value, cls, name):
     if value is None:
         return cls()
@@ -108,7 +125,8 @@ class World:
         """Creates a world from embra_default_solver_def(), `solver` (a SolverDef or dict) and keyword
         settings (any SolverDef field: dt, substeps, iterations, gravity, damping, ...)."""
         self._ptr = None
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()  # one call at a time (the C library refuses a second: LOCKED)
+        self._cancel_lock = threading.Lock()  # cancel() against close(): never a destroyed pointer
         d = lib.embra_default_solver_def()
         if solver is not None:
             _fill(d, as_dict(solver) if isinstance(solver, SolverDef) else dict(solver), "SolverDef")
@@ -122,34 +140,59 @@ class World:
         w = cls.__new__(cls)
         w._ptr = ptr
         w._lock = threading.Lock()
+        w._cancel_lock = threading.Lock()
         return w
 
     @classmethod
-    def load_json(cls, text, base_dir=None):
-        """A world from scene JSON text (str or bytes); `base_dir` resolves relative OBJ paths."""
+    def load_json(cls, text, base_dir=None, *, allow_paths_outside_base=False):
+        """A world from scene JSON text (str or bytes). The scene's OBJ paths are relative to
+        `base_dir` (None: the current folder) and must stay inside it, unless
+        allow_paths_outside_base=True (for scenes the host trusts: absolute paths and ".." allowed)."""
         data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
+        options = _load_options(base_dir, allow_paths_outside_base)
         ptr = c_void_p()
-        check(lib.embra_world_load_json(byref(ptr), data, len(data),
-                                        None if base_dir is None else str(base_dir).encode()))
+        check(lib.embra_world_load_json_with_options(byref(ptr), data, len(data), byref(options)))
         return cls._adopt(ptr)
 
     @classmethod
-    def load_file(cls, path):
-        """A world from a scene file (relative OBJ paths resolve against its folder)."""
-        ptr = c_void_p()
-        check(lib.embra_world_load_file(byref(ptr), str(path).encode()))
-        return cls._adopt(ptr)
+    def load_file(cls, path, *, allow_paths_outside_base=False):
+        """A world from a scene file. Its OBJ paths are relative to the file's folder and must stay
+        inside it, unless allow_paths_outside_base=True (as for load_json)."""
+        if not _flag(allow_paths_outside_base, "allow_paths_outside_base"):
+            ptr = c_void_p()
+            check(lib.embra_world_load_file(byref(ptr), os.fsencode(path)))
+            return cls._adopt(ptr)
+        # embra_world_load_file has no options: read the file here, its folder as base_dir
+        with open(path, "rb") as f:
+            data = f.read()
+        return cls.load_json(data, os.path.dirname(os.fspath(path)) or ".", allow_paths_outside_base=True)
 
     # --- lifetime ------------------------------------------------------------------------------
     def close(self):
-        """Destroys the world (embra_world_destroy). Idempotent; waits for a call in progress."""
+        """Destroys the world (embra_world_destroy). Idempotent; waits for a call in progress (call
+        cancel() first to stop a long step)."""
         lock = getattr(self, "_lock", None)
         if lock is None:  # __init__ failed before the world existed
             return
-        with lock:
+        with lock, self._cancel_lock:
             ptr, self._ptr = self._ptr, None
             if ptr is not None and ptr.value:
                 lib.embra_world_destroy(ptr)
+
+    def cancel(self):
+        """Asks the step in progress (on another thread) to stop: that step raises CancelledError with
+        the world as before its frame. Callable from any thread at any time; it does not wait for the
+        World's lock (the step holds it). A request made while no step runs stops the next frame
+        stepped, before its first iteration. A closed World raises InvalidArgumentError."""
+        with self._cancel_lock:  # held only for the C call: close() cannot free the world meanwhile
+            ptr = self._ptr
+            status = lib.embra_world_cancel(ptr)
+            if status != _capi.OK:
+                err = error_for(status)
+        if status != _capi.OK:
+            if ptr is None:
+                err = type(err)(f"{err.message} (this World was closed)")
+            raise err
 
     @property
     def closed(self):
@@ -613,7 +656,8 @@ class World:
 
     # --- stepping and reading back -------------------------------------------------------------
     def step(self, frames=1):
-        """Advances `frames` frames. NumericalError: the world is as before the failing frame."""
+        """Advances `frames` frames. NumericalError or CancelledError (cancel() from another thread):
+        the world is as before the failing frame, and the frames before it stay stepped."""
         for _ in range(buf.int32(frames, "frames")):
             self._call("embra_world_step")
 

@@ -22,6 +22,23 @@ def test_every_header_function_is_bound(source_dir):
     assert declared == set(_capi.PROTOTYPES)
 
 
+def test_every_status_has_its_own_error():
+    """Each EMBRA_ERROR_* code of embra.h raises its own exception class, which names that status."""
+    from embra import errors
+    statuses = {name: value for name, value in vars(_capi).items() if name.startswith("ERROR_")}
+    assert {"ERROR_LOCKED", "ERROR_CANCELLED"} <= set(statuses)
+    classes = set()
+    for name, value in statuses.items():
+        e = errors.error_for(value, "message")
+        assert type(e) is not embra.EmbraError and isinstance(e, embra.EmbraError), name
+        assert e.status == value and e.status_name == "EMBRA_" + name and e.message == "message"
+        classes.add(type(e))
+    assert len(classes) == len(statuses)
+    assert isinstance(errors.error_for(_capi.ERROR_LOCKED, ""), embra.LockedError)
+    assert isinstance(errors.error_for(_capi.ERROR_CANCELLED, ""), embra.CancelledError)
+    assert embra.status_name(_capi.ERROR_CANCELLED) == "EMBRA_ERROR_CANCELLED"
+
+
 def test_versions():
     v = embra.version()
     major, minor, patch = (int(x) for x in embra.version_string().split("."))
@@ -234,14 +251,23 @@ def test_library_found_from_env_next_to_package_or_system(tmp_path, source_dir):
 
 
 def test_every_header_constant_is_mirrored(source_dir):
-    """Status codes, enum values and def versions of embra.h have the same values in embra._capi."""
+    """Status codes, enum values, def versions and the ranges and limits (EMBRA_MAX_*) of embra.h have
+    the same values, and the same kind of number, in embra._capi."""
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         header = f.read()
-    constants = dict(re.findall(r"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)", header))
-    constants.update(re.findall(r"#define\s+EMBRA_([A-Z0-9_]+_VERSION)\s+(\d+)", header))  # defs, tolerances, ...
-    assert len(constants) > 30
+    constants = {name: int(v) for name, v in re.findall(r"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)", header)}
+    # every numeric #define: the def versions (integers) and the ranges and limits (1e300, 2097152, ...)
+    for name, v in re.findall(r"^#define\s+EMBRA_([A-Z0-9_]+)\s+([-+0-9.eE]+)\s*$", header, re.MULTILINE):
+        constants[name] = int(v) if re.fullmatch(r"-?\d+", v) else float(v)
+    assert len(constants) > 40
+    assert {"ERROR_CANCELLED", "LOAD_OPTIONS_VERSION", "MAX_ABS_VALUE", "MIN_POSITIVE", "MAX_DT",
+            "MAX_PASSES_PER_STEP", "MAX_OBJ_BYTES"} <= set(constants)
     for name, value in constants.items():
-        assert getattr(_capi, name, None) == int(value), f"EMBRA_{name} = {value} is not mirrored in _capi.py"
+        mirrored = getattr(_capi, name, None)
+        assert mirrored == value and type(mirrored) is type(value), \
+            f"EMBRA_{name} = {value} is not mirrored in _capi.py (found {mirrored!r})"
+        if name.startswith("MAX_") or name.startswith("MIN_"):
+            assert getattr(embra, name) == value  # the public names
 
     def values(prefix):
         return sorted(v for k, v in vars(_capi).items() if k.startswith(prefix) and not k.endswith("_VERSION"))
@@ -270,7 +296,8 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_tolerance": _capi.Tolerance, "embra_tolerances": _capi.Tolerances,
                "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics,
                "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
-               "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef}
+               "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
+               "embra_load_options": _capi.LoadOptions}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
     assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",

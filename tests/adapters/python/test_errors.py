@@ -106,7 +106,7 @@ def test_bad_def_version_and_values():
 def test_bad_scene_json(source_dir):
     with pytest.raises(embra.SchemaError) as e:
         embra.World.load_json('{"format": "embra-scene", "version": 1, "solver": {"dt": 0}}')
-    assert "/solver/dt" in str(e.value) and str(e.value).startswith("embra_world_load_json: ")
+    assert "/solver/dt" in str(e.value) and str(e.value).startswith("embra_world_load_json_with_options: ")
     with pytest.raises(embra.SchemaError):
         embra.World.load_json("{ not json")
     with pytest.raises(embra.InvalidArgumentError, match="embra_world_load_file"):
@@ -135,9 +135,10 @@ def test_wrong_lengths_are_refused_before_c(world):
 
 
 def test_a_step_that_goes_non_finite(world):
-    """A velocity of 1e308 m/s overflows in the step: NumericalError (an ArithmeticError) with the C
+    """A velocity of 1e300 m/s (the largest value a world accepts) overflows in the step: the
+    stretch constraint squares lengths of 1e297 m. NumericalError (an ArithmeticError) with the C
     message, the world restored to the start of the frame, and a warning record saying where."""
-    world.set_velocities([(1e308, 0.0, 0.0)], first=1)
+    world.set_velocities([(embra.MAX_ABS_VALUE, 0.0, 0.0)], first=1)
     before = snapshot(world)
     frame = world.report().frame
     with pytest.raises(ArithmeticError) as e:
@@ -146,3 +147,49 @@ def test_a_step_that_goes_non_finite(world):
     assert str(e.value).startswith("embra_world_step: non-finite")
     assert snapshot(world) == before and world.report().frame == frame
     assert world.warning().frame == frame and world.warning().particle >= 0
+    world.set_velocities([(0.0, 0.0, 0.0)], first=1)  # the cause removed, the world steps on
+    world.step()
+    assert world.report().frame == frame + 1
+
+
+def test_values_out_of_range_are_refused_and_change_nothing(world):
+    """Finite values beyond embra.h's ranges (|v| > 1e300, positives and masses < 1e-300, dt > 1e6,
+    substeps x iterations > 1e5, unit_scale > 1e12) are refused with the C message; nothing changes."""
+    big, tiny = 1e308, embra.MIN_POSITIVE / 10
+    pin = world.create_pin(0, (0.0, 0.0, 0.0))
+    before = snapshot(world) + (embra.as_dict(world.solver), embra.as_dict(world.tolerances), world.pin_target(pin))
+    refused = [
+        ("embra_world_set_velocities", lambda: world.set_velocities([(big, 0.0, 0.0)], first=1)),
+        ("embra_world_set_positions", lambda: world.set_positions([(0.0, -2 * embra.MAX_ABS_VALUE, 0.0)], first=2)),
+        ("embra_world_set_gravity", lambda: world.set_gravity((0.0, 0.0, big))),
+        ("embra_pin_set_target", lambda: world.set_pin_target(pin, (big, 0.0, 0.0))),
+        ("embra_pin_create", lambda: world.create_pin(1, (0.0, big, 0.0))),
+        ("embra_body_create", lambda: world.create_body(SQUARE, triangles=SQUARE_TRIS, masses=[1.0, 1.0, 1.0, tiny])),
+        ("embra_world_set_solver", lambda: world.set_solver(dt=2 * embra.MAX_DT)),
+        ("embra_world_set_solver", lambda: world.set_solver(dt=tiny)),
+        ("embra_world_set_solver", lambda: world.set_solver(substeps=1000,
+                                                            iterations=embra.MAX_PASSES_PER_STEP // 1000 + 1)),
+        ("embra_world_set_tolerances", lambda: world.set_tolerances(unit_scale=10 * embra.MAX_UNIT_SCALE)),
+        ("embra_collider_create", lambda: world.create_collider("sphere", position=(0.0, 0.0, big), radius=1.0)),
+    ]
+    for function, call in refused:
+        with pytest.raises(embra.InvalidArgumentError) as e:
+            call()
+        assert str(e.value).startswith(function + ": "), str(e.value)
+    after = snapshot(world) + (embra.as_dict(world.solver), embra.as_dict(world.tolerances), world.pin_target(pin))
+    assert after == before
+
+
+def test_values_at_the_limits_are_accepted_and_saved_scenes_load_back():
+    """What the C API accepts, the saved scene reads back: a world holding the extreme accepted values."""
+    top = embra.MAX_ABS_VALUE
+    with embra.World(dt=embra.MAX_DT, substeps=1000, iterations=embra.MAX_PASSES_PER_STEP // 1000,
+                     gravity=(top, -top, 0.0)) as w:
+        w.create_body([(top, 0.0, -top)], masses=[embra.MIN_POSITIVE])  # one particle each: no element
+        w.create_body([(0.0, top, 0.0)], masses=[top])                  # measure overflows
+        w.create_pin(0, (-top, top, top))
+        w.set_tolerances(unit_scale=embra.MAX_UNIT_SCALE)
+        text = w.save_json()
+        with embra.World.load_json(text) as back:
+            assert back.save_json() == text
+            assert struct.pack("<6d", *flat(back.positions())) == struct.pack("<6d", *flat(w.positions()))
