@@ -30,6 +30,17 @@ const ERROR_VERSION = -5;
 const ERROR_LOCKED = -6;
 const ERROR_NUMERICAL = -7;
 const ERROR_INTERNAL = -8;
+const ERROR_CANCELLED = -9;
+
+// --- ranges and limits (what a world accepts; beyond them: EMBRA_ERROR_INVALID_ARGUMENT) -----------
+const MAX_ABS_VALUE = 1e300;
+const MIN_POSITIVE = 1e-300;
+const MAX_DT = 1e6;
+const MAX_UNIT_SCALE = 1e12;
+const MAX_PARTICLES = 2097152;
+const MAX_CONSTRAINTS = 16777216;
+const MAX_PASSES_PER_STEP = 100000;
+const MAX_OBJ_BYTES = 268435456;
 
 // --- enums ----------------------------------------------------------------------------------------
 const GENERATE_STRETCH = 1;
@@ -81,6 +92,7 @@ const WIND_DEF_VERSION = 1;
 const PRESSURE_DEF_VERSION = 1;
 const SURFACE_TENSION_DEF_VERSION = 1;
 const VORTEX_DEF_VERSION = 1;
+const LOAD_OPTIONS_VERSION = 1;
 
 // --- types ----------------------------------------------------------------------------------------
 koffi.alias('embra_status', 'int32_t');
@@ -206,6 +218,10 @@ const VortexDef = koffi.struct('embra_vortex_def', {
   radius: 'double', twist: 'double', decay: 'double', start_time: 'double',
 });
 
+const LoadOptions = koffi.struct('embra_load_options', {
+  version: 'int32_t', allow_paths_outside_base: 'int32_t', base_dir: 'const char *',
+});
+
 /** Every struct of embra.h by its C name (the layout test compares each with the C compiler's). */
 const STRUCTS = {
   embra_group_id: GroupIdType, embra_body_id: BodyIdType, embra_pin_id: PinIdType,
@@ -216,7 +232,7 @@ const STRUCTS = {
   embra_warning: Warning, embra_panel_mesh_def: PanelMeshDef, embra_tolerance: Tolerance,
   embra_tolerances: Tolerances, embra_metric_summary: MetricSummary, embra_panel_metrics: PanelMetrics,
   embra_wind_def: WindDef, embra_pressure_def: PressureDef, embra_surface_tension_def: SurfaceTensionDef,
-  embra_vortex_def: VortexDef,
+  embra_vortex_def: VortexDef, embra_load_options: LoadOptions,
 };
 
 // --- functions ------------------------------------------------------------------------------------
@@ -294,6 +310,7 @@ const PROTOTYPES = {
     double *out_position, double *out_rotation)`,
   // stepping and reading back
   embra_world_step: `embra_status embra_world_step(${W})`,
+  embra_world_cancel: `embra_status embra_world_cancel(${W})`,
   embra_world_get_report: `embra_status embra_world_get_report(${CW}, _Out_ embra_step_report *out_report)`,
   embra_group_get_report: `embra_status embra_group_get_report(${CW}, embra_group_id group,
     _Out_ embra_group_report *out_report)`,
@@ -328,6 +345,9 @@ const PROTOTYPES = {
   embra_world_load_json: `embra_status embra_world_load_json(_Out_ embra_world **out_world, const char *json,
     int64_t length, const char *base_dir)`,
   embra_world_load_file: 'embra_status embra_world_load_file(_Out_ embra_world **out_world, const char *path)',
+  embra_default_load_options: 'embra_load_options embra_default_load_options(void)',
+  embra_world_load_json_with_options: `embra_status embra_world_load_json_with_options(_Out_ embra_world **out_world,
+    const char *json, int64_t length, const embra_load_options *options)`,
   embra_world_save_json:
     `embra_status embra_world_save_json(${CW}, char *out, int64_t capacity, _Out_ int64_t *out_length)`,
   embra_world_save_file: `embra_status embra_world_save_file(${CW}, const char *path)`,
@@ -382,7 +402,9 @@ const { lib, libraryPath } = load();
 module.exports = {
   koffi, lib, libraryPath, LIBRARY_ENV, ABI_VERSION, PROTOTYPES, STRUCTS,
   OK, ERROR_INVALID_ARGUMENT, ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED,
-  ERROR_NUMERICAL, ERROR_INTERNAL,
+  ERROR_NUMERICAL, ERROR_INTERNAL, ERROR_CANCELLED,
+  MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS, MAX_PASSES_PER_STEP,
+  MAX_OBJ_BYTES,
   GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME,
   CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD,
   CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET,
@@ -393,8 +415,9 @@ module.exports = {
   CUTS_JSON, CUTS_CSV,
   SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION, CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION,
   PIN_DEF_VERSION, COLLIDER_DEF_VERSION, PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION,
-  WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION,
+  WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, LOAD_OPTIONS_VERSION,
   SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef,
   StepReport, GroupReport, Warning, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, WindDef,
-  PressureDef, SurfaceTensionDef, VortexDef, GroupIdType, BodyIdType, PinIdType, ColliderIdType, FieldIdType,
+  PressureDef, SurfaceTensionDef, VortexDef, LoadOptions, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
+  FieldIdType,
 };

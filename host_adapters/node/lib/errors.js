@@ -42,7 +42,10 @@ SchemaError.STATUS = capi.ERROR_SCHEMA;
 class VersionError extends EmbraError {}
 VersionError.STATUS = capi.ERROR_VERSION;
 
-/** EMBRA_ERROR_LOCKED: the world is in use by a call in progress. */
+/**
+ * EMBRA_ERROR_LOCKED: the world is in use by a call in progress on another thread (World.stepAsync's
+ * worker); this call changed nothing and did not wait.
+ */
 class LockedError extends EmbraError {}
 LockedError.STATUS = capi.ERROR_LOCKED;
 
@@ -50,12 +53,16 @@ LockedError.STATUS = capi.ERROR_LOCKED;
 class NumericalError extends EmbraError {}
 NumericalError.STATUS = capi.ERROR_NUMERICAL;
 
+/** EMBRA_ERROR_CANCELLED: World.cancel() stopped the step; the world is as before that frame. */
+class CancelledError extends EmbraError {}
+CancelledError.STATUS = capi.ERROR_CANCELLED;
+
 /** EMBRA_ERROR_INTERNAL: a bug in embra, or out of memory. */
 class InternalError extends EmbraError {}
 InternalError.STATUS = capi.ERROR_INTERNAL;
 
 const BY_STATUS = new Map([InvalidArgumentError, StaleIdError, BufferTooSmallError, SchemaError, VersionError,
-  LockedError, NumericalError, InternalError].map((cls) => [cls.STATUS, cls]));
+  LockedError, NumericalError, CancelledError, InternalError].map((cls) => [cls.STATUS, cls]));
 
 /** The error for a failed status, with the calling thread's last C message unless one is given. */
 function errorFor(status, message) {
@@ -72,5 +79,5 @@ function check(status) {
 
 module.exports = {
   EmbraError, InvalidArgumentError, StaleIdError, BufferTooSmallError, SchemaError, VersionError, LockedError,
-  NumericalError, InternalError, errorFor, check,
+  NumericalError, CancelledError, InternalError, errorFor, check,
 };

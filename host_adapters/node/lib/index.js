@@ -82,5 +82,6 @@ module.exports = {
   defaultPressureDef: defaults('embra_default_pressure_def', capi.PressureDef),
   defaultSurfaceTensionDef: defaults('embra_default_surface_tension_def', capi.SurfaceTensionDef),
   defaultVortexDef: defaults('embra_default_vortex_def', capi.VortexDef),
+  defaultLoadOptions: defaults('embra_default_load_options', capi.LoadOptions),
   ABI_VERSION: capi.ABI_VERSION, libraryPath: capi.libraryPath, capi,
 };

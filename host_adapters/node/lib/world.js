@@ -8,6 +8,14 @@
 // in every object read back); camelCase spellings are accepted as well (settleSpeed = settle_speed).
 // close() is idempotent; a closed World refuses every call (InvalidArgumentError "world is NULL ...
 // (this World was closed)"). A World not closed is destroyed when garbage-collected.
+//
+// Every method runs on the calling (JS) thread and returns when C returns, except stepAsync, whose
+// frames run on koffi's worker threads: while one runs, the JS thread stays free, cancel() stops it,
+// and any other call on that World is refused by C with LockedError (one call at a time per world)
+// and changes nothing.
+
+const fs = require('node:fs');
+const nodePath = require('node:path');
 
 const capi = require('./capi');
 const buf = require('./buffers');
@@ -157,6 +165,18 @@ function fill(def, type, fields, what) {
   return def;
 }
 
+/** options.allowPathsOutsideBase of a load: true or false only (a security choice is not guessed). */
+function allowOutside(value, what) {
+  const opts = options(value, what);
+  const allow = take(opts, 'allow_paths_outside_base');
+  if (opts.size) throw new TypeError(`${what}: unknown option '${[...opts.keys()][0]}' (known: allowPathsOutsideBase)`);
+  if (allow === undefined) return false;
+  if (typeof allow !== 'boolean') {
+    throw new TypeError(`${what}.allowPathsOutsideBase: expected true or false, got ${buf.describe(allow)}`);
+  }
+  return allow;
+}
+
 function enumValue(value, table, name) {
   if (typeof value === 'string') {
     if (!Object.prototype.hasOwnProperty.call(table, value)) {
@@ -193,6 +213,12 @@ const ADOPT = Symbol('adopt');
 /** An embra world. Call close() when done (or let it be garbage-collected); a closed World refuses calls. */
 class World {
   #ptr = null;
+  /** A stepAsync frame is inside C on a worker thread. */
+  #inFlight = false;
+  /** close() during that frame: the pointer to destroy when it returns. */
+  #destroyWhenReturned = null;
+  /** stepAsync calls run one after another. */
+  #queue = Promise.resolve();
 
   /**
    * A world from embra_default_solver_def() and `settings`: any embra_solver_def field (dt, substeps,
@@ -214,39 +240,69 @@ class World {
     registry.register(this, ptr, this);
   }
 
-  /** A world from scene JSON text (a string or UTF-8 bytes); `baseDir` resolves relative OBJ paths. */
-  static loadJson(text, baseDir = null) {
+  /**
+   * A world from scene JSON text (a string or UTF-8 bytes). The scene's OBJ paths are relative to
+   * `baseDir` (null: the current folder) and must stay inside it, unless
+   * `loadOptions.allowPathsOutsideBase` is true (for scenes the host trusts: absolute paths and '..' allowed).
+   */
+  static loadJson(text, baseDir = null, loadOptions = undefined) {
     let data;
     if (typeof text === 'string') data = Buffer.from(text, 'utf8');
     else if (text instanceof Uint8Array) data = text;
     else throw new TypeError(`text: expected a string or a Uint8Array, got ${buf.describe(text)}`);
-    const dir = baseDir === null || baseDir === undefined ? null : buf.cString(baseDir, 'baseDir');
+    const def = lib.embra_default_load_options();
+    def.allow_paths_outside_base = allowOutside(loadOptions, 'loadJson options') ? 1 : 0;
+    def.base_dir = baseDir === null || baseDir === undefined ? null : buf.cString(baseDir, 'baseDir');
     const out = [null];
-    check(lib.embra_world_load_json(out, data, data.length, dir));
+    check(lib.embra_world_load_json_with_options(out, data, data.length, def));
     return new World(ADOPT, out[0]);
   }
 
-  /** A world from a scene file (relative OBJ paths resolve against its folder). */
-  static loadFile(path) {
+  /**
+   * A world from a scene file. Its OBJ paths are relative to the file's folder and must stay inside it,
+   * unless `loadOptions.allowPathsOutsideBase` is true (as for loadJson).
+   */
+  static loadFile(path, loadOptions = undefined) {
+    const file = buf.cString(path, 'path');
+    if (allowOutside(loadOptions, 'loadFile options')) {
+      // embra_world_load_file has no options: the file is read here, its folder the base
+      return World.loadJson(fs.readFileSync(file), nodePath.dirname(file), { allowPathsOutsideBase: true });
+    }
     const out = [null];
-    check(lib.embra_world_load_file(out, buf.cString(path, 'path')));
+    check(lib.embra_world_load_file(out, file));
     return new World(ADOPT, out[0]);
   }
 
   // --- lifetime -----------------------------------------------------------------------------------
 
-  /** Destroys the world (embra_world_destroy). Idempotent. */
+  /**
+   * Destroys the world (embra_world_destroy). Idempotent. During a stepAsync frame it cancels that frame
+   * and the world is destroyed when the worker returns; the stepAsync promise rejects.
+   */
   close() {
     const ptr = this.#ptr;
     this.#ptr = null;
-    if (ptr !== null) {
-      registry.unregister(this);
+    if (ptr === null) return;
+    registry.unregister(this);
+    if (this.#inFlight) {
+      lib.embra_world_cancel(ptr);
+      this.#destroyWhenReturned = ptr;
+    } else {
       lib.embra_world_destroy(ptr);
     }
   }
 
   get closed() {
     return this.#ptr === null;
+  }
+
+  /**
+   * Asks the step in progress (a stepAsync frame on a worker thread) to stop: that frame rejects with
+   * CancelledError and the world is as before it. A request made while no step runs stops the next frame
+   * stepped, before its first iteration. The one call C accepts while another is in progress.
+   */
+  cancel() {
+    this.#call('embra_world_cancel');
   }
 
   /** Calls a C function with this world first; a closed World passes NULL, which C refuses. */
@@ -746,11 +802,74 @@ class World {
 
   // --- stepping and reading back ------------------------------------------------------------------
 
-  /** Advances `frames` frames. NumericalError: the world is as before the failing frame. */
+  /**
+   * Advances `frames` frames on this thread. NumericalError: the world is as before the failing frame (the
+   * frames before it stay stepped).
+   */
   step(frames = 1) {
     buf.int32(frames, 'frames');
     if (frames < 0) throw new RangeError(`frames: ${frames} is negative`);
     for (let i = 0; i < frames; i++) this.#call('embra_world_step');
+  }
+
+  /**
+   * Advances `frames` frames on koffi's worker threads, one embra_world_step at a time; the promise
+   * resolves when the last returns. While a frame runs, cancel() stops it (CancelledError) and every other
+   * call on this World throws LockedError. A frame that fails rejects the promise with the error of its
+   * status (NumericalError, CancelledError, ...): the world is as before that frame. The C message stays
+   * on the worker thread, so the error's message is composed here. A frame that found the world in use
+   * by a call made on the JS thread at that instant did not run and is dispatched again. stepAsync calls
+   * made while one runs wait for it.
+   */
+  stepAsync(frames = 1) {
+    buf.int32(frames, 'frames');
+    if (frames < 0) throw new RangeError(`frames: ${frames} is negative`);
+    const run = this.#queue.then(async () => {
+      for (let i = 0; i < frames; i++) await this.#stepOnWorker();
+    });
+    this.#queue = run.catch(() => {});
+    return run;
+  }
+
+  #stepOnWorker() {
+    return new Promise((resolve, reject) => {
+      const ptr = this.#ptr;
+      if (ptr === null) {
+        try {
+          this.#call('embra_world_step'); // C refuses the NULL world with its message
+        } catch (e) {
+          reject(e);
+        }
+        return;
+      }
+      this.#inFlight = true;
+      lib.embra_world_step.async(ptr, (failure, status) => {
+        this.#inFlight = false;
+        const closed = this.#destroyWhenReturned !== null;
+        if (closed) {
+          lib.embra_world_destroy(this.#destroyWhenReturned);
+          this.#destroyWhenReturned = null;
+        }
+        if (failure) reject(failure);
+        else if (status === capi.OK) resolve();
+        // the JS thread was inside a call on this World just then (the frame did not run): again
+        else if (status === capi.ERROR_LOCKED && !closed) this.#stepOnWorker().then(resolve, reject);
+        else reject(this.#workerError(status, closed));
+      });
+    });
+  }
+
+  /** The error of a frame that failed on a worker thread (whose C message stays on that thread). */
+  #workerError(status, closed) {
+    let text = `embra_world_step (on a worker thread): ${lib.embra_status_name(status)}`;
+    if (status === capi.ERROR_CANCELLED) text += ' by World.cancel()';
+    if (status === capi.ERROR_NUMERICAL && !closed) {
+      const w = this.warning();
+      text += ` at particle ${w.particle} in frame ${w.frame} (World.warning())`;
+    }
+    if (status === capi.ERROR_CANCELLED || status === capi.ERROR_NUMERICAL) text += '; the world is as before the frame';
+    if (closed) text += '; the World was closed meanwhile';
+    return errorFor(status, text);
   }
 
   /** The report of the last step: {frame, time, kinetic_energy, max_speed, residual_max, ...}. */

@@ -149,9 +149,9 @@ test('a bad def version, bad values, unknown fields', () => {
 
 test('a bad scene', () => {
   const e = refusedByC(() => embra.World.loadJson('{"format": "embra-scene", "version": 1, "solver": {"dt": 0}}'),
-    embra.SchemaError, 'embra_world_load_json');
+    embra.SchemaError, 'embra_world_load_json_with_options');
   assert.match(e.message, /\/solver\/dt/);
-  refusedByC(() => embra.World.loadJson('{ not json'), embra.SchemaError, 'embra_world_load_json');
+  refusedByC(() => embra.World.loadJson('{ not json'), embra.SchemaError, 'embra_world_load_json_with_options');
   refusedByC(() => embra.World.loadFile('/nonexistent-embra-dir/scene.json'), embra.InvalidArgumentError,
     'embra_world_load_file');
   refused(() => embra.World.loadFile('a\0b'), RangeError, /NUL/);
@@ -179,8 +179,10 @@ test('wrong lengths and types are refused before C', () => {
 });
 
 test('a step that goes non-finite restores the world and records where', () => {
+  // 1e300 m/s, the largest value a world accepts, overflows in the step (the stretch constraints
+  // square lengths of 1e297 m)
   const w = square();
-  w.setVelocities([[1e308, 0.0, 0.0]], 1);
+  w.setVelocities([[embra.capi.MAX_ABS_VALUE, 0.0, 0.0]], 1);
   const before = snapshot(w);
   const frame = w.report().frame;
   const e = refusedByC(() => w.step(), embra.NumericalError, 'embra_world_step', /^embra_world_step: non-finite/);
@@ -189,6 +191,52 @@ test('a step that goes non-finite restores the world and records where', () => {
   assert.equal(w.report().frame, frame);
   assert.equal(w.warning().frame, frame);
   assert.ok(w.warning().particle >= 0);
+  w.setVelocities([[0.0, 0.0, 0.0]], 1); // the cause removed, the world steps on
+  w.step();
+  assert.equal(w.report().frame, frame + 1);
+  w.close();
+});
+
+test('values beyond the ranges of embra.h are refused and change nothing', () => {
+  // |v| > 1e300, masses and positives below 1e-300, dt > 1e6, substeps x iterations > 1e5, unit_scale > 1e12
+  const { capi } = embra;
+  const big = 1e308;
+  const tiny = capi.MIN_POSITIVE / 10;
+  const w = square();
+  const pin = w.createPin(0, [0, 0, 0]);
+  const state = () => ({ ...snapshot(w), solver: w.solver, target: w.pinTarget(pin) });
+  const before = state();
+  const I = embra.InvalidArgumentError;
+  refusedByC(() => w.setVelocities([[big, 0, 0]], 1), I, 'embra_world_set_velocities', /1e\+?300/);
+  refusedByC(() => w.setPositions([[0, -2 * capi.MAX_ABS_VALUE, 0]], 2), I, 'embra_world_set_positions');
+  refusedByC(() => w.setGravity([0, 0, big]), I, 'embra_world_set_gravity');
+  refusedByC(() => w.setPinTarget(pin, [big, 0, 0]), I, 'embra_pin_set_target');
+  refusedByC(() => w.createPin(1, [0, big, 0]), I, 'embra_pin_create');
+  refusedByC(() => w.createBody(SQUARE, { triangles: SQUARE_TRIS, masses: [1, 1, 1, tiny] }), I, 'embra_body_create');
+  refusedByC(() => w.setSolver({ dt: 2 * capi.MAX_DT }), I, 'embra_world_set_solver');
+  refusedByC(() => w.setSolver({ dt: tiny }), I, 'embra_world_set_solver');
+  refusedByC(() => w.setSolver({ substeps: 1000, iterations: capi.MAX_PASSES_PER_STEP / 1000 + 1 }), I,
+    'embra_world_set_solver');
+  refusedByC(() => w.setTolerances({ unitScale: 10 * capi.MAX_UNIT_SCALE }), I, 'embra_world_set_tolerances');
+  refusedByC(() => w.createCollider('sphere', { position: [0, 0, big], radius: 1 }), I, 'embra_collider_create');
+  assert.deepEqual(state(), before);
+  w.close();
+});
+
+test('values at the limits are accepted, and the saved scene loads back', () => {
+  const { capi } = embra;
+  const top = capi.MAX_ABS_VALUE;
+  const w = new embra.World({ dt: capi.MAX_DT, substeps: 1000, iterations: capi.MAX_PASSES_PER_STEP / 1000,
+    gravity: [top, -top, 0] });
+  w.createBody([[top, 0, -top]], { masses: [capi.MIN_POSITIVE] }); // one particle each: no element measure
+  w.createBody([[0, top, 0]], { masses: [top] });
+  w.createPin(0, [-top, top, top]);
+  w.setTolerances({ unitScale: capi.MAX_UNIT_SCALE });
+  const text = w.saveJson();
+  const back = embra.World.loadJson(text);
+  assert.equal(back.saveJson(), text);
+  assert.deepEqual(back.positions(), w.positions());
+  back.close();
   w.close();
 });
 

@@ -28,17 +28,38 @@ test('every header function is bound, and nothing else', () => {
   }
 });
 
-test('every status code, enum value and def version is mirrored with its value', () => {
+test('every status code, enum value, def version, range and limit is mirrored with its value', () => {
   const constants = new Map([...header.matchAll(/\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)/g)].map((m) => [m[1], m[2]]));
-  for (const m of header.matchAll(/#define\s+EMBRA_([A-Z0-9_]+)\s+(-?\d+)\b/g)) constants.set(m[1], m[2]);
-  assert.ok(constants.size > 30, `only ${constants.size} constants found in embra.h`);
+  // every numeric #define: def versions and the ranges and limits (1e300, 1e-300, 2097152, ...)
+  for (const m of header.matchAll(/^#define\s+EMBRA_([A-Z0-9_]+)\s+([-+0-9.eE]+)\s*$/gm)) constants.set(m[1], m[2]);
+  assert.ok(constants.size > 40, `only ${constants.size} constants found in embra.h`);
   assert.ok([...constants.keys()].some((k) => k.endsWith('_DEF_VERSION')), 'no *_DEF_VERSION found');
+  for (const name of ['ERROR_CANCELLED', 'LOAD_OPTIONS_VERSION', 'MAX_ABS_VALUE', 'MIN_POSITIVE', 'MAX_DT',
+    'MAX_PASSES_PER_STEP', 'MAX_OBJ_BYTES']) assert.ok(constants.has(name), `EMBRA_${name} not found in embra.h`);
   const missing = [];
   for (const [name, value] of constants) {
     if (capi[name] !== Number(value)) missing.push(`EMBRA_${name} = ${value} (capi.${name} is ${capi[name]})`);
   }
   assert.deepEqual(missing, [], `not mirrored in lib/capi.js:\n  ${missing.join('\n  ')}`);
   assert.equal(capi.ABI_VERSION, embra.abiVersion());
+});
+
+test('every status code has its own error class, which names it', () => {
+  const statuses = Object.entries(capi).filter(([k]) => k.startsWith('ERROR_'));
+  assert.ok(statuses.some(([k]) => k === 'ERROR_LOCKED') && statuses.some(([k]) => k === 'ERROR_CANCELLED'));
+  const classes = new Set();
+  for (const [name, status] of statuses) {
+    const e = embra.errorFor(status, 'message');
+    assert.ok(e instanceof embra.EmbraError && e.constructor !== embra.EmbraError, name);
+    assert.equal(e.status, status);
+    assert.equal(e.statusName, `EMBRA_${name}`);
+    assert.equal(e.message, 'message');
+    assert.equal(e.constructor.STATUS, status);
+    classes.add(e.constructor);
+  }
+  assert.equal(classes.size, statuses.length);
+  assert.ok(embra.errorFor(capi.ERROR_LOCKED, '') instanceof embra.LockedError);
+  assert.ok(embra.errorFor(capi.ERROR_CANCELLED, '') instanceof embra.CancelledError);
 });
 
 test('the names the World methods accept cover each enum', () => {
