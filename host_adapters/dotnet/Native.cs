@@ -19,6 +19,21 @@ namespace Embra
         public const int Locked = -6;
         public const int Numerical = -7;
         public const int Internal = -8;
+        public const int Cancelled = -9;
+    }
+
+    /// <summary>EMBRA_MAX_* and EMBRA_MIN_POSITIVE: the ranges and limits of what a world accepts
+    /// (beyond them: EMBRA_ERROR_INVALID_ARGUMENT). Meanings: embra.h, RANGES AND LIMITS.</summary>
+    public static class Limits
+    {
+        public const double MaxAbsValue = 1e300;
+        public const double MinPositive = 1e-300;
+        public const double MaxDt = 1e6;
+        public const double MaxUnitScale = 1e12;
+        public const int MaxParticles = 2097152;
+        public const int MaxConstraints = 16777216;
+        public const int MaxPassesPerStep = 100000;
+        public const long MaxObjBytes = 268435456;
     }
 
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7 }
@@ -231,6 +246,16 @@ namespace Embra
         public double Strength, Radius, Twist, Decay, StartTime;
     }
 
+    /// <summary>embra_load_options (EMBRA_LOAD_OPTIONS_VERSION 1): where a scene's OBJ paths resolve
+    /// (BaseDir, a NUL-terminated UTF-8 string or IntPtr.Zero for ".") and whether they may leave it.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct LoadOptions
+    {
+        public const int CurrentVersion = 1;
+        public int Version, AllowPathsOutsideBase;
+        public IntPtr BaseDir;
+    }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct StepReport
     {
@@ -328,6 +353,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_collider_get_transform(IntPtr world, ColliderId collider, [Out] double[] position, [Out] double[] rotation);
         // stepping and reading back
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_step(IntPtr world);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_cancel(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_report(IntPtr world, out StepReport report);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_warning(IntPtr world, out Warning warning);
@@ -338,6 +364,8 @@ namespace Embra
         // JSON scenes
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_load_json(out IntPtr world, byte[] json, long length, byte[] baseDir);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_load_file(out IntPtr world, byte[] path);
+        [DllImport(Library, CallingConvention = C)] public static extern LoadOptions embra_default_load_options();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_load_json_with_options(out IntPtr world, byte[] json, long length, ref LoadOptions options);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_save_json(IntPtr world, [Out] byte[] json, long capacity, out long length);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_save_file(IntPtr world, byte[] path);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_scene_frames(IntPtr world, out long frames);

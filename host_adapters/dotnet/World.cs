@@ -1,8 +1,11 @@
 // The managed side of embra: a SafeHandle owning each world, exceptions carrying the C message,
 // and World, whose methods cover the whole C ABI with flat double[] / int[] arrays pinned in place
-// (no per-element marshalling). One thread at a time per World; different Worlds may step on
-// different threads (or tasks) at once.
+// (no per-element marshalling). Threads sharing one World take turns (a lock around each call; the
+// C library refuses a second concurrent call on a world with EMBRA_ERROR_LOCKED); Cancel() takes no
+// turn, so another thread can stop a long Step. Different Worlds may step on different threads (or
+// tasks) at once.
 using System;
+using System.IO;
 using System.Runtime.InteropServices;
 using System.Text;
 
@@ -38,6 +41,22 @@ namespace Embra
     {
         public EmbraInvalidOperationException(int status, string message) : base(message) { Status = status; }
         public int Status { get; private set; }
+        public string StatusName { get { return Errors.StatusName(Status); } }
+    }
+
+    /// <summary>EMBRA_ERROR_LOCKED: the world is in use by a call in progress on another thread; this call
+    /// changed nothing and did not wait. A World's own methods take turns, so this comes from calls made on
+    /// the same embra_world* around the World (through Native with World.Handle).</summary>
+    public class EmbraLockedException : EmbraInvalidOperationException
+    {
+        public EmbraLockedException(string message) : base(Embra.Status.Locked, message) { }
+    }
+
+    /// <summary>EMBRA_ERROR_CANCELLED: World.Cancel() stopped the step; the world is as before that frame.</summary>
+    public class EmbraCancelledException : OperationCanceledException, IEmbraException
+    {
+        public EmbraCancelledException(string message) : base(message) { }
+        public int Status { get { return Embra.Status.Cancelled; } }
         public string StatusName { get { return Errors.StatusName(Status); } }
     }
 
@@ -101,10 +120,13 @@ namespace Embra
                     return new EmbraSchemaException(message);
                 case Status.StaleId:
                 case Status.Version:
-                case Status.Locked:
                     return new EmbraInvalidOperationException(status, message);
+                case Status.Locked:
+                    return new EmbraLockedException(message);
                 case Status.Numerical:
                     return new EmbraNumericalException(message);
+                case Status.Cancelled:
+                    return new EmbraCancelledException(message);
                 default:
                     return new EmbraException(status, message);
             }
@@ -183,18 +205,42 @@ namespace Embra
             handle = new WorldHandle(world);
         }
 
-        public static World LoadJson(string json, string baseDir = null)
+        /// <summary>A world from scene JSON text. Its OBJ paths are relative to baseDir (null: the current
+        /// folder) and must stay inside it, unless allowPathsOutsideBase (for scenes the host trusts:
+        /// absolute paths and ".." allowed).</summary>
+        public static World LoadJson(string json, string baseDir = null, bool allowPathsOutsideBase = false)
         {
             Library.Touch();
-            byte[] text = Encoding.UTF8.GetBytes(json);
+            if (json == null) throw new ArgumentNullException("json");
+            return LoadJson(Encoding.UTF8.GetBytes(json), baseDir, allowPathsOutsideBase);
+        }
+
+        static World LoadJson(byte[] text, string baseDir, bool allowPathsOutsideBase)
+        {
+            var options = Native.embra_default_load_options();
+            options.AllowPathsOutsideBase = allowPathsOutsideBase ? 1 : 0;
+            byte[] dir = CString(baseDir);
             IntPtr world;
-            Errors.Check(Native.embra_world_load_json(out world, text, text.LongLength, CString(baseDir)));
+            fixed (byte* d = dir)
+            {
+                options.BaseDir = (IntPtr)d;  // null when baseDir is
+                Errors.Check(Native.embra_world_load_json_with_options(out world, text, text.LongLength, ref options));
+            }
             return new World(world);
         }
 
-        public static World LoadFile(string path)
+        /// <summary>A world from a scene file. Its OBJ paths are relative to the file's folder and must stay
+        /// inside it, unless allowPathsOutsideBase (as for LoadJson).</summary>
+        public static World LoadFile(string path, bool allowPathsOutsideBase = false)
         {
             Library.Touch();
+            if (allowPathsOutsideBase)
+            {
+                // embra_world_load_file has no options: the file is read here, its folder the base
+                if (path == null) throw new ArgumentNullException("path");
+                string folder = Path.GetDirectoryName(path);
+                return LoadJson(File.ReadAllBytes(path), string.IsNullOrEmpty(folder) ? "." : folder, true);
+            }
             IntPtr world;
             Errors.Check(Native.embra_world_load_file(out world, CString(path)));
             return new World(world);
@@ -211,6 +257,32 @@ namespace Embra
             lock (gate) handle.Dispose();
         }
         public bool IsDisposed { get { return handle.IsClosed; } }
+
+        /// <summary>Asks the step in progress (on another thread) to stop: that Step throws
+        /// EmbraCancelledException with the world as before its frame. Callable from any thread at any
+        /// time: it does not wait for the turn the step holds. A request made while no step runs stops the
+        /// next frame stepped. A disposed World throws EmbraObjectDisposedException.</summary>
+        public void Cancel()
+        {
+            bool added = false;
+            try
+            {
+                try
+                {
+                    if (!handle.IsClosed) handle.DangerousAddRef(ref added);  // the world stays alive for the call
+                }
+                catch (ObjectDisposedException)
+                {
+                    // disposed between the check and the reference (Cancel takes no turn): as disposed
+                }
+                int status = Native.embra_world_cancel(added ? handle.DangerousGetHandle() : IntPtr.Zero);
+                if (status != Status.Ok) throw Errors.For(status, !added);
+            }
+            finally
+            {
+                if (added) handle.DangerousRelease();
+            }
+        }
         public WorldHandle Handle { get { return handle; } }
 
         delegate int Fn(IntPtr world);
@@ -649,6 +721,8 @@ namespace Embra
         }
 
         // --- stepping and reading back ----------------------------------------------------------
+        /// <summary>Advances frames. EmbraNumericalException, or EmbraCancelledException (Cancel() from
+        /// another thread): the world is as before the failing frame; the frames before it stay stepped.</summary>
         public void Step(int frames = 1)
         {
             for (int i = 0; i < frames; ++i) Call(Native.embra_world_step);

@@ -10,6 +10,7 @@ using System.Linq;
 using System.Reflection;
 using System.Runtime.InteropServices;
 using System.Text.RegularExpressions;
+using System.Threading;
 using System.Threading.Tasks;
 using Embra;
 using Embra.Grasshopper;
@@ -269,7 +270,9 @@ namespace Embra.Tests
         {
             using (var w = Square())
             {
-                w.SetVelocities(new[] { 1e308, 0, 0 }, 1);  // overflows to infinity in the step
+                // 1e300 m/s, the largest value a world accepts, overflows in the step (the stretch
+                // constraints square lengths of 1e297 m)
+                w.SetVelocities(new[] { Limits.MaxAbsValue, 0, 0 }, 1);
                 string before = Snapshot(w);
                 long frame = w.Report.Frame;
                 var e = Assert.Throws<EmbraNumericalException>(() => w.Step());
@@ -278,7 +281,97 @@ namespace Embra.Tests
                 Assert.AreEqual(before, Snapshot(w));  // restored to the start of the frame
                 Assert.AreEqual(frame, w.Warning.Frame);
                 Assert.GreaterOrEqual(w.Warning.Particle, 0);
+                w.SetVelocities(new double[] { 0, 0, 0 }, 1);  // the cause removed, the world steps on
+                w.Step();
+                Assert.AreEqual(frame + 1, w.Report.Frame);
             }
+        }
+
+        [Test]
+        public void ValuesBeyondTheRangesAreRefusedAndChangeNothing()
+        {
+            // |v| > 1e300, masses and positives below 1e-300, dt > 1e6, substeps x iterations > 1e5, unit_scale > 1e12
+            const double big = 1e308, tiny = Limits.MinPositive / 10;
+            using (var w = Square())
+            {
+                var pin = w.CreatePin(0, new double[] { 0, 0, 0 });
+                Func<string> state = () => Snapshot(w) + "|" + string.Join(",", w.PinTarget(pin)) + "|" + w.Solver.Dt +
+                    "," + w.Solver.Substeps + "," + w.Solver.Iterations + "|" + w.Tolerances.UnitScale;
+                string before = state();
+                var refused = new List<Tuple<string, TestDelegate>> {
+                    Tuple.Create<string, TestDelegate>("embra_world_set_velocities", () => w.SetVelocities(new[] { big, 0, 0 }, 1)),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_positions", () => w.SetPositions(new[] { 0, -2 * Limits.MaxAbsValue, 0 }, 2)),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_gravity", () => w.SetGravity(0, 0, big)),
+                    Tuple.Create<string, TestDelegate>("embra_pin_set_target", () => w.SetPinTarget(pin, new[] { big, 0, 0 })),
+                    Tuple.Create<string, TestDelegate>("embra_pin_create", () => w.CreatePin(1, new[] { 0, big, 0 })),
+                    Tuple.Create<string, TestDelegate>("embra_body_create", () => w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0 },
+                        new[] { 0, 1, 2 }, masses: new[] { 1, 1, tiny })),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_solver", () => { var d = w.Solver; d.Dt = 2 * Limits.MaxDt; w.Solver = d; }),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_solver", () => { var d = w.Solver; d.Dt = tiny; w.Solver = d; }),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_solver", () => {
+                        var d = w.Solver; d.Substeps = 1000; d.Iterations = Limits.MaxPassesPerStep / 1000 + 1; w.Solver = d; }),
+                    Tuple.Create<string, TestDelegate>("embra_world_set_tolerances", () => {
+                        var t = w.Tolerances; t.UnitScale = 10 * Limits.MaxUnitScale; w.Tolerances = t; }),
+                };
+                foreach (var r in refused)
+                {
+                    var e = Assert.Throws<EmbraArgumentException>(r.Item2, r.Item1);
+                    StringAssert.StartsWith(r.Item1 + ": ", e.Message);
+                }
+                Assert.AreEqual(before, state());
+            }
+        }
+
+        [Test]
+        public void ValuesAtTheLimitsAreAcceptedAndTheSavedSceneLoadsBack()
+        {
+            const double top = Limits.MaxAbsValue;
+            var solver = Library.DefaultSolverDef();
+            solver.Dt = Limits.MaxDt;
+            solver.Substeps = 1000;
+            solver.Iterations = Limits.MaxPassesPerStep / 1000;
+            unsafe { solver.Gravity[0] = top; solver.Gravity[1] = -top; solver.Gravity[2] = 0; }
+            using (var w = new World(solver))
+            {
+                w.CreateBody(new[] { top, 0, -top }, masses: new[] { Limits.MinPositive });  // one particle each:
+                w.CreateBody(new[] { 0, top, 0 }, masses: new[] { top });                   // no element measure
+                w.CreatePin(0, new[] { -top, top, top });
+                var t = w.Tolerances;
+                t.UnitScale = Limits.MaxUnitScale;
+                w.Tolerances = t;
+                string text = w.SaveJson();
+                using (var back = World.LoadJson(text))
+                {
+                    Assert.AreEqual(text, back.SaveJson());
+                    Env.AssertBitIdentical(w.GetPositions(), back.GetPositions());
+                }
+            }
+        }
+
+        [Test]
+        public void EveryStatusMapsToItsException()
+        {
+            var statuses = typeof(Status).GetFields(BindingFlags.Public | BindingFlags.Static)
+                .Where(f => f.Name != "Ok").ToDictionary(f => f.Name, f => (int)f.GetValue(null));
+            Assert.That(statuses.Keys, Has.Member("Locked").And.Member("Cancelled"));
+            Assert.IsInstanceOf<EmbraLockedException>(Errors.For(Status.Locked));
+            Assert.IsInstanceOf<InvalidOperationException>(Errors.For(Status.Locked));
+            Assert.IsInstanceOf<EmbraCancelledException>(Errors.For(Status.Cancelled));
+            Assert.IsInstanceOf<OperationCanceledException>(Errors.For(Status.Cancelled));
+            Assert.IsInstanceOf<EmbraNumericalException>(Errors.For(Status.Numerical));
+            Assert.AreEqual("EMBRA_ERROR_CANCELLED", Errors.StatusName(Status.Cancelled));
+            foreach (var s in statuses)
+            {
+                var e = Errors.For(s.Value);
+                Assert.AreEqual(s.Value, ((IEmbraException)e).Status, s.Key);
+                Assert.AreEqual("EMBRA_ERROR_" + Regex.Replace(s.Key, "(?<=.)([A-Z])", "_$1").ToUpperInvariant(),
+                                ((IEmbraException)e).StatusName, s.Key);
+            }
+            // LOCKED, CANCELLED, NUMERICAL and SCHEMA each have a type of their own (the others share
+            // ArgumentException / InvalidOperationException types, told apart by Status)
+            foreach (int own in new[] { Status.Locked, Status.Cancelled, Status.Numerical, Status.Schema })
+                Assert.AreEqual(1, statuses.Values.Count(v => Errors.For(v).GetType() == Errors.For(own).GetType()),
+                                Errors.StatusName(own));
         }
 
         [Test]
@@ -599,7 +692,8 @@ namespace Embra.Tests
                 def.PanelSize = double.NaN;
                 var nan = Assert.Throws<EmbraArgumentException>(() => w.CreatePanelMesh(def));
                 Assert.That(nan, Is.InstanceOf<ArgumentException>());
-                Assert.AreEqual("embra_panel_mesh_create: panel size must be finite", nan.Message);
+                StringAssert.StartsWith("embra_panel_mesh_create: panel size must be finite", nan.Message);
+                Assert.AreEqual(Errors.LastMessage(), nan.Message);  // the C message, verbatim
                 Assert.Throws<EmbraArgumentException>(() => w.CreatePanelMesh(null, new double[] { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 }, new[] { 0, 1, 2, 9 }));
                 Assert.Throws<ArgumentException>(() => w.CreatePanelMesh(null, new double[] { 0, 0, 0 }, null));  // refused before C
 
@@ -720,6 +814,149 @@ namespace Embra.Tests
             StringAssert.Contains("world is NULL", e.InnerException.Message);
         }
 
+        /// <summary>A pinned n x n cloth stepped with the most passes a step may take (substeps x iterations
+        /// = EMBRA_MAX_PASSES_PER_STEP): one frame takes seconds.</summary>
+        static World LongCloth(int n)
+        {
+            var xyz = new List<double>();
+            var tri = new List<int>();
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j)
+                    xyz.AddRange(new[] { 0.05 * j, 0.05 * i, 0 });
+            for (int i = 0; i + 1 < n; ++i)
+                for (int j = 0; j + 1 < n; ++j)
+                {
+                    int v = i * n + j;
+                    tri.AddRange(new[] { v, v + 1, v + n + 1, v, v + n + 1, v + n });
+                }
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 1000;
+            solver.Iterations = Limits.MaxPassesPerStep / 1000;
+            var w = new World(solver);
+            var def = Native.embra_default_body_def();
+            def.Material.Mass = 0.1;
+            w.CreateBody(xyz.ToArray(), tri.ToArray(), def: def);
+            w.CreatePin(0, new[] { xyz[0], xyz[1], xyz[2] });
+            w.CreatePin(n - 1, new[] { xyz[3 * n - 3], xyz[3 * n - 2], xyz[3 * n - 1] });
+            return w;
+        }
+
+        /// <summary>A call on the world made around the World's turns (Native, World.Handle) is refused with LOCKED.</summary>
+        static bool HeldByAnotherCall(World w)
+        {
+            WorldCounts c;
+            return Native.embra_world_get_counts(w.Handle.DangerousGetHandle(), out c) == Status.Locked;
+        }
+
+        [Test]
+        public void CancelFromAnotherThreadStopsALongStep()
+        {
+            using (var w = LongCloth(24))
+            {
+                string before = w.SaveJson();
+                long frame = w.Report.Frame;
+                Exception outcome = null;
+                bool completed = false;
+                var stepper = new Thread(() =>
+                {
+                    while (true)
+                    {
+                        try { w.Step(); completed = true; return; }
+                        catch (EmbraLockedException) { }  // HeldByAnotherCall's probe had the world just then
+                        catch (Exception failure) { outcome = failure; return; }
+                    }
+                });
+                stepper.Start();
+                while (!HeldByAnotherCall(w))  // the step is in progress
+                    Assert.IsTrue(stepper.IsAlive, "the step ended before it was seen in progress");
+                w.Cancel();  // takes no turn: the step holds it
+                stepper.Join();
+                Assert.IsFalse(completed, "the step was not cancelled");
+                Assert.IsInstanceOf<EmbraCancelledException>(outcome);
+                Assert.IsInstanceOf<OperationCanceledException>(outcome);
+                var e = (EmbraCancelledException)outcome;
+                Assert.AreEqual(Status.Cancelled, e.Status);
+                Assert.AreEqual("EMBRA_ERROR_CANCELLED", e.StatusName);
+                StringAssert.StartsWith("embra_world_step: ", e.Message);
+                Assert.AreEqual(before, w.SaveJson());  // as before the frame
+                Assert.AreEqual(frame, w.Report.Frame);
+                var solver = w.Solver;  // the request was consumed: the world steps on
+                solver.Substeps = 2;
+                solver.Iterations = 1;
+                w.Solver = solver;
+                w.Step();
+                Assert.AreEqual(frame + 1, w.Report.Frame);
+            }
+            using (var w = LongCloth(4))
+            {
+                string before = w.SaveJson();
+                w.Cancel();  // no step in progress: the next one stops before its first iteration
+                Assert.Throws<EmbraCancelledException>(() => w.Step());
+                Assert.AreEqual(before, w.SaveJson());
+            }
+            var disposed = new World();
+            disposed.Dispose();
+            var d = Assert.Throws<EmbraObjectDisposedException>(() => disposed.Cancel());
+            StringAssert.Contains("embra_world_cancel: world is NULL", d.Message);
+        }
+
+        [Test]
+        public void RawCallsAroundTheWorldsTurnsGetLockedNeverACrash()
+        {
+            // Native calls on one world from two threads with no turns between them: while one steps, the
+            // other's calls are refused with LOCKED and change nothing; every status is OK or LOCKED, and the
+            // frame count is the number of steps that returned OK.
+            using (var w = Chain())
+            {
+                IntPtr ptr = w.Handle.DangerousGetHandle();
+                var stepStatuses = new List<int>();
+                var otherStatuses = new List<int>();
+                var lockedErrors = new List<Exception>();
+                double lastGravity = -9.81;
+                var done = new ManualResetEventSlim();
+                var stepper = new Thread(() =>
+                {
+                    for (int i = 0; i < 200000; ++i)
+                    {
+                        lock (lockedErrors) if (lockedErrors.Count >= 20) break;
+                        stepStatuses.Add(Native.embra_world_step(ptr));
+                    }
+                    done.Set();
+                });
+                var other = new Thread(() =>
+                {
+                    var xyz = new double[24];
+                    for (int i = 1; !done.IsSet; ++i)
+                    {
+                        var g = new double[] { 0, 0, -(i % 50) };
+                        int status = Native.embra_world_set_gravity(ptr, g);
+                        otherStatuses.Add(status);
+                        if (status == Status.Ok) lastGravity = g[2];
+                        int read = Native.embra_world_get_positions(ptr, xyz, xyz.Length, 0, 8);
+                        otherStatuses.Add(read);
+                        foreach (int s in new[] { status, read })
+                            if (s == Status.Locked)
+                                lock (lockedErrors) lockedErrors.Add(Errors.For(s));  // this thread's C message
+                    }
+                });
+                stepper.Start();
+                other.Start();
+                stepper.Join();
+                other.Join();
+                CollectionAssert.IsSubsetOf(stepStatuses.Concat(otherStatuses).Distinct().ToList(), new[] { Status.Ok, Status.Locked });
+                Assert.GreaterOrEqual(lockedErrors.Count, 20, "calls overlapping a step");
+                foreach (var e in lockedErrors)
+                {
+                    Assert.IsInstanceOf<EmbraLockedException>(e);
+                    StringAssert.Contains("in use by a call in progress", e.Message);
+                }
+                Assert.AreEqual((long)stepStatuses.Count(s => s == Status.Ok), w.Report.Frame);
+                var solver = w.Solver;
+                unsafe { Assert.AreEqual(lastGravity, solver.Gravity[2]); }  // refused calls changed nothing
+                w.Step();
+            }
+        }
+
         [Test]
         public void TwoTentsOnTwoTasksEqualOneAfterTheOther()
         {
@@ -776,6 +1013,22 @@ namespace Embra.Tests
                     value = (int)mirror.Item2.GetField(name).GetValue(null);
                 Assert.AreEqual(c.Value, value, "EMBRA_" + c.Key);
             }
+            Assert.That(constants.Keys, Has.Member("ERROR_CANCELLED"));
+            // EMBRA_MAX_ABS_VALUE -> Limits.MaxAbsValue, EMBRA_MIN_POSITIVE -> Limits.MinPositive, ... (same value and kind)
+            var limits = Regex.Matches(header, @"^#define\s+EMBRA_((?:MAX|MIN)_[A-Z0-9_]+)\s+([-+0-9.eE]+)\s*$", RegexOptions.Multiline)
+                .Cast<Match>().ToList();
+            Assert.GreaterOrEqual(limits.Count, 8);
+            var mirrored = typeof(Limits).GetFields(BindingFlags.Public | BindingFlags.Static).ToDictionary(f => f.Name);
+            foreach (Match m in limits)
+            {
+                string name = Pascal(m.Groups[1].Value), text = m.Groups[2].Value;
+                Assert.IsTrue(mirrored.ContainsKey(name), "EMBRA_" + m.Groups[1].Value + " has no Limits." + name);
+                object value = mirrored[name].GetValue(null);
+                bool integer = Regex.IsMatch(text, @"^-?\d+$");
+                Assert.AreEqual(integer, !(value is double), "EMBRA_" + m.Groups[1].Value + " is " + (integer ? "an integer" : "a double"));
+                Assert.AreEqual(double.Parse(text, CultureInfo.InvariantCulture), Convert.ToDouble(value), "EMBRA_" + m.Groups[1].Value);
+            }
+            Assert.AreEqual(limits.Count, mirrored.Count, "Limits has a constant embra.h does not define");
             // EMBRA_PANEL_MESH_DEF_VERSION -> PanelMeshDef.CurrentVersion, EMBRA_TOLERANCES_VERSION -> Tolerances...
             var versions = Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_VERSION\s+(\d+)").Cast<Match>().ToList();
             Assert.GreaterOrEqual(versions.Count, 10);
@@ -983,6 +1236,81 @@ namespace Embra.Tests
                 StringAssert.Contains("99", component.RuntimeMessages[0].Value);
                 Env.AssertBitIdentical(before, component.PositionsXyz());
             }
+        }
+    }
+
+    /// <summary>A scene's OBJ paths resolve against its folder (the file's for LoadFile, baseDir for LoadJson)
+    /// and may not leave it unless the host allows it (allowPathsOutsideBase).</summary>
+    [TestFixture]
+    public class LoadOptionsTests
+    {
+        const string Obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";  // one quad: 4 vertices
+
+        static string Scene(string obj)
+        {
+            return "{\"format\": \"embra-scene\", \"version\": 1, \"name\": \"obj_scene\", \"bodies\": [{\"name\": \"sheet\", " +
+                   "\"mesh\": {\"obj\": \"" + obj.Replace("\\", "\\\\") + "\"}, \"material\": {\"mass\": 0.5}}]}";
+        }
+
+        string root, scenes;
+
+        [SetUp]
+        public void Folders()
+        {
+            root = Env.TempDir();
+            scenes = Path.Combine(root, "scenes");
+            Directory.CreateDirectory(scenes);
+            File.WriteAllText(Path.Combine(root, "outside.obj"), Obj);
+            File.WriteAllText(Path.Combine(scenes, "inside.obj"), Obj);
+            File.WriteAllText(Path.Combine(scenes, "inside.json"), Scene("inside.obj"));
+            File.WriteAllText(Path.Combine(scenes, "outside.json"), Scene("../outside.obj"));
+            File.WriteAllText(Path.Combine(scenes, "absolute.json"), Scene(Path.Combine(root, "outside.obj")));
+        }
+
+        [TearDown]
+        public void Remove() { Directory.Delete(root, true); }
+
+        static int Particles(World w)
+        {
+            using (w) return w.Counts.Particles;
+        }
+
+        [Test]
+        public void ObjPathsResolveAgainstTheScenesFolder()
+        {
+            string cwd = Environment.CurrentDirectory;
+            Environment.CurrentDirectory = root;  // not the scene's folder
+            try
+            {
+                Assert.AreEqual(4, Particles(World.LoadFile(Path.Combine(scenes, "inside.json"))));
+                Assert.AreEqual(4, Particles(World.LoadJson(File.ReadAllText(Path.Combine(scenes, "inside.json")), scenes)));
+                Assert.AreEqual(4, Particles(World.LoadFile(Path.Combine("scenes", "inside.json"), allowPathsOutsideBase: true)));
+            }
+            finally { Environment.CurrentDirectory = cwd; }
+        }
+
+        [TestCase("outside.json", "../outside.obj")]
+        [TestCase("absolute.json", null)]
+        public void ObjPathsOutOfTheScenesFolderAreRefusedUnlessAllowed(string name, string obj)
+        {
+            obj = obj ?? Path.Combine(root, "outside.obj");
+            string file = Path.Combine(scenes, name), text = File.ReadAllText(file);
+            var e = Assert.Catch<Exception>(() => World.LoadFile(file));
+            Assert.IsInstanceOf<IEmbraException>(e);
+            StringAssert.StartsWith("embra_world_load_file: ", e.Message);
+            StringAssert.Contains(obj, e.Message);
+            e = Assert.Catch<Exception>(() => World.LoadJson(text, scenes));
+            Assert.IsInstanceOf<IEmbraException>(e);
+            StringAssert.StartsWith("embra_world_load_json_with_options: ", e.Message);
+            StringAssert.Contains(obj, e.Message);
+            // the host that trusts the scene says so
+            Assert.AreEqual(4, Particles(World.LoadFile(file, allowPathsOutsideBase: true)));
+            Assert.AreEqual(4, Particles(World.LoadJson(text, scenes, allowPathsOutsideBase: true)));
+            Assert.Throws<FileNotFoundException>(() => World.LoadFile(Path.Combine(scenes, "missing.json"), true));
+            var o = Native.embra_default_load_options();
+            Assert.AreEqual(LoadOptions.CurrentVersion, o.Version);
+            Assert.AreEqual(0, o.AllowPathsOutsideBase);
+            Assert.AreEqual(IntPtr.Zero, o.BaseDir);
         }
     }
 
