@@ -1,6 +1,7 @@
 'use strict';
-// The ctest entry of the Node adapter tests (adapters.node): checks that the adapter's npm packages
-// are installed, then runs every *.test.js here with `node --test`.
+// The ctest entries of the Node adapter tests: checks that the adapter's npm packages are installed,
+// then runs *.test.js here with `node --test`: `run.js live` the live server's (live*.test.js,
+// ctest adapters.node.live), `run.js` the rest (adapters.node).
 
 const { spawnSync } = require('node:child_process');
 const fs = require('node:fs');
@@ -17,7 +18,9 @@ if (!fs.existsSync(path.join(modules, 'koffi', 'package.json'))) {
     `  Install them with: (cd ${path.dirname(modules)} && npm ci)   (scripts/deps.sh does)`);
   process.exit(1);
 }
-const tests = fs.readdirSync(__dirname).filter((f) => f.endsWith('.test.js')).sort()
+const live = process.argv[2] === 'live';
+const tests = fs.readdirSync(__dirname).filter((f) => f.endsWith('.test.js'))
+  .filter((f) => f.startsWith('live') === live).sort()
   .map((f) => path.join(__dirname, f));
 if (tests.length === 0) {
   console.error(`adapters.node: no *.test.js in ${__dirname}`);
