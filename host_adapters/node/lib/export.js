@@ -9,6 +9,8 @@
 // increasing particle order), so a panel mesh's top and bottom layers stay separate objects'
 // geometry exactly as the solver holds them.
 
+const fs = require('fs');
+const path = require('path');
 const { errorColor } = require('./colors');
 
 /** Per-particle RGB for one error field against its tolerance; NaN/null values are "not measured". */
@@ -110,72 +112,135 @@ function toGltf(snapshot) {
 }
 
 let rhinoModule = null;
-/** rhino3dm's WebAssembly module, loaded once. */
-async function rhino() {
-  if (!rhinoModule) rhinoModule = await require('rhino3dm')();
+let rhinoMemory = null;
+
+/**
+ * rhino3dm's WebAssembly module, loaded once (concurrent first calls share the load). The module is
+ * instantiated here (Emscripten's instantiateWasm hook) only to keep its memory in view for
+ * rhinoHeapBytes; the bytes and imports are rhino3dm's own.
+ */
+function rhino() {
+  if (!rhinoModule) {
+    rhinoModule = new Promise((resolve, reject) => {
+      const wasm = path.join(path.dirname(require.resolve('rhino3dm')), 'rhino3dm.wasm');
+      require('rhino3dm')({
+        instantiateWasm(imports, done) {
+          WebAssembly.instantiate(fs.readFileSync(wasm), imports).then(({ instance, module }) => {
+            rhinoMemory = Object.values(instance.exports).find((e) => e instanceof WebAssembly.Memory) ||
+              (imports.env && imports.env.memory) || null;
+            done(instance, module);
+          }, reject);
+          return {};
+        },
+      }).then(resolve, reject);
+    });
+    rhinoModule.catch(() => { rhinoModule = null; }); // a failed load is retried by the next call
+  }
   return rhinoModule;
+}
+
+/**
+ * The size in bytes of rhino3dm's WebAssembly heap (its linear memory, which only ever grows), or
+ * 0 before the module is loaded. Every export returns what it allocated, so after the first export
+ * this stays the same however many follow.
+ */
+function rhinoHeapBytes() {
+  return rhinoMemory ? rhinoMemory.buffer.byteLength : 0;
+}
+
+/**
+ * Runs `body(own)` and deletes, whatever happens, every rhino3dm object passed through `own` (which
+ * returns its argument). rhino3dm's objects live in the WebAssembly heap until deleted, and every
+ * accessor (doc.settings(), doc.objects(), mesh.vertices(), ...) returns a new one.
+ */
+async function withOwned(body) {
+  const owned = [];
+  const own = (object) => {
+    if (object) owned.push(object);
+    return object;
+  };
+  try {
+    return await body(own);
+  } finally {
+    for (const object of owned.reverse()) release(object);
+  }
+}
+
+/**
+ * Deletes one rhino3dm object through Embind's own `delete` (found on the prototype that defines
+ * `isDeleted`): some classes shadow it with a method of their own, File3dmObjectTable.delete(id).
+ */
+function release(object) {
+  let handle = Object.getPrototypeOf(object);
+  while (handle && !Object.prototype.hasOwnProperty.call(handle, 'isDeleted')) handle = Object.getPrototypeOf(handle);
+  if (!handle) throw new TypeError('not a rhino3dm object');
+  if (!handle.isDeleted.call(object)) handle.delete.call(object);
 }
 
 /**
  * Rhino .3dm bytes (openNURBS through rhino3dm): a mesh object per body, named after it, with 8-bit
  * vertex colours. Units: metres. Mesh vertices are single precision, as Rhino stores them (a .3dm
  * written by rhino3dm with double-precision vertices reads back rounded to float all the same): a
- * position is the solver's rounded to the nearest float, about 0.1 micrometre at 1 m.
+ * position is the solver's rounded to the nearest float, about 0.1 micrometre at 1 m. Every
+ * rhino3dm object it makes is deleted before it returns or throws.
  */
 async function to3dm(snapshot) {
   checkSnapshot(snapshot);
   const r = await rhino();
-  const doc = new r.File3dm();
-  doc.settings().modelUnitSystem = r.UnitSystem.Meters;
-  for (const m of snapshot.meshes) {
-    const { used, indices } = compact(m.triangles);
-    const mesh = new r.Mesh();
-    const vertices = mesh.vertices();
-    for (const p of used) vertices.add(snapshot.positions[3 * p], snapshot.positions[3 * p + 1], snapshot.positions[3 * p + 2]);
-    const faces = mesh.faces();
-    for (let k = 0; k < indices.length; k += 3) faces.addTriFace(indices[k], indices[k + 1], indices[k + 2]);
-    if (snapshot.colors) {
-      const colors = mesh.vertexColors();
-      const byte = (v) => Math.max(0, Math.min(255, Math.round(v * 255)));
-      for (const p of used)
-        colors.add(byte(snapshot.colors[3 * p]), byte(snapshot.colors[3 * p + 1]), byte(snapshot.colors[3 * p + 2]));
+  return withOwned((own) => {
+    const doc = own(new r.File3dm());
+    own(doc.settings()).modelUnitSystem = r.UnitSystem.Meters;
+    const objects = own(doc.objects());
+    for (const m of snapshot.meshes) {
+      const { used, indices } = compact(m.triangles);
+      const mesh = own(new r.Mesh());
+      const vertices = own(mesh.vertices());
+      for (const p of used) vertices.add(snapshot.positions[3 * p], snapshot.positions[3 * p + 1], snapshot.positions[3 * p + 2]);
+      const faces = own(mesh.faces());
+      for (let k = 0; k < indices.length; k += 3) faces.addTriFace(indices[k], indices[k + 1], indices[k + 2]);
+      if (snapshot.colors) {
+        const colors = own(mesh.vertexColors());
+        const byte = (v) => Math.max(0, Math.min(255, Math.round(v * 255)));
+        for (const p of used)
+          colors.add(byte(snapshot.colors[3 * p]), byte(snapshot.colors[3 * p + 1]), byte(snapshot.colors[3 * p + 2]));
+      }
+      own(mesh.normals()).computeNormals();
+      const attributes = own(new r.ObjectAttributes());
+      attributes.name = m.name;
+      objects.add(mesh, attributes);
     }
-    mesh.normals().computeNormals();
-    const attributes = new r.ObjectAttributes();
-    attributes.name = m.name;
-    doc.objects().add(mesh, attributes);
-    mesh.delete();
-    attributes.delete();
-  }
-  const bytes = doc.toByteArray();
-  doc.delete();
-  return Buffer.from(bytes);
+    return Buffer.from(doc.toByteArray());
+  });
 }
 
-/** A .3dm read back: per mesh object its name, vertex positions (xyz doubles), colours and face count. */
+/**
+ * A .3dm read back: per mesh object its name, vertex positions (xyz doubles), colours and face
+ * count. Like to3dm, it deletes every rhino3dm object it makes.
+ */
 async function read3dm(bytes) {
   const r = await rhino();
-  const doc = r.File3dm.fromByteArray(new Uint8Array(bytes));
-  if (!doc) throw new Error('not a readable .3dm file');
-  const out = [];
-  const objects = doc.objects();
-  for (let i = 0; i < objects.count; ++i) {
-    const o = objects.get(i);
-    const g = o.geometry();
-    if (!(g instanceof r.Mesh)) continue;
-    const v = g.vertices();
-    const positions = new Float64Array(v.count * 3);
-    for (let k = 0; k < v.count; ++k) positions.set(v.get(k), 3 * k);
-    const c = g.vertexColors();
-    const colors = [];
-    for (let k = 0; k < c.count; ++k) {
-      const { r: red, g: green, b: blue } = c.get(k);
-      colors.push([red, green, blue]);
+  return withOwned((own) => {
+    const doc = own(r.File3dm.fromByteArray(new Uint8Array(bytes)));
+    if (!doc) throw new Error('not a readable .3dm file');
+    const out = [];
+    const objects = own(doc.objects());
+    for (let i = 0; i < objects.count; ++i) {
+      const o = own(objects.get(i));
+      const g = own(o.geometry());
+      if (!(g instanceof r.Mesh)) continue;
+      const v = own(g.vertices());
+      const positions = new Float64Array(v.count * 3);
+      for (let k = 0; k < v.count; ++k) positions.set(v.get(k), 3 * k);
+      const c = own(g.vertexColors());
+      const colors = [];
+      for (let k = 0; k < c.count; ++k) {
+        const { r: red, g: green, b: blue } = c.get(k);
+        colors.push([red, green, blue]);
+      }
+      out.push({ name: own(o.attributes()).name, positions, colors, faces: own(g.faces()).count });
     }
-    out.push({ name: o.attributes().name, positions, colors, faces: g.faces().count });
-  }
-  doc.delete();
-  return out;
+    return out;
+  });
 }
 
-module.exports = { fieldColors, toGltf, to3dm, read3dm, compact };
+module.exports = { fieldColors, toGltf, to3dm, read3dm, rhinoHeapBytes, compact };

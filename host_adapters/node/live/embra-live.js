@@ -1,24 +1,38 @@
 #!/usr/bin/env node
 'use strict';
-// embra-live SCENE.json [--port P] [--host H] [--save-dir DIR] [--web DIR]
+// embra-live SCENE.json [--port P] [--host H] [--save-dir DIR] [--web DIR] [--allow-origin ORIGIN]...
+//                       [--max-connections N] [--keep-files N]
 //
 // Loads a scene, steps it in real time and serves the page at http://H:P/ (loopback by default):
 // drag the mesh, move colliders, toggle gravity and pins, change group weights and rest scales,
-// save a design alternative as scene JSON, export glTF or Rhino .3dm. The protocol is
-// docs/live-protocol.md. Exit codes: 0 stopped by a signal, 1 usage, 2 the scene or a file is invalid.
+// save a design alternative as scene JSON, export glTF or Rhino .3dm. The protocol and the security
+// model are docs/live-protocol.md. Exit codes: 0 stopped by a signal, 1 usage, 2 the scene or a
+// file is invalid.
 
 const fs = require('fs');
 const path = require('path');
-const { startServer } = require('./server');
+const { startServer, checkOrigin, DEFAULTS } = require('./server');
+
+const USAGE = 'usage: embra-live SCENE.json [--port P] [--host 127.0.0.1] [--save-dir DIR] [--web DIR]\n' +
+  '                  [--allow-origin ORIGIN]... [--max-connections N] [--keep-files N]\n' +
+  `  --save-dir DIR         the output folder of save and export (default: the current folder)\n` +
+  `  --keep-files N         files of this scene kept there, the oldest deleted beyond (default ${DEFAULTS.keepFiles})\n` +
+  `  --allow-origin ORIGIN  another origin whose pages may connect, e.g. http://192.168.1.5:8710 (repeatable)\n` +
+  `  --max-connections N    WebSocket connections at once (default ${DEFAULTS.maxConnections})\n`;
 
 function usage(message) {
   if (message) process.stderr.write(`embra-live: ${message}\n`);
-  process.stderr.write('usage: embra-live SCENE.json [--port P] [--host 127.0.0.1] [--save-dir DIR] [--web DIR]\n');
+  process.stderr.write(USAGE);
   process.exit(1);
 }
 
 function parse(argv) {
-  const o = { port: 8710, host: '127.0.0.1', saveDir: '.', web: undefined, scene: undefined };
+  const o = { port: 8710, host: '127.0.0.1', saveDir: '.', web: undefined, scene: undefined, allowOrigins: [] };
+  const count = (what, text) => {
+    const n = Number(text);
+    if (!Number.isInteger(n) || n < 1) usage(`${what} must be an integer >= 1`);
+    return n;
+  };
   for (let i = 0; i < argv.length; ++i) {
     const a = argv[i];
     const value = () => {
@@ -31,6 +45,15 @@ function parse(argv) {
     } else if (a === '--host') o.host = value();
     else if (a === '--save-dir') o.saveDir = value();
     else if (a === '--web') o.web = value();
+    else if (a === '--allow-origin') {
+      try {
+        o.allowOrigins.push(checkOrigin(value()));
+      } catch (e) {
+        usage(e.message);
+      }
+    }
+    else if (a === '--max-connections') o.maxConnections = count(a, value());
+    else if (a === '--keep-files') o.keepFiles = count(a, value());
     else if (a === '-h' || a === '--help') usage();
     else if (a.startsWith('-')) usage(`unknown option ${a}`);
     else if (o.scene === undefined) o.scene = a;
@@ -53,7 +76,8 @@ async function main() {
     process.exit(2);
   }
   const s = live.session;
-  process.stdout.write(`embra-live: ${s.name} (${s.particles} particles, dt ${s.dt.toFixed(4)} s) at ${live.url}\n`);
+  const name = s.name.replace(/[\u0000-\u001f\u007f-\u009f]/g, '?'); // the scene's own text: no terminal controls
+  process.stdout.write(`embra-live: ${name} (${s.particles} particles, dt ${s.dt.toFixed(4)} s) at ${live.url}\n`);
   const stop = () => live.close().then(() => process.exit(0));
   process.on('SIGINT', stop);
   process.on('SIGTERM', stop);

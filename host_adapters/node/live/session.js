@@ -2,7 +2,8 @@
 // One live scene: the world a page watches and edits (docs/live-protocol.md). The server owns the
 // clock and the sockets; a Session owns the world, turns it into the protocol's messages, and
 // applies the page's edits. Every edit is validated here or refused by the C library; either way a
-// refused edit changes nothing and comes back as an `error` reply.
+// refused edit changes nothing and comes back as an `error` reply. Saves and exports go to one
+// output folder under names made here (never from the scene), the oldest deleted beyond a bound.
 
 const fs = require('fs');
 const path = require('path');
@@ -12,6 +13,17 @@ const { fieldColors, toGltf, to3dm } = require('../lib/export');
 const FIELDS = ['planarity', 'thickness', 'miter'];
 const DRAG_COMPLIANCE = 1e-6; // m/N: a soft pin firm enough to lead, soft enough not to tear
 const MAGIC = 0x464d4245; // 'EBMF' little-endian
+/**
+ * A page's coordinates (drag targets, collider positions) are places in the scene: within its
+ * workspace, the box around everything the scene holds at load (particles, pin targets, collider
+ * positions) grown on every side by WORKSPACE_REACH times its diagonal (at least 1 model unit).
+ * The C library accepts any coordinate up to +-1e300, but a drag pin pulled to 1e200 makes the
+ * next step fail and one pulled to 1e30 flings the mesh beyond what a frame's float32 can carry.
+ */
+const WORKSPACE_REACH = 1000;
+/** Output files kept per scene in the output folder (the oldest deleted beyond it), by default. */
+const KEEP_FILES = 100;
+const OUTPUT_KINDS = ['json', 'gltf', '3dm'];
 
 class RefusedMessage extends Error {}
 
@@ -23,6 +35,15 @@ function finite3(value, what, n = 3) {
   if (!Array.isArray(value) || value.length !== n || !value.every((v) => typeof v === 'number' && Number.isFinite(v)))
     refuse(`${what} must be ${n} finite numbers`);
   return value;
+}
+
+/**
+ * The stem of output file names: the scene file's name as given on the command line (never the
+ * scene's `name`), reduced to [A-Za-z0-9_-] and at most 64 characters; "scene" if nothing is left.
+ */
+function outputStem(scenePath) {
+  const stem = path.basename(scenePath, path.extname(scenePath)).replace(/[^A-Za-z0-9_-]/g, '_').slice(0, 64);
+  return /[A-Za-z0-9]/.test(stem) ? stem : 'scene';
 }
 
 function indexIn(value, list, what) {
@@ -39,12 +60,18 @@ function bool(value, what) {
 class Session {
   /**
    * @param {string} scenePath a scene JSON file (schemas/scene.schema.json)
-   * @param {{saveDir?: string}} options where `save` and `export` write their files
+   * @param {{saveDir?: string, keepFiles?: number}} options the output folder `save` and `export`
+   *   write to (default: the current folder), and how many of this scene's files it keeps there
    */
   constructor(scenePath, options = {}) {
     this.scenePath = path.resolve(scenePath);
     this.sceneText = fs.readFileSync(this.scenePath, 'utf8');
     this.saveDir = path.resolve(options.saveDir || '.');
+    this.keepFiles = options.keepFiles ?? KEEP_FILES;
+    if (!Number.isInteger(this.keepFiles) || this.keepFiles < 1) throw new RangeError('keepFiles must be an integer >= 1');
+    this.stem = outputStem(this.scenePath);
+    this.outputPattern = new RegExp(`^${this.stem}-(\\d{6,})-f\\d+\\.(${OUTPUT_KINDS.join('|')})$`);
+    this.seq = 0;
     this.world = null;
     this.#load();
   }
@@ -107,6 +134,36 @@ class Session {
     this.positions = new Float64Array(3 * this.particles);
     this.fieldValues = FIELDS.map(() => new Float64Array(this.particles).fill(NaN));
     this.#measure();
+    this.workspace = this.#workspace();
+  }
+
+  /** The box a page's coordinates must lie in (WORKSPACE_REACH): {min, max}, 3 numbers each. */
+  #workspace() {
+    const lo = [Infinity, Infinity, Infinity];
+    const hi = [-Infinity, -Infinity, -Infinity];
+    const add = (p) => p.forEach((v, k) => {
+      lo[k] = Math.min(lo[k], v);
+      hi[k] = Math.max(hi[k], v);
+    });
+    for (let i = 0; i < this.particles; ++i) add(this.positions.subarray(3 * i, 3 * i + 3));
+    for (const p of this.pins) add(this.world.pinTarget(p.id));
+    for (const c of this.colliders) add(this.world.colliderTransform(c.id).position);
+    if (lo[0] > hi[0]) { // an empty scene: the box around the origin
+      lo.fill(0);
+      hi.fill(0);
+    }
+    const reach = WORKSPACE_REACH * Math.max(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]), 1);
+    return { min: lo.map((v) => v - reach), max: hi.map((v) => v + reach) };
+  }
+
+  /** A point of the scene from a page: 3 finite numbers inside the workspace. */
+  #point(value, what) {
+    finite3(value, what);
+    const { min, max } = this.workspace;
+    if (!value.every((v, k) => v >= min[k] && v <= max[k]))
+      refuse(`${what} ${JSON.stringify(value)} is outside the scene's workspace ` +
+             `[${min.map((v) => v.toPrecision(6))}] .. [${max.map((v) => v.toPrecision(6))}]`);
+    return value;
   }
 
   /** Reads the state the messages report: positions, error fields and the frame's numbers. */
@@ -217,14 +274,14 @@ class Session {
       case 'drag_start': {
         if (!Number.isInteger(msg.particle) || msg.particle < 0 || msg.particle >= this.particles)
           refuse(`particle ${JSON.stringify(msg.particle)} is not in [0, ${this.particles})`);
-        const target = finite3(msg.target, 'target');
+        const target = this.#point(msg.target, 'target');
         const pin = w.createPin(msg.particle, target, { compliance: DRAG_COMPLIANCE });
         this.releaseDrag(page);
         this.drags.set(page, { pin, particle: msg.particle });
         return {};
       }
       case 'drag': {
-        const target = finite3(msg.target, 'target');
+        const target = this.#point(msg.target, 'target');
         const drag = this.drags.get(page);
         if (!drag) refuse('drag without drag_start');
         w.setPinTarget(drag.pin, target);
@@ -235,7 +292,7 @@ class Session {
         return {};
       case 'collider_pose': {
         const c = indexIn(msg.index, this.colliders, 'collider');
-        const position = finite3(msg.position, 'position');
+        const position = this.#point(msg.position, 'position');
         const rotation = msg.rotation === undefined ? w.colliderTransform(c.id).rotation : finite3(msg.rotation, 'rotation', 4);
         w.setColliderTransform(c.id, position, rotation);
         return {};
@@ -290,25 +347,73 @@ class Session {
         return { scene: true };
       case 'save': {
         const json = this.#saveWithoutDrags();
-        fs.mkdirSync(this.saveDir, { recursive: true });
-        const file = path.join(this.saveDir, `${this.name}-${String(this.record.frame).padStart(5, '0')}.json`);
-        fs.writeFileSync(file, json);
+        const file = this.writeOutput('json', json, this.record.frame);
         return { replies: [{ type: 'saved', path: file, json }] };
       }
       case 'export': {
         if (msg.format !== 'gltf' && msg.format !== '3dm') refuse('format must be "gltf" or "3dm"');
         const metric = msg.metric ?? 'planarity';
         if (!FIELDS.includes(metric)) refuse(`metric must be one of ${FIELDS.join(', ')}`);
-        const file = path.join(this.saveDir, `${this.name}-${String(this.record.frame).padStart(5, '0')}.${msg.format}`);
+        const frame = this.record.frame;
         const bytes = await this.exportBytes(msg.format, metric);
-        fs.mkdirSync(this.saveDir, { recursive: true });
-        fs.writeFileSync(file, bytes);
+        const file = this.writeOutput(msg.format, bytes, frame);
         return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
       }
       default:
         refuse(`unknown message type ${JSON.stringify(msg.type)}`);
     }
     return {};
+  }
+
+  /** This scene's files in the output folder, oldest first: [{name, seq}]. */
+  outputFiles() {
+    let entries;
+    try {
+      entries = fs.readdirSync(this.saveDir, { withFileTypes: true });
+    } catch (e) {
+      if (e.code === 'ENOENT') return [];
+      throw e;
+    }
+    return entries.filter((d) => d.isFile() || d.isSymbolicLink())
+      .map((d) => ({ name: d.name, m: this.outputPattern.exec(d.name) })).filter((f) => f.m)
+      .map((f) => ({ name: f.name, seq: Number(f.m[1]) })).sort((a, b) => a.seq - b.seq);
+  }
+
+  /**
+   * Writes one output file as `<stem>-<seq>-f<frame>.<kind>` in the output folder and returns its
+   * path. `seq` counts up past every file of this scene already there; the file is created, never
+   * overwritten (nor a link followed); beyond keepFiles of this scene's files the oldest are deleted.
+   */
+  writeOutput(kind, data, frame) {
+    if (!OUTPUT_KINDS.includes(kind)) throw new RangeError(`no output kind ${kind}`);
+    try {
+      fs.mkdirSync(this.saveDir, { recursive: true });
+      const existing = this.outputFiles();
+      for (let attempt = 0; ; ++attempt) {
+        this.seq = Math.max(this.seq, existing.length ? existing[existing.length - 1].seq : 0) + 1;
+        const name = `${this.stem}-${String(this.seq).padStart(6, '0')}-f${String(frame).padStart(5, '0')}.${kind}`;
+        const file = path.resolve(this.saveDir, name);
+        if (path.dirname(file) !== this.saveDir || !this.outputPattern.test(path.basename(file)))
+          throw new Error(`${name} is not a file name of the output folder`); // unreachable: names are made here
+        try {
+          fs.writeFileSync(file, data, { flag: 'wx' });
+        } catch (e) {
+          if (e.code === 'EEXIST' && attempt < 10) continue;
+          throw e;
+        }
+        const files = this.outputFiles();
+        for (const old of files.slice(0, Math.max(0, files.length - this.keepFiles))) {
+          try {
+            fs.unlinkSync(path.join(this.saveDir, old.name));
+          } catch (e) {
+            if (e.code !== 'ENOENT') throw e;
+          }
+        }
+        return file;
+      }
+    } catch (e) {
+      refuse(`output folder ${this.saveDir}: ${e.message}`);
+    }
   }
 
   /** Ends a page's drag (its pin destroyed); nothing when it holds none. Also when a page closes. */
@@ -353,4 +458,4 @@ class Session {
   }
 }
 
-module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE };
+module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, WORKSPACE_REACH, KEEP_FILES, outputStem };
