@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libccd-dev nlohmann-json3-dev libvalijson-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format binutils
+  clang-14 libclang-rt-14-dev llvm-14
   python3-jsonschema
   python3-pytest python3-numpy
   mono-mcs nunit-console libnunit-cil-dev

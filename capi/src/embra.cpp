@@ -660,11 +660,15 @@ embra_collider_def embra_default_collider_def(void) {
   return d;
 }
 
+}  // extern "C"
+
 namespace {
 Eigen::Quaterniond quat(const double* wxyz) {
   return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
 }
 }  // namespace
+
+extern "C" {
 
 embra_status embra_collider_create(embra_world* world, const embra_collider_def* def, embra_collider_id* out_collider) {
   return guard("embra_collider_create", world, [&] {
@@ -891,6 +895,8 @@ embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_
   });
 }
 
+}  // extern "C"
+
 namespace {
 const embra::PanelLayout& layout_of(const embra_world* world, embra_body_id body) {
   world->world.body(to_id(body));  // stale ids: EMBRA_ERROR_STALE_ID
@@ -956,6 +962,8 @@ void write_text(const std::string& text, char* out, int64_t capacity, int64_t* o
   *out_length = n;
 }
 }  // namespace
+
+extern "C" {
 
 embra_status embra_panel_mesh_get_panel_count(const embra_world* world, embra_body_id body, int32_t* out_count) {
   return guard("embra_panel_mesh_get_panel_count", world, [&] {
@@ -1059,6 +1067,8 @@ embra_status embra_panel_mesh_export_cuts(const embra_world* world, embra_body_i
 
 // --- JSON scenes -------------------------------------------------------------------------------
 
+}  // extern "C"
+
 namespace {
 embra_world* load_with(std::string_view text, const embra::io::LoadOptions& options) {
   embra::io::SceneMeta meta;
@@ -1077,6 +1087,8 @@ std::string folder_of(const std::string& path) {
   return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
 }
 }  // namespace
+
+extern "C" {
 
 embra_status embra_world_load_json(embra_world** out_world, const char* json, int64_t length, const char* base_dir) {
   if (out_world != nullptr) *out_world = nullptr;
@@ -1184,6 +1196,8 @@ embra_status embra_world_get_scene_frames(const embra_world* world, int64_t* out
 
 // --- fields ------------------------------------------------------------------------------------
 
+}  // extern "C"
+
 namespace {
 /// The body index a field def names: -1 for {0,0} when `optional`, else a live body (or refused).
 int32_t field_body(const embra_world* world, embra_body_id body, bool optional, const char* def) {
@@ -1200,6 +1214,8 @@ embra_field_id create_field(embra_world* world, const embra::FieldDesc& d) {
   return from_id<embra_field_id>(world->world.create_field(d));
 }
 }  // namespace
+
+extern "C" {
 
 embra_wind_def embra_default_wind_def(void) {
   const embra::WindDesc w;

@@ -1528,6 +1528,11 @@ void World::step(const StepControl& control) {
   const FrameStart start = frame_start();
   const auto cancelled = [&] { return control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed); };
   try {
+    // A hard pin's particle glides from where it starts the frame (where the host's
+    // set_positions put it, or the pin's last target) to the target: derived from the state, so a
+    // saved and reloaded world steps the same.
+    for (Pin& p : pins_)
+      if (p.alive && p.compliance == 0.0) p.target_prev = x_[p.particle];
     if (control.before_frame) control.before_frame(*this);
     if (solver_dirty_)
       rebuild_solver();
@@ -1586,8 +1591,6 @@ void World::step(const StepControl& control) {
       for (size_t i = 0; i < a.size(); ++i)
         for (int c = 0; c < per; ++c) g.arrays[k].lambda[per * a.source[i] + c] = a.lambda[per * i + c];
     }
-  for (Pin& p : pins_)
-    if (p.alive) p.target_prev = p.target;
   for (Collider& c : colliders_)
     if (c.alive) {
       c.frame_position = c.desc.position;

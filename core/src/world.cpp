@@ -1249,7 +1249,6 @@ Id World::create_pin(const PinDesc& desc) {
   p = Pin{};
   p.particle = desc.particle;
   p.target = desc.target;
-  p.target_prev = desc.compliance == 0.0 ? x_[desc.particle] : desc.target;  // a hard pin glides there
   p.compliance = desc.compliance;
   p.group = gid;
   p.generation = generation;

@@ -339,7 +339,7 @@ struct Group {
 struct Pin {
   int32_t particle = 0;
   Vec3 target = Vec3::Zero();
-  Vec3 target_prev = Vec3::Zero();  // target at the start of the current frame
+  Vec3 target_prev = Vec3::Zero();  // hard pin: its particle's position at the start of the frame
   double compliance = 0.0;
   Id group;
   Vec3 lambda = Vec3::Zero();
