@@ -1,8 +1,9 @@
 /* The `embra` command. Uses only the C ABI (embra.h), as any CAD host would.
  *
  *   embra version
- *   embra validate SCENE.json
- *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T]
+ *   embra help
+ *   embra validate SCENE.json [--allow-outside-paths]
+ *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--allow-outside-paths]
  *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
@@ -11,6 +12,11 @@
  * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
  * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
  * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses.
+ *
+ * A scene's OBJ paths resolve against the scene file's folder and must stay inside it (no absolute
+ * path, no ".." or symbolic link leading out: a scene file may come from anyone);
+ * --allow-outside-paths lifts that for a scene you trust. Either way an OBJ file must be a regular
+ * file of at most EMBRA_MAX_OBJ_BYTES.
  *
  * `demo tent` is the paper's Gaudi paradigm (section 3.2, figure 6): a triangular cloth pinned at
  * its three corners under reversed gravity. The membrane is elastic, so reversed gravity stretches
@@ -21,6 +27,7 @@
  * Exit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,13 +40,82 @@
 
 enum { EXIT_USAGE = 1, EXIT_INVALID = 2, EXIT_SIM = 3 };
 
+static const char kUsage[] =
+    "usage: embra version\n"
+    "       embra help\n"
+    "       embra validate SCENE.json [--allow-outside-paths]\n"
+    "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--allow-outside-paths]\n"
+    "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]\n";
+
 static int usage(void) {
-  fprintf(stderr,
-          "usage: embra version\n"
-          "       embra validate SCENE.json\n"
-          "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T]\n"
-          "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]\n");
+  fputs(kUsage, stderr);
   return EXIT_USAGE;
+}
+
+static int help(void) {
+  fputs(kUsage, stdout);
+  fputs(
+      "\n"
+      "validate  loads SCENE.json (schemas/scene.schema.json) and builds its world; exit 0 if valid.\n"
+      "run       steps the scene N frames (default: its own \"frames\"; 0: load and save only) and writes\n"
+      "          DIR/final.json, DIR/metrics.jsonl, DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
+      "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files.\n"
+      "\n"
+      "OBJ files a scene names: paths are relative to the scene file's folder and must stay inside it\n"
+      "(an absolute path, or \"..\" or a symbolic link leading out, is refused: a scene file may come\n"
+      "from anyone). --allow-outside-paths lifts that for a scene you trust. Either way an OBJ file must\n",
+      stdout);
+  printf("be a regular file (no folder, device or pipe) of at most %lld bytes (EMBRA_MAX_OBJ_BYTES).\n",
+         (long long)EMBRA_MAX_OBJ_BYTES);
+  fputs("\nExit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state).\n", stdout);
+  return 0;
+}
+
+/* Loads the scene file at `path`: its OBJ paths relative to its folder and confined to it, unless
+ * `allow_outside` (then through embra_world_load_json_with_options, the scene read here: a regular
+ * file of at most 2 GiB). On failure prints why and returns EXIT_INVALID. */
+static int load_scene_file(const char* path, int allow_outside, embra_world** world) {
+  if (!allow_outside) {
+    if (embra_world_load_file(world, path) == EMBRA_OK) return 0;
+    fprintf(stderr, "embra: %s: %s\n", path, embra_last_error_message());
+    return EXIT_INVALID;
+  }
+  struct stat st;
+  const int fd = open(path, O_RDONLY | O_NONBLOCK); /* a pipe does not block the open */
+  FILE* f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+  if (f == NULL || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > ((int64_t)1 << 31)) {
+    fprintf(stderr, "embra: %s: %s\n", path, f == NULL ? strerror(errno) : "not a regular file of at most 2 GiB");
+    if (f)
+      fclose(f);
+    else if (fd >= 0)
+      close(fd);
+    return EXIT_INVALID;
+  }
+  char* text = malloc((size_t)st.st_size + 1);
+  const size_t got = text ? fread(text, 1, (size_t)st.st_size + 1, f) : 0;
+  const int failed = text == NULL || ferror(f) || got != (size_t)st.st_size;
+  fclose(f);
+  if (failed) {
+    fprintf(stderr, "embra: %s: cannot read it\n", path);
+    free(text);
+    return EXIT_INVALID;
+  }
+  char folder[4096];
+  const char* slash = strrchr(path, '/');
+  if (slash == NULL)
+    snprintf(folder, sizeof folder, ".");
+  else if (slash == path)
+    snprintf(folder, sizeof folder, "/");
+  else
+    snprintf(folder, sizeof folder, "%.*s", (int)(slash - path), path);
+  embra_load_options options = embra_default_load_options();
+  options.base_dir = folder;
+  options.allow_paths_outside_base = 1;
+  const embra_status s = embra_world_load_json_with_options(world, text, (int64_t)got, &options);
+  free(text);
+  if (s == EMBRA_OK) return 0;
+  fprintf(stderr, "embra: %s: %s\n", path, embra_last_error_message());
+  return EXIT_INVALID;
 }
 
 /* Parses a whole decimal integer in [lo, hi]; 0 on success. */
@@ -439,13 +515,11 @@ static void print_tolerance_row(const char* name, double value, embra_tolerance 
 }
 
 static int cmd_validate(int argc, char** argv) {
-  if (argc != 1) return usage();
+  const int allow_outside = argc == 2 && strcmp(argv[1], "--allow-outside-paths") == 0;
+  if (argc != 1 + allow_outside) return usage();
   embra_world* world = NULL;
-  const embra_status s = embra_world_load_file(&world, argv[0]);
-  if (s != EMBRA_OK) {
-    fprintf(stderr, "embra: %s: %s\n", argv[0], embra_last_error_message());
-    return EXIT_INVALID;
-  }
+  const int rc = load_scene_file(argv[0], allow_outside, &world);
+  if (rc != 0) return rc;
   embra_world_counts c;
   embra_world_get_counts(world, &c);
   printf("%s: valid (%d particles, %lld constraints, %d pins, %d colliders)\n", argv[0], c.particles,
@@ -536,7 +610,12 @@ static int cmd_run(int argc, char** argv) {
   const char* scene = argv[0];
   const char* out = "out";
   long frames = -1, every = 0, threads = 1;
+  int allow_outside = 0;
   for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--allow-outside-paths") == 0) {
+      allow_outside = 1;
+      continue;
+    }
     if (i + 1 >= argc) return usage();
     if (strcmp(argv[i], "--frames") == 0) {
       if (parse_int(argv[++i], 0, 100000000, &frames)) return usage();
@@ -552,10 +631,8 @@ static int cmd_run(int argc, char** argv) {
   }
   (void)threads; /* the solver is single-threaded for now; results never depend on this */
   embra_world* world = NULL;
-  if (embra_world_load_file(&world, scene) != EMBRA_OK) {
-    fprintf(stderr, "embra: %s: %s\n", scene, embra_last_error_message());
-    return EXIT_INVALID;
-  }
+  const int loaded = load_scene_file(scene, allow_outside, &world);
+  if (loaded != 0) return loaded;
   if (frames < 0) {
     int64_t f = 0;
     embra_world_get_scene_frames(world, &f);
@@ -729,6 +806,7 @@ int main(int argc, char** argv) {
     return EXIT_INVALID;
   }
   if (argc < 2) return usage();
+  if (strcmp(argv[1], "help") == 0 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) return help();
   if (strcmp(argv[1], "version") == 0) {
     printf("embra %s (ABI %d)\n", embra_version_string(), embra_abi_version());
     return 0;

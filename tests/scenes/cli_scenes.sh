@@ -12,6 +12,8 @@
 #    final.json and final.obj; 50 frames, then 50 from that final.json, end identical to 100;
 #    --every and --threads; a run without --frames steps the scene's own "frames".
 # 3. Usage errors exit 1, unreadable input exits 2.
+# 4. An OBJ path leading out of the scene's folder is refused unless --allow-outside-paths; `help`
+#    says so; special files stay refused either way.
 set -u
 embra="$1"
 invalid_dir="$2"
@@ -141,6 +143,22 @@ expect 2 "run a missing file" run "$work/no-such-scene.json" --out "$work/missin
 [ ! -e "$work/missing_out/final.json" ] && ok || bad "run of a missing file wrote final.json"
 expect 2 "validate a folder" validate "$work"
 expect 2 "run into an unwritable folder" run "$scene" --frames 0 --out /proc/embra-cannot-write
+
+# --- 4. OBJ paths outside the scene's folder: refused unless --allow-outside-paths ----------------
+expect 0 "help" help
+grep -q -- "--allow-outside-paths" "$work/usage.out" && grep -q "relative to the scene file's folder" "$work/usage.out" &&
+  ok || bad "help must explain --allow-outside-paths"
+outside="$invalid_dir/obj_parent_path.json" # its OBJ is ../valid/quad.obj
+expect 2 "validate an OBJ path outside the folder" validate "$outside"
+expect 0 "validate it with --allow-outside-paths" validate "$outside" --allow-outside-paths
+expect 1 "validate with an unknown flag" validate "$outside" --allow
+expect 2 "run an OBJ path outside the folder" run "$outside" --frames 1 --out "$work/outside_refused"
+[ ! -e "$work/outside_refused/final.json" ] && ok || bad "a refused OBJ path wrote final.json"
+expect 0 "run it with --allow-outside-paths" run "$outside" --frames 1 --allow-outside-paths --out "$work/outside"
+[ -s "$work/outside/final.json" ] && ok || bad "run --allow-outside-paths wrote no final.json"
+expect 2 "validate /dev/zero as a scene with --allow-outside-paths" validate /dev/zero --allow-outside-paths
+expect 2 "validate an OBJ of /dev/zero even when allowed" validate "$invalid_dir/obj_absolute_path.json" --allow-outside-paths
+grep -q "is not a regular file" "$work/usage.err" && ok || bad "/dev/zero as an OBJ: $(cat "$work/usage.err")"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -10,7 +10,8 @@
  * nesting limit's edge is refused the same way; a valid scene still loads after all of that.
  *
  * Usage: test_scene_invalid MANIFEST INVALID_DIR GENERATED_DIR
- *   Rows whose file is not in INVALID_DIR are looked up in GENERATED_DIR (written at test time). */
+ *   Rows of the manifest's table after the line "Generated at test time" are files in GENERATED_DIR
+ *   (written at test time); the others are in INVALID_DIR. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
 #include <stdlib.h>
@@ -86,14 +87,15 @@ static void corpus_is_refused(void) {
   int64_t length = 0;
   char* manifest = scene_read_file(g_manifest, &length);
   char *line, *save = NULL;
-  int rows = 0, committed = 0, generated = 0;
+  int rows = 0, committed = 0, generated = 0, in_generated = 0;
   CAPI_CONTEXT("%s", g_manifest);
   if (!CHECK(manifest != NULL)) return;
   for (line = strtok_r(manifest, "\n", &save); line != NULL; line = strtok_r(NULL, "\n", &save)) {
     const char* p = line;
     char file[256], cls[32], pointer[256], fragment[512], path[4096];
     FILE* probe;
-    const char* dir = g_dir;
+    const char* dir;
+    if (strncmp(line, "Generated at test time", 22) == 0) in_generated = 1;
     if (strncmp(line, "| `", 3) != 0) continue;
     CAPI_CONTEXT("manifest row %.200s", line);
     if (!CHECK(next_quoted(&p, file, sizeof file) && class_of(line, cls, sizeof cls) &&
@@ -102,18 +104,15 @@ static void corpus_is_refused(void) {
     CAPI_CONTEXT("%.120s (%.16s)", file, cls);
     CHECK(strcmp(cls, "syntax") == 0 || strcmp(cls, "schema") == 0 || strcmp(cls, "semantic") == 0 ||
           strcmp(cls, "depth") == 0);
-    snprintf(path, sizeof path, "%s/%s", g_dir, file);
+    dir = in_generated ? g_generated : g_dir;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
     probe = fopen(path, "rb");
-    if (probe == NULL) {
-      snprintf(path, sizeof path, "%s/%s", g_generated, file);
-      probe = fopen(path, "rb");
-      dir = g_generated;
-      ++generated;
-    } else {
-      ++committed;
-    }
-    CAPI_CONTEXT("%.60s: in neither %.80s nor %.80s", file, g_dir, g_generated);
+    CAPI_CONTEXT("%.60s: not in %.160s", file, dir);
     if (!CHECK(probe != NULL)) continue;
+    if (in_generated)
+      ++generated;
+    else
+      ++committed;
     CAPI_CONTEXT("%.120s (%.16s)", file, cls);
     fclose(probe);
     check_refused(path, dir, pointer, fragment);
@@ -121,7 +120,7 @@ static void corpus_is_refused(void) {
   }
   CAPI_CONTEXT("manifest");
   CHECK_MSG(committed >= 40, "only %d committed corpus files", committed);
-  CHECK_INT(generated, 1);
+  CHECK(generated >= 1);
   printf("%d corpus files refused (%d committed, %d generated)\n", rows, committed, generated);
   free(manifest);
 }

@@ -2,22 +2,36 @@
 // through embra::World, and save back.
 #include "embra/io/scene.hpp"
 
+#include "embra/core/limits.hpp"
+
 #include "closed_meshes.hpp"
 #include "scene_schema.hpp"
 
 #include <nlohmann/json.hpp>
 #include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/constraint_builder.hpp>
+#include <valijson/constraints/concrete_constraints.hpp>
 #include <valijson/schema.hpp>
 #include <valijson/schema_parser.hpp>
 #include <valijson/validator.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
-#include <fstream>
+#include <cstring>
+#include <filesystem>
+#include <limits>
 #include <memory>
+#include <new>
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace embra::io {
 
@@ -73,10 +87,156 @@ std::string pointer_of(const std::vector<std::string>& context) {
   return p.empty() ? "/" : p;
 }
 
+// --- keywords the loader checks itself -------------------------------------------------------------
+// valijson checks "pattern" with std::regex, whose recursive matcher overflows the stack on a long
+// string (a 30,000-character name crashed the process) and whose construction races in
+// libstdc++'s locale caches when scenes load on several threads; and it prints the bounds of
+// "minimum" and "maximum" with std::to_string, which shows 1e-300 as "0.000000". The schema keeps
+// its standard keywords (for every other validator); the loader hands them to valijson under
+// keywords of its own, checked by the constraints below, and refuses to compile a schema holding
+// a pattern they do not implement, or a keyword that would bring std::regex back
+// ("patternProperties", "format").
+
+/// The one pattern the scene schema uses: names of groups, bodies, pins, colliders, fields, sets.
+constexpr std::string_view kNamePattern = "^[A-Za-z0-9_.:-]+$";
+constexpr const char* kPatternKeyword = "x-embra-pattern";
+constexpr const char* kRangeKeyword = "x-embra-range";  // {"minimum": a, "maximum": b} as the schema gives them
+
+bool name_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '.' ||
+         c == ':' || c == '-';
+}
+
+bool matches_name_pattern(std::string_view text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), name_char);
+}
+
+/// A number as people write it: integers whole, others in the shortest form that reads back
+/// exactly (1e-300, not 0.000000).
+std::string number_text(double v) {
+  if (v == std::floor(v) && std::abs(v) < 1e15) return std::to_string(static_cast<int64_t>(v));
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+  return std::string(buffer, end);
+}
+
+/// A schema "pattern" the loader implements, checked in linear time without recursion.
+class PatternConstraint : public valijson::constraints::PolyConstraint {
+ public:
+  bool validate(const valijson::adapters::Adapter& target, const std::vector<std::string>& context,
+                valijson::ValidationResults* results) const override {
+    if (!target.isString()) return true;  // "pattern" constrains strings only
+    if (matches_name_pattern(target.asString())) return true;
+    if (results != nullptr)
+      results->pushError(context,
+                         "a name holds only letters A-Z and a-z, digits and the characters _ . : - "
+                         "(the schema's pattern ^[A-Za-z0-9_.:-]+$)");
+    return false;
+  }
+
+ private:
+  valijson::constraints::Constraint* cloneInto(void* memory) const override {
+    return new (memory) PatternConstraint(*this);
+  }
+  size_t sizeOf() const override { return sizeof(PatternConstraint); }
+};
+
+/// "minimum" and "maximum" (inclusive, as draft 7 defines them) of a number.
+class RangeConstraint : public valijson::constraints::PolyConstraint {
+ public:
+  RangeConstraint(double minimum, double maximum) : minimum_(minimum), maximum_(maximum) {}
+
+  bool validate(const valijson::adapters::Adapter& target, const std::vector<std::string>& context,
+                valijson::ValidationResults* results) const override {
+    if (!target.isNumber()) return true;  // as valijson: the bounds constrain numbers only
+    const double v = target.asDouble();
+    bool ok = true;
+    if (v < minimum_) {
+      ok = false;
+      if (results != nullptr)
+        results->pushError(context, "Expected number greater than or equal to " + number_text(minimum_));
+    }
+    if (v > maximum_) {
+      ok = false;
+      if (results != nullptr)
+        results->pushError(context, "Expected number less than or equal to " + number_text(maximum_));
+    }
+    return ok;
+  }
+
+ private:
+  valijson::constraints::Constraint* cloneInto(void* memory) const override {
+    return new (memory) RangeConstraint(*this);
+  }
+  size_t sizeOf() const override { return sizeof(RangeConstraint); }
+
+  double minimum_, maximum_;
+};
+
+class PatternConstraintBuilder : public valijson::ConstraintBuilder {
+ public:
+  valijson::constraints::Constraint* make(const valijson::adapters::Adapter& value) const override {
+    if (!value.isString() || value.asString() != kNamePattern)
+      throw std::logic_error("the scene schema has a \"pattern\" the loader does not implement");
+    return new PatternConstraint();
+  }
+};
+
+class RangeConstraintBuilder : public valijson::ConstraintBuilder {
+ public:
+  valijson::constraints::Constraint* make(const valijson::adapters::Adapter& value) const override {
+    double minimum = -std::numeric_limits<double>::infinity(), maximum = std::numeric_limits<double>::infinity();
+    value.applyToObject([&](const std::string& key, const valijson::adapters::Adapter& bound) {
+      if (!bound.isNumber()) throw std::logic_error("a bound of the scene schema is not a number");
+      (key == "minimum" ? minimum : maximum) = bound.asDouble();
+      return true;
+    });
+    return new RangeConstraint(minimum, maximum);
+  }
+};
+
+/// Moves the keywords of a schema that the loader checks itself (see above) to its own keywords.
+/// Keywords whose values are data (const, enum, default, examples, required) are left alone; the
+/// keys of "properties" and "definitions" are names, their values schemas.
+void move_keywords(json& schema) {
+  if (schema.is_array()) {
+    for (json& item : schema) move_keywords(item);
+    return;
+  }
+  if (!schema.is_object()) return;
+  for (auto it = schema.begin(); it != schema.end(); ++it) {
+    const std::string& key = it.key();
+    if (key == "const" || key == "enum" || key == "default" || key == "examples" || key == "required") continue;
+    if (key == "patternProperties" || key == "exclusiveMinimum" || key == "exclusiveMaximum" ||
+        (key == "format" && it->is_string()))
+      throw std::logic_error("the scene schema uses \"" + key + "\", which the loader does not check itself");
+    if (key == "properties" || key == "definitions") {
+      for (json& sub : *it) move_keywords(sub);
+    } else {
+      move_keywords(*it);
+    }
+  }
+  const auto pattern = schema.find("pattern");
+  if (pattern != schema.end() && pattern->is_string()) {
+    schema[kPatternKeyword] = *pattern;
+    schema.erase("pattern");
+  }
+  for (const char* bound : {"minimum", "maximum"}) {
+    const auto it = schema.find(bound);
+    if (it != schema.end() && it->is_number()) {
+      schema[kRangeKeyword][bound] = *it;
+      schema.erase(bound);
+    }
+  }
+}
+
 std::unique_ptr<valijson::Schema> parse_schema(std::string_view text) {
   auto s = std::make_unique<valijson::Schema>();
-  const json doc = json::parse(text);
+  json doc = json::parse(text);
+  move_keywords(doc);
   valijson::SchemaParser parser;
+  parser.addConstraintBuilder(kPatternKeyword, new PatternConstraintBuilder());  // the parser owns them
+  parser.addConstraintBuilder(kRangeKeyword, new RangeConstraintBuilder());
   valijson::adapters::NlohmannJsonAdapter adapter(doc);
   parser.populateSchema(adapter, *s);
   return s;
@@ -99,19 +259,33 @@ void validate(const json& doc, const valijson::Schema& schema, const std::string
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter adapter(doc);
   if (validator.validate(schema, adapter, &results)) return;
-  valijson::ValidationResults::Error first, e;
-  results.popError(first);
-  std::string message = first.description;
-  // oneOf failures report every alternative; the deepest first error is the most telling.
-  size_t depth = first.context.size();
-  while (results.popError(e))
-    if (e.context.size() > depth) {
-      depth = e.context.size();
-      first = e;
-    }
-  const std::string pointer = pointer_of(first.context);
+  // oneOf and anyOf failures report every alternative; the deepest error is the most telling, and
+  // every distinct error at its place says what would have been accepted (0, or at least 1e-300).
+  std::vector<valijson::ValidationResults::Error> errors;
+  valijson::ValidationResults::Error e;
+  while (results.popError(e)) errors.push_back(e);
+  if (errors.empty()) fail(prefix, std::string("does not match the ") + what + " schema");
+  const valijson::ValidationResults::Error* deepest = &errors.front();
+  for (const auto& err : errors)
+    if (err.context.size() > deepest->context.size()) deepest = &err;
+  // allOf and if-then-else only repeat that something below them failed.
+  auto wrapper = [](const std::string& d) {
+    return d.starts_with("Failed to validate against child schema #") ||
+           d.starts_with("Failed to validate against a conditional schema");
+  };
+  std::vector<std::string> said;
+  for (const auto& err : errors)
+    if (err.context == deepest->context && (!wrapper(err.description) || err.description == deepest->description) &&
+        std::find(said.begin(), said.end(), err.description) == said.end())
+      said.push_back(err.description);
+  std::string message;
+  for (std::string d : said) {
+    if (said.size() > 1 && d.ends_with('.')) d.pop_back();
+    message += (message.empty() ? "" : "; ") + d;
+  }
+  const std::string pointer = pointer_of(deepest->context);
   fail(prefix.empty() ? pointer : prefix + (pointer == "/" ? "" : pointer),
-       std::string("does not match the ") + what + " schema: " + first.description);
+       std::string("does not match the ") + what + " schema: " + message);
 }
 
 constexpr const char* kColliderShapeNames[kColliderShapeCount] = {"plane",   "sphere", "box",
@@ -161,7 +335,6 @@ Mesh grid_mesh(const json& s) {
   Mesh m;
   const int nx = s["resolution"][0].get<int>(), ny = s["resolution"][1].get<int>();
   const double sx = s["size"][0].get<double>(), sy = s["size"][1].get<double>();
-  if (static_cast<int64_t>(nx) * ny > 50000000) fail("/resolution", "more than 50 million vertices");
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
       const double x = sx * (static_cast<double>(i) / (nx - 1) - 0.5),
@@ -261,62 +434,189 @@ Mesh closed_mesh(const json& s, const std::string& where) {
   return m;
 }
 
-/// Reads the OBJ file named by s["obj"] (a path relative to base_dir unless absolute; vertices
-/// scaled by s["scale"]): its vertices into `positions`, and every face (0-based vertex indices) to
-/// `on_face(face, at)` with `at` the "file:line: " it came from. Errors name the JSON pointer
-/// `where`/obj and the file's line. Returns the file's path.
+/// The file an OBJ path names, read whole: resolved against options.base_dir (unless absolute) and,
+/// unless options.allow_paths_outside_base, refused when absolute or when it resolves (following
+/// symbolic links and "..") outside base_dir; refused unless a regular file (no folder, device or
+/// pipe: it is opened without blocking and checked before a byte is read) of at most
+/// limits::kMaxObjBytes, a bound the reading keeps too. Errors name `where` and the path as the
+/// scene gives it (JSON-quoted), never the file's content.
+std::string read_obj_file(const std::string& rel, const LoadOptions& options, const std::string& where,
+                          std::string& shown) {
+  namespace fs = std::filesystem;
+  shown = "OBJ file " + json(rel).dump(-1, ' ', true);
+  const fs::path given(rel);
+  const fs::path base(options.base_dir.empty() ? "." : options.base_dir);
+  fs::path path = given.is_absolute() ? given : base / given;
+  if (!options.allow_paths_outside_base) {
+    if (given.is_absolute())
+      fail(where, shown + ": an absolute path is refused: OBJ paths are relative to the scene's folder");
+    std::error_code ec;
+    const fs::path root = fs::canonical(base, ec);
+    if (ec) fail(where, "cannot open " + shown + " (" + path.string() + "): the scene's folder: " + ec.message());
+    const fs::path resolved = fs::weakly_canonical(path, ec);
+    if (ec) fail(where, "cannot open " + shown + " (" + path.string() + "): " + ec.message());
+    // Inside: the folder's components are the first of the file's (both canonical, no "..").
+    const bool inside = std::distance(root.begin(), root.end()) <= std::distance(resolved.begin(), resolved.end()) &&
+                        std::mismatch(root.begin(), root.end(), resolved.begin()).first == root.end();
+    if (!inside)
+      fail(where, shown +
+                      " leads outside the scene's folder (by \"..\" or a symbolic link): refused unless the "
+                      "host allows paths outside it");
+    path = resolved;
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) fail(where, "cannot open " + shown + " (" + path.string() + "): " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st;
+  if (::fstat(fd, &st) != 0) fail(where, "cannot read " + shown + ": " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) fail(where, shown + " is not a regular file (a folder, device or pipe is refused)");
+  const auto too_large = [&] {
+    fail(where, shown + " is larger than " + std::to_string(limits::kMaxObjBytes) +
+                    " bytes, the most an OBJ file may have (EMBRA_MAX_OBJ_BYTES)");
+  };
+  if (st.st_size > limits::kMaxObjBytes) too_large();
+  std::string text;
+  text.resize(static_cast<size_t>(st.st_size) + 1);  // one byte more shows a file that grew
+  size_t got = 0;
+  for (;;) {
+    if (got == text.size()) {
+      if (text.size() > static_cast<size_t>(limits::kMaxObjBytes)) too_large();
+      text.resize(std::min(2 * text.size(), static_cast<size_t>(limits::kMaxObjBytes) + 1));
+    }
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(where, "cannot read " + shown + ": " + std::strerror(errno));
+    if (n == 0) break;
+    got += static_cast<size_t>(n);
+  }
+  if (got > static_cast<size_t>(limits::kMaxObjBytes)) too_large();
+  text.resize(got);
+  return text;
+}
+
+/// Reads the OBJ file named by s["obj"] (read_obj_file; vertices scaled by s["scale"]): its
+/// vertices into `positions`, at most `max_vertices` of them, and every face (0-based vertex
+/// indices) to `on_face(face, at)` with `at` the "OBJ file "...": line N: " it came from. Errors
+/// name the JSON pointer `where`/obj and the line, never the file's content. Returns how the
+/// messages name the file.
 template <class OnFace>
-std::string read_obj(const json& s, const std::string& base_dir, const std::string& where,
+std::string read_obj(const json& s, const LoadOptions& options, const std::string& where, int64_t max_vertices,
                      std::vector<double>& positions, OnFace&& on_face) {
-  const std::string rel = s["obj"].get<std::string>();
-  const std::string path = !rel.empty() && rel[0] == '/' ? rel : base_dir + "/" + rel;
-  std::ifstream in(path);
-  if (!in) fail(where + "/obj", "cannot open " + path);
+  std::string shown;
+  const std::string text = read_obj_file(s["obj"].get<std::string>(), options, where + "/obj", shown);
   const double scale = value_or(s, "scale", 1.0);
-  std::string line;
   int64_t line_no = 0;
   std::vector<int32_t> face;
-  while (std::getline(in, line)) {
+  for (size_t begin = 0; begin < text.size();) {
+    size_t stop = text.find('\n', begin);
+    if (stop == std::string::npos) stop = text.size();
+    std::istringstream ls(text.substr(begin, stop - begin));
+    begin = stop + 1;
     ++line_no;
-    std::istringstream ls(line);
     std::string tag;
     ls >> tag;
-    const std::string at = path + ":" + std::to_string(line_no) + ": ";
+    const std::string at = shown + ": line " + std::to_string(line_no) + ": ";
     if (tag == "v") {
       double x, y, z;
       if (!(ls >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
         fail(where + "/obj", at + "a vertex needs three finite numbers");
+      if (static_cast<int64_t>(positions.size() / 3) >= max_vertices)
+        fail(where + "/obj", at + "more than " + std::to_string(max_vertices) +
+                                 " vertices, the most there is room for (a world holds at most " +
+                                 std::to_string(limits::kMaxParticles) + " particles, EMBRA_MAX_PARTICLES)");
       positions.insert(positions.end(), {scale * x, scale * y, scale * z});
     } else if (tag == "f") {
       face.clear();
       std::string token;
+      const long n = static_cast<long>(positions.size() / 3);
       while (ls >> token) {
         long v = 0;
         try {
           v = std::stol(token.substr(0, token.find('/')));
         } catch (const std::exception&) {
-          fail(where + "/obj", at + "bad face index '" + token + "'");
+          fail(where + "/obj", at + "bad face index");
         }
-        const long n = static_cast<long>(positions.size() / 3);
         if (v < 0) v = n + v + 1;  // OBJ's relative indices
-        if (v < 1 || v > n) fail(where + "/obj", at + "face index " + token + " out of range");
+        if (v < 1 || v > n)
+          fail(where + "/obj", at + "a face index is outside the " + std::to_string(n) + " vertices before it");
         face.push_back(static_cast<int32_t>(v - 1));
       }
       on_face(face, at);
     }
   }
-  return path;
+  return shown;
 }
 
-Mesh obj_mesh(const json& s, const std::string& base_dir, const std::string& where) {
+/// Room left in `w` for a body of `vertices` vertices and `triangles` triangles, checked before the
+/// body is generated: the bounds World::create_body applies (limits.hpp: particles, and constraints
+/// counted as it counts them, six per triangle: a stretch, a shear and a bend per triangle edge).
+void check_room(const World& w, int64_t vertices, int64_t triangles, const std::string& where,
+                const std::string& what) {
+  if (vertices > limits::kMaxParticles - w.particle_count())
+    fail(where, what + " has " + std::to_string(vertices) + " vertices: a world holds at most " +
+                    std::to_string(limits::kMaxParticles) + " particles (EMBRA_MAX_PARTICLES) and has " +
+                    std::to_string(w.particle_count()));
+  if (6 * triangles > limits::kMaxConstraints - w.constraint_count())
+    fail(where, what + " has " + std::to_string(triangles) + " triangles, which could generate " +
+                    std::to_string(6 * triangles) + " constraints: a world holds at most " +
+                    std::to_string(limits::kMaxConstraints) + " (EMBRA_MAX_CONSTRAINTS) and has " +
+                    std::to_string(w.constraint_count()));
+}
+
+/// The vertices and triangles a generator makes, checked against the room in `w` before it runs.
+void check_generator_room(const World& w, const json& s, const std::string& at) {
+  const std::string gen = s["generator"].get<std::string>();
+  int64_t nv = 0, nt = 0;
+  std::string key, what;
+  if (gen == "grid") {
+    const int64_t nx = s["resolution"][0].get<int64_t>(), ny = s["resolution"][1].get<int64_t>();
+    nv = nx * ny;
+    nt = 2 * (nx - 1) * (ny - 1);
+    key = "/resolution";
+    what = "a " + std::to_string(nx) + " x " + std::to_string(ny) + " grid";
+  } else if (gen == "triangle") {
+    const int64_t r = s["rows"].get<int64_t>();
+    nv = (r + 1) * (r + 2) / 2;
+    nt = r * r;
+    key = "/rows";
+    what = "a triangle of " + std::to_string(r) + " rows";
+  } else if (gen == "tube") {
+    const int64_t seg = s["segments"].get<int64_t>(), rings = s["rings"].get<int64_t>();
+    nv = seg * rings;
+    nt = 2 * seg * (rings - 1);
+    what = "a tube of " + std::to_string(seg) + " segments x " + std::to_string(rings) + " rings";
+  } else if (gen == "icosphere") {
+    const int64_t n = int64_t{1} << (2 * s["subdivisions"].get<int>());  // 4^subdivisions
+    nv = 10 * n + 2;
+    nt = 20 * n;
+    key = "/subdivisions";
+    what = "an icosphere of " + std::to_string(s["subdivisions"].get<int>()) + " subdivisions";
+  } else {  // rounded_box: the lattice points on a cube's surface, two triangles per face square
+    const int64_t n = s["resolution"].get<int64_t>();
+    nv = 6 * n * n + 2;
+    nt = 12 * n * n;
+    key = "/resolution";
+    what = "a rounded box of resolution " + std::to_string(n);
+  }
+  check_room(w, nv, nt, at + key, what);
+}
+
+Mesh obj_mesh(const World& w, const json& s, const LoadOptions& options, const std::string& where) {
   Mesh m;
-  const std::string path =
-      read_obj(s, base_dir, where, m.positions, [&](const std::vector<int32_t>& face, const std::string& at) {
-        if (face.size() < 3) fail(where + "/obj", at + "a face needs 3 vertices");
-        for (size_t k = 1; k + 1 < face.size(); ++k)
-          m.triangles.insert(m.triangles.end(), {face[0], face[k], face[k + 1]});
-      });
-  if (m.positions.empty()) fail(where + "/obj", path + " has no vertices");
+  const int64_t max_triangles = (limits::kMaxConstraints - w.constraint_count()) / 6;
+  const std::string shown = read_obj(s, options, where, limits::kMaxParticles - w.particle_count(), m.positions,
+                                     [&](const std::vector<int32_t>& face, const std::string& at) {
+                                       if (face.size() < 3) fail(where + "/obj", at + "a face needs 3 vertices");
+                                       for (size_t k = 1; k + 1 < face.size(); ++k)
+                                         m.triangles.insert(m.triangles.end(), {face[0], face[k], face[k + 1]});
+                                       if (static_cast<int64_t>(m.triangles.size() / 3) > max_triangles)
+                                         check_room(w, 0, static_cast<int64_t>(m.triangles.size() / 3), where + "/obj",
+                                                    at + "the file so far");
+                                     });
+  if (m.positions.empty()) fail(where + "/obj", shown + " has no vertices");
   return m;
 }
 
@@ -378,8 +678,7 @@ const char* const kKindNames[] = {"distance", "edge_angle", "dihedral",  "tet_vo
 /// Builds the world from a validated document, section by section; every error names its place.
 class Builder {
  public:
-  Builder(const json& doc, const std::string& base_dir, SceneMeta& meta)
-      : doc_(doc), base_dir_(base_dir), meta_(meta) {}
+  Builder(const json& doc, const LoadOptions& options, SceneMeta& meta) : doc_(doc), options_(options), meta_(meta) {}
 
   std::unique_ptr<World> build() {
     Settings s;
@@ -501,18 +800,21 @@ class Builder {
   void body(World& w, const json& b, const std::string& at) {
     const json& spec = b["mesh"];
     Mesh m;
-    if (spec.contains("vertices"))
+    if (spec.contains("vertices")) {
       m = inline_mesh(spec);
-    else if (spec.contains("obj"))
-      m = obj_mesh(spec, base_dir_, at + "/mesh");
-    else if (spec["generator"] == "grid")
-      m = grid_mesh(spec);
-    else if (spec["generator"] == "triangle")
-      m = triangle_mesh(spec);
-    else if (spec["generator"] == "tube")
-      m = tube_mesh(spec);
-    else
-      m = closed_mesh(spec, at + "/mesh");
+    } else if (spec.contains("obj")) {
+      m = obj_mesh(w, spec, options_, at + "/mesh");
+    } else {
+      check_generator_room(w, spec, at + "/mesh");  // before a byte of it is generated
+      if (spec["generator"] == "grid")
+        m = grid_mesh(spec);
+      else if (spec["generator"] == "triangle")
+        m = triangle_mesh(spec);
+      else if (spec["generator"] == "tube")
+        m = tube_mesh(spec);
+      else
+        m = closed_mesh(spec, at + "/mesh");
+    }
     if (!spec.contains("vertices")) place(m, spec, at + "/mesh");
     const int64_t nv = static_cast<int64_t>(m.positions.size() / 3);
     if (!m.uvs.empty() && static_cast<int64_t>(m.uvs.size()) != 2 * nv)
@@ -671,12 +973,20 @@ class Builder {
       for (const json& q : p["quads"])
         for (const json& v : q) quads.push_back(v.get<int32_t>());
     } else {  // "obj": a quad mesh file
-      const std::string path =
-          read_obj(p, base_dir_, at, positions, [&](const std::vector<int32_t>& face, const std::string& line) {
-            if (face.size() != 4) fail(at + "/obj", line + "a panel mesh's faces must be quads (4 vertices)");
-            quads.insert(quads.end(), face.begin(), face.end());
-          });
-      if (positions.empty() || quads.empty()) fail(at + "/obj", path + " has no quads");
+      // Each panel becomes 8 particles: the file is refused at the first panel the world has no room for.
+      const int64_t max_panels = (limits::kMaxParticles - w.particle_count()) / 8;
+      const std::string shown =
+          read_obj(p, options_, at, limits::kMaxParticles, positions,
+                   [&](const std::vector<int32_t>& face, const std::string& line) {
+                     if (face.size() != 4) fail(at + "/obj", line + "a panel mesh's faces must be quads (4 vertices)");
+                     if (static_cast<int64_t>(quads.size() / 4) >= max_panels)
+                       fail(at + "/obj",
+                            line + "more than " + std::to_string(max_panels) +
+                                " panels, the most the world has room for (8 particles each; a world holds at most " +
+                                std::to_string(limits::kMaxParticles) + " particles, EMBRA_MAX_PARTICLES)");
+                     quads.insert(quads.end(), face.begin(), face.end());
+                   });
+      if (positions.empty() || quads.empty()) fail(at + "/obj", shown + " has no quads");
     }
     PanelMeshDesc d;
     d.positions = positions;
@@ -760,11 +1070,14 @@ class Builder {
       last = frame;
       if (!key.contains("value")) fail(where, "needs a \"value\"");
       std::vector<double> value = key["value"].get<std::vector<double>>();
-      const bool pose = act.type == Action::Type::collider_pose && value.size() == 7;
-      if (value.size() != width && !pose)
+      // A collider's keys are all positions (3 numbers) or all poses (7: position and rotation).
+      if (act.type == Action::Type::collider_pose && i == 0 && value.size() == 7) width = 7;
+      if (value.size() != width)
         fail(where + "/value", "needs " + std::to_string(width) + " numbers" +
-                                   (act.type == Action::Type::collider_pose ? " (or 7: position and rotation)" : ""));
-      if (pose) quat(json(std::vector<double>(value.begin() + 3, value.end())), where + "/value");
+                                   (act.type != Action::Type::collider_pose ? ""
+                                    : i == 0                                ? " (or 7: position and rotation)"
+                                             : " like the action's first key (3: position; 7: position and rotation)"));
+      if (width == 7) quat(json(std::vector<double>(value.begin() + 3, value.end())), where + "/value");
       if (act.type == Action::Type::rest_scale)
         for (double s : value)
           if (s < 0.0) fail(where + "/value", "rest scales must be >= 0");
@@ -811,7 +1124,7 @@ class Builder {
   }
 
   const json& doc_;
-  std::string base_dir_;
+  const LoadOptions& options_;
   SceneMeta& meta_;
   std::map<std::string, Id> groups_, bodies_, pins_, colliders_;
   std::map<std::string, Id> fields_;
@@ -849,6 +1162,12 @@ std::string_view scene_schema() {
   return kSceneSchema;
 }
 
+bool schema_pattern_matches(std::string_view pattern, std::string_view text) {
+  if (pattern != kNamePattern)
+    throw std::invalid_argument("the loader does not implement the pattern " + json(std::string(pattern)).dump());
+  return matches_name_pattern(text);
+}
+
 std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta) {
   LoadOptions options;
   options.base_dir = base_dir;
@@ -856,7 +1175,6 @@ std::unique_ptr<World> load_scene(std::string_view text, const std::string& base
 }
 
 std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& options, SceneMeta& out_meta) {
-  const std::string& base_dir = options.base_dir;
   const json doc = parse(text);
   // What the document is comes first: the schema alone would only say a `const` did not match.
   auto shown = [](const json& v) {
@@ -868,10 +1186,15 @@ std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& opti
   if (doc.is_object() && doc.contains("version") && doc["version"] != 1)
     fail("/version", "is " + shown(doc["version"]) + "; this library reads scene version 1");
   validate(doc, scene_schema_compiled(), "", "scene");
-  if (doc.contains("tolerances"))
+  if (doc.contains("tolerances")) {
     validate(doc["tolerances"], tolerances_schema_compiled(), "/tolerances", "tolerances");
+    // What embra_world_set_tolerances refuses, a scene cannot hold either.
+    for (const auto& [key, value] : doc["tolerances"].items())
+      if (value.is_object() && value["target"].get<double>() > value["max"].get<double>())
+        fail("/tolerances/" + key + "/target", "is above its max");
+  }
   SceneMeta meta;
-  auto world = Builder(doc, base_dir, meta).build();
+  auto world = Builder(doc, options, meta).build();
   out_meta = std::move(meta);
   return world;
 }
@@ -1166,8 +1489,18 @@ void apply_actions(World& w, const SceneMeta& meta, int64_t frame) {
     else {
       const double t =
           static_cast<double>(frame - a.frames[hi - 1]) / static_cast<double>(a.frames[hi] - a.frames[hi - 1]);
-      v.resize(a.values[hi].size());
-      for (size_t k = 0; k < v.size(); ++k) v[k] = (1.0 - t) * a.values[hi - 1][k] + t * a.values[hi][k];
+      std::vector<double> from = a.values[hi - 1];
+      const std::vector<double>& to = a.values[hi];
+      if (from.size() == 7) {
+        // q and -q are one rotation: turn along the shorter arc (from the earlier key's sign flipped
+        // when the keys point apart), so the blend never passes through the zero quaternion.
+        double dot = 0.0;
+        for (size_t k = 3; k < 7; ++k) dot += from[k] * to[k];
+        if (dot < 0.0)
+          for (size_t k = 3; k < 7; ++k) from[k] = -from[k];
+      }
+      v.resize(to.size());
+      for (size_t k = 0; k < v.size(); ++k) v[k] = (1.0 - t) * from[k] + t * to[k];
     }
     switch (a.type) {
       case Action::Type::rest_scale:

@@ -72,4 +72,10 @@ std::string tolerances_json(const Tolerances& t);
 /// The scene schema text compiled into the library.
 std::string_view scene_schema();
 
+/// Whether `text` matches `pattern`, a "pattern" of the scene schema, as the loader checks it: in
+/// code, never with std::regex (whose recursion overflows the stack on long strings). Throws
+/// std::invalid_argument for a pattern the loader does not implement (the loader refuses to compile
+/// a schema holding one).
+bool schema_pattern_matches(std::string_view pattern, std::string_view text);
+
 }  // namespace embra::io
