@@ -1129,22 +1129,9 @@ embra_status embra_world_load_file(embra_world** out_world, const char* path) {
   return guard("embra_world_load_file", [&] {
     need(out_world, "out_world");
     need(path, "path");
-    std::FILE* f = std::fopen(path, "rb");
-    if (f == nullptr)
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot open ") + path + ": " + std::strerror(errno));
-    std::string text;
-    char buffer[65536];
-    size_t got;
-    while ((got = std::fread(buffer, 1, sizeof buffer, f)) > 0) {
-      text.append(buffer, got);
-      if (text.size() > (size_t{1} << 31)) {
-        std::fclose(f);
-        refuse(EMBRA_ERROR_SCHEMA, std::string(path) + " is larger than 2 GiB");
-      }
-    }
-    const bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot read ") + path);
+    std::string text, error;
+    if (!embra::io::read_regular_file(path, embra::limits::kMaxSceneBytes, text, error))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(path) + " " + error);
     *out_world = load(text, folder_of(path));
   });
 }

@@ -14,14 +14,6 @@ namespace embra {
 
 namespace {
 
-[[noreturn]] void refuse(const std::string& message) {
-  invalid(message);
-}
-
-void finite(double v, const std::string& what) {
-  check_finite(v, what);
-}
-
 /// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection 5.1.5) and the
 /// feature it lies on: 0..2 vertex k, 3..5 edge (k, k+1), 6 the face.
 Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int& feature) {
@@ -266,11 +258,11 @@ void build_tree(ColliderGeometry& g) {
 }
 
 std::vector<Vec3> read_points(const ColliderDesc& desc, const char* shape) {
-  if (desc.vertices.size() % 3 != 0) refuse(std::string(shape) + " vertex array length is not a multiple of 3");
+  if (desc.vertices.size() % 3 != 0) invalid(std::string(shape) + " vertex array length is not a multiple of 3");
   std::vector<Vec3> pts(desc.vertices.size() / 3);
   for (size_t i = 0; i < pts.size(); ++i) {
     for (int k = 0; k < 3; ++k)
-      finite(desc.vertices[3 * i + k], std::string(shape) + " vertex " + std::to_string(i) + " coordinate");
+      check_finite(desc.vertices[3 * i + k], std::string(shape) + " vertex " + std::to_string(i) + " coordinate");
     pts[i] = Vec3(desc.vertices[3 * i], desc.vertices[3 * i + 1], desc.vertices[3 * i + 2]);
   }
   return pts;
@@ -310,7 +302,7 @@ void build_hull(ColliderGeometry& g, const std::vector<Vec3>& pts) {
   }
   const double pn_len = pn.norm();
   if (scale == 0.0 || pn_len <= 1e-12 * scale * scale || best / pn_len <= 1e-9 * scale)
-    refuse("convex collider points are degenerate: the hull needs at least 4 points not in one plane");
+    invalid("convex collider points are degenerate: the hull needs at least 4 points not in one plane");
 
   struct Face {
     std::array<int32_t, 3> v;
@@ -359,8 +351,8 @@ void build_hull(ColliderGeometry& g, const std::vector<Vec3>& pts) {
 }
 
 void build_mesh(ColliderGeometry& g, const ColliderDesc& desc, const std::vector<Vec3>& pts) {
-  if (desc.triangles.empty()) refuse("mesh collider has no triangles");
-  if (desc.triangles.size() % 3 != 0) refuse("mesh collider triangle index array length is not a multiple of 3");
+  if (desc.triangles.empty()) invalid("mesh collider has no triangles");
+  if (desc.triangles.size() % 3 != 0) invalid("mesh collider triangle index array length is not a multiple of 3");
   const double scale = extent_of(pts);
   const size_t nt = desc.triangles.size() / 3;
   for (size_t i = 0; i < nt; ++i) {
@@ -368,12 +360,12 @@ void build_mesh(ColliderGeometry& g, const ColliderDesc& desc, const std::vector
     for (int k = 0; k < 3; ++k) {
       t[k] = desc.triangles[3 * i + k];
       if (t[k] < 0 || static_cast<size_t>(t[k]) >= pts.size())
-        refuse("mesh collider triangle " + std::to_string(i) + " has vertex index " + std::to_string(t[k]) +
-               " outside [0, " + std::to_string(pts.size()) + ")");
+        invalid("mesh collider triangle " + std::to_string(i) + " has vertex index " + std::to_string(t[k]) +
+                " outside [0, " + std::to_string(pts.size()) + ")");
     }
     const Vec3 n = (pts[t[1]] - pts[t[0]]).cross(pts[t[2]] - pts[t[0]]);
     if (!(n.norm() > 1e-12 * scale * scale))
-      refuse("mesh collider triangle " + std::to_string(i) + " is degenerate (zero area)");
+      invalid("mesh collider triangle " + std::to_string(i) + " is degenerate (zero area)");
     g.triangles.push_back(t);
     g.face_normal.push_back(n.normalized());
   }
@@ -431,34 +423,30 @@ std::shared_ptr<const ColliderGeometry> build_collider_geometry(const ColliderDe
     case ColliderShape::sphere:
       return nullptr;
     case ColliderShape::box:
-      for (int k = 0; k < 3; ++k) {
-        finite(desc.half_extents[k], "box half_extents");
-        if (desc.half_extents[k] <= 0.0) refuse("box half_extents must be > 0");
-      }
+      for (int k = 0; k < 3; ++k) check_positive(desc.half_extents[k], "box half_extents");
       return std::make_shared<ColliderGeometry>();
     case ColliderShape::capsule:
-      finite(desc.radius, "capsule radius");
-      if (desc.radius <= 0.0) refuse("capsule radius must be > 0");
-      finite(desc.half_length, "capsule half_length");
-      if (desc.half_length < 0.0) refuse("capsule half_length must be >= 0");
+      check_positive(desc.radius, "capsule radius");
+      check_non_negative(desc.half_length, "capsule half_length");
       return std::make_shared<ColliderGeometry>();
     case ColliderShape::convex: {
-      if (!desc.triangles.empty()) refuse("convex collider takes points only, no triangles");
+      if (!desc.triangles.empty()) invalid("convex collider takes points only, no triangles");
       const std::vector<Vec3> pts = read_points(desc, "convex collider");
-      if (pts.size() < 4) refuse("convex collider needs at least 4 points (it has " + std::to_string(pts.size()) + ")");
+      if (pts.size() < 4)
+        invalid("convex collider needs at least 4 points (it has " + std::to_string(pts.size()) + ")");
       auto g = std::make_shared<ColliderGeometry>();
       build_hull(*g, pts);
       return g;
     }
     case ColliderShape::mesh: {
       const std::vector<Vec3> pts = read_points(desc, "mesh collider");
-      if (pts.size() < 3) refuse("mesh collider needs at least 3 vertices");
+      if (pts.size() < 3) invalid("mesh collider needs at least 3 vertices");
       auto g = std::make_shared<ColliderGeometry>();
       build_mesh(*g, desc, pts);
       return g;
     }
   }
-  refuse("unknown collider shape " + std::to_string(static_cast<int>(desc.shape)));
+  invalid("unknown collider shape " + std::to_string(static_cast<int>(desc.shape)));
 }
 
 double shape_distance(const ColliderDesc& desc, const ColliderGeometry& g, const Vec3& p, Vec3& normal) {

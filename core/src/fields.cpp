@@ -99,8 +99,7 @@ Id World::create_field(const FieldDesc& desc) {
       check_vec(d.vortex.center, "vortex center");
       unit_or_fail(d.vortex.axis, "vortex axis");
       check_finite(d.vortex.strength, "vortex strength");
-      check_finite(d.vortex.radius, "vortex radius");
-      if (!(d.vortex.radius > 0.0)) invalid("vortex radius must be > 0");
+      check_positive(d.vortex.radius, "vortex radius");
       check_finite(d.vortex.twist, "vortex twist");
       check_non_negative(d.vortex.decay, "vortex decay");
       check_finite(d.vortex.start_time, "vortex start_time");

@@ -366,8 +366,7 @@ void panel_grid(int32_t n, int32_t m, double size, const Vec3& origin, std::vect
   if (8 * int64_t{n} * m > limits::kMaxParticles)
     invalid("a panel grid of " + std::to_string(n) + " x " + std::to_string(m) +
             " panels needs more than the 2097152 particles a world holds (8 per panel)");
-  check_finite(size, "panel size");
-  if (!(size > 0.0)) invalid("panel size must be > 0");
+  check_positive(size, "panel size");
   for (int c = 0; c < 3; ++c) check_finite(origin[c], "panel grid origin");
   out_positions.clear();
   out_quads.clear();
@@ -393,8 +392,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     invalid("a world holds at most 2097152 particles; " + std::to_string(np) +
             " panels (8 particles each) would make " + std::to_string(8 * np + world.particle_count()));
   for (double c : d.positions) check_finite(c, "panel mesh vertex coordinate");
-  check_finite(d.thickness, "panel thickness");
-  if (!(d.thickness > 0.0)) invalid("panel thickness must be > 0");
+  check_positive(d.thickness, "panel thickness");
   check_zero_or_positive(d.mass, "panel mesh mass");
   check_zero_or_positive(d.density, "panel mesh density");
   if (d.mass == 0.0 && d.density == 0.0) invalid("panel mesh needs a mass or a density > 0");

@@ -692,8 +692,7 @@ void World::set_panel_layout(const PanelLayout& layout) {
         if (layout.quads[q + j] == v)
           invalid("panel layout quad " + std::to_string(q / 4) + " repeats vertex " + std::to_string(v));
     }
-  check_finite(layout.thickness, "panel thickness");
-  if (!(layout.thickness > 0.0)) invalid("panel thickness must be > 0");
+  check_positive(layout.thickness, "panel thickness");
   for (const PanelLayout& l : panel_layouts_)
     if (l.body == layout.body) invalid("the body already has a panel layout");
   PanelLayout copy = layout;
@@ -1300,7 +1299,8 @@ namespace {
 void check_transform(const Vec3& position, const Eigen::Quaterniond& rotation) {
   for (int k = 0; k < 3; ++k) check_finite(position[k], "collider position");
   for (int k = 0; k < 4; ++k) check_finite(rotation.coeffs()[k], "collider rotation");
-  if (std::abs(rotation.norm() - 1.0) > 1e-6) invalid("collider rotation must be a unit quaternion");
+  if (std::abs(rotation.norm() - 1.0) > limits::kUnitQuaternionTolerance)
+    invalid("collider rotation must be a unit quaternion");
 }
 }  // namespace
 
@@ -1311,10 +1311,7 @@ Id World::create_collider(const ColliderDesc& desc) {
   check_non_negative(desc.thickness, "collider thickness");
   check_non_negative(desc.friction_static, "collider friction_static");
   check_non_negative(desc.friction_dynamic, "collider friction_dynamic");
-  if (desc.shape == ColliderShape::sphere) {
-    check_finite(desc.radius, "sphere radius");
-    if (desc.radius <= 0.0) invalid("sphere radius must be > 0");
-  }
+  if (desc.shape == ColliderShape::sphere) check_positive(desc.radius, "sphere radius");
   std::shared_ptr<const ColliderGeometry> geometry = build_collider_geometry(desc);  // validates the shape
   size_t slot = colliders_.size();
   for (size_t i = 0; i < colliders_.size(); ++i)

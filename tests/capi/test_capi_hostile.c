@@ -106,6 +106,85 @@ static void test_extreme_values_round_trip(void) {
   embra_world_destroy(w);
 }
 
+/* The smallest positive sizes the API accepts (EMBRA_MIN_POSITIVE) save and load back, and a
+ * plane collider's radius, which no plane uses, never reaches the scene. */
+static void test_smallest_sizes_round_trip(void) {
+  embra_world* w = NULL;
+  embra_collider_def col = embra_default_collider_def();
+  embra_vortex_def vortex = embra_default_vortex_def();
+  embra_panel_mesh_def panels = embra_default_panel_mesh_def();
+  embra_collider_id cid;
+  embra_field_id fid;
+  embra_body_id pb;
+  int32_t first = 0;
+  CHECK_OK(embra_world_create(&w, NULL));
+  cloth(w, 1.0, 1.0, &first);
+  col.shape = EMBRA_COLLIDER_SPHERE;
+  col.radius = EMBRA_MIN_POSITIVE;
+  CHECK_OK(embra_collider_create(w, &col, &cid));
+  col.shape = EMBRA_COLLIDER_CAPSULE;
+  CHECK_OK(embra_collider_create(w, &col, &cid));
+  col.shape = EMBRA_COLLIDER_BOX;
+  col.half_extents[0] = col.half_extents[1] = col.half_extents[2] = EMBRA_MIN_POSITIVE;
+  CHECK_OK(embra_collider_create(w, &col, &cid));
+  col.shape = EMBRA_COLLIDER_PLANE;
+  col.radius = 0.0;
+  CHECK_OK(embra_collider_create(w, &col, &cid));
+  vortex.radius = EMBRA_MIN_POSITIVE;
+  CHECK_OK(embra_vortex_create(w, &vortex, &fid));
+  panels.grid_columns = 1;
+  panels.grid_rows = 1;
+  panels.thickness = EMBRA_MIN_POSITIVE;
+  CHECK_OK(embra_panel_mesh_create(w, &panels, &pb, NULL));
+  check_round_trip(w, "the API's smallest accepted sizes");
+  embra_world_destroy(w);
+}
+
+/* Sizes below EMBRA_MIN_POSITIVE (positive, finite, but refused by the scene schema) are refused
+ * by the API too, and change nothing. */
+static void test_sizes_below_the_smallest_are_refused(void) {
+  const double below = 1e-310; /* subnormal */
+  embra_world* w = NULL;
+  embra_collider_def col = embra_default_collider_def();
+  embra_vortex_def vortex = embra_default_vortex_def();
+  embra_panel_mesh_def panels = embra_default_panel_mesh_def();
+  embra_collider_id cid;
+  embra_field_id fid;
+  embra_body_id pb;
+  char* before;
+  char* after;
+  CHECK_OK(embra_world_create(&w, NULL));
+  before = save(w);
+  col.shape = EMBRA_COLLIDER_SPHERE;
+  col.radius = below;
+  CHECK_STATUS(embra_collider_create(w, &col, &cid), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "sphere radius");
+  col.shape = EMBRA_COLLIDER_CAPSULE;
+  CHECK_STATUS(embra_collider_create(w, &col, &cid), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "capsule radius");
+  col.shape = EMBRA_COLLIDER_BOX;
+  col.half_extents[1] = below;
+  CHECK_STATUS(embra_collider_create(w, &col, &cid), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "half_extents");
+  vortex.radius = below;
+  CHECK_STATUS(embra_vortex_create(w, &vortex, &fid), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "vortex radius");
+  panels.grid_columns = 1;
+  panels.grid_rows = 1;
+  panels.thickness = below;
+  CHECK_STATUS(embra_panel_mesh_create(w, &panels, &pb, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "panel thickness");
+  panels.thickness = 0.01;
+  panels.panel_size = below;
+  CHECK_STATUS(embra_panel_mesh_create(w, &panels, &pb, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "panel size");
+  after = save(w);
+  CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+  embra_world_destroy(w);
+}
+
 static void test_values_beyond_the_ranges_are_refused(void) {
   embra_world* w = NULL;
   const double beyond = 1.0000001e300;
@@ -342,6 +421,8 @@ static void test_cancel_before_a_step(void) {
 int main(void) {
   if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) return 1;
   RUN(test_extreme_values_round_trip);
+  RUN(test_smallest_sizes_round_trip);
+  RUN(test_sizes_below_the_smallest_are_refused);
   RUN(test_values_beyond_the_ranges_are_refused);
   RUN(test_particle_limit);
   RUN(test_destroyed_group_still_saves);

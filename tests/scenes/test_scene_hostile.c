@@ -5,8 +5,8 @@
  *   leading out is refused unless embra_load_options.allow_paths_outside_base); only regular files
  *   (a folder, /dev/zero, /dev/null or a FIFO is refused, and opening a FIFO does not block); a
  *   file larger than EMBRA_MAX_OBJ_BYTES is refused before it is read; embra_world_load_file
- *   confines a scene to its own folder. Every refusal is EMBRA_ERROR_SCHEMA with the pointer of
- *   the "obj" value and leaves *out_world NULL.
+ *   confines a scene to its own folder, and reads a scene from a regular file only. Every refusal is EMBRA_ERROR_SCHEMA
+ * with the pointer of the "obj" value and leaves *out_world NULL.
  * - Error messages about an OBJ file never repeat its content (a token of the file is a secret
  *   the host may not mean to show).
  * - A collider_pose action keyed from q to -q (one rotation) steps through every frame, and a
@@ -239,6 +239,25 @@ static void other_entry_points_confine(void) {
   embra_world_destroy(w);
 }
 
+/* embra_world_load_file reads regular files only: a FIFO is refused without waiting for a writer,
+ * /dev/zero without reading it, a folder without trying. */
+static void scene_files_must_be_regular(void) {
+  char fifo[4200];
+  const char* paths[3];
+  size_t i;
+  path_in(fifo, sizeof fifo, g_base, "fifo.obj");
+  paths[0] = fifo;
+  paths[1] = "/dev/zero";
+  paths[2] = g_base;
+  for (i = 0; i < 3; ++i) {
+    embra_world* w = NULL;
+    CAPI_CONTEXT("embra_world_load_file(%s)", paths[i]);
+    CHECK_STATUS(embra_world_load_file(&w, paths[i]), EMBRA_ERROR_INVALID_ARGUMENT);
+    CHECK(w == NULL);
+    CHECK_CONTAINS(embra_last_error_message(), "is not a regular file");
+  }
+}
+
 /* The rotation angle (radians, in [0, pi]) and the axis' z of a unit quaternion, either sign. */
 static double angle_of(const double q[4]) {
   const double w = fabs(q[0]);
@@ -300,6 +319,7 @@ int main(int argc, char** argv) {
   RUN(messages_never_show_the_file);
   RUN(panel_obj_paths_are_confined);
   RUN(other_entry_points_confine);
+  RUN(scene_files_must_be_regular);
   RUN(collider_pose_takes_the_short_way);
   return capi_test_finish();
 }

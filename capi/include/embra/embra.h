@@ -754,7 +754,9 @@ EMBRA_API embra_status embra_panel_mesh_export_cuts(const embra_world* world, em
  * at most EMBRA_MAX_OBJ_BYTES. On failure *out_world is NULL. */
 EMBRA_API embra_status embra_world_load_json(embra_world** out_world, const char* json, int64_t length,
                                              const char* base_dir);
-/* Same, from a file (relative paths resolve against the file's folder, and stay inside it). */
+/* Same, from a file (relative paths resolve against the file's folder, and stay inside it). The
+ * file must be a regular file of at most 2 GiB (a folder, device or pipe is refused without being
+ * read or waited on): otherwise EMBRA_ERROR_INVALID_ARGUMENT. */
 EMBRA_API embra_status embra_world_load_file(embra_world** out_world, const char* path);
 
 #define EMBRA_LOAD_OPTIONS_VERSION 1

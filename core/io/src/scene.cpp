@@ -304,7 +304,8 @@ Vec3 vec3(const json& j) {
 
 Eigen::Quaterniond quat(const json& j, const std::string& where) {
   Eigen::Quaterniond q(j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j[3].get<double>());
-  if (std::abs(q.norm() - 1.0) > 1e-6) fail(where, "rotation must be a unit quaternion [w, x, y, z]");
+  if (std::abs(q.norm() - 1.0) > limits::kUnitQuaternionTolerance)
+    fail(where, "rotation must be a unit quaternion [w, x, y, z]");
   return q;
 }
 
@@ -464,36 +465,9 @@ std::string read_obj_file(const std::string& rel, const LoadOptions& options, co
                       "host allows paths outside it");
     path = resolved;
   }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) fail(where, "cannot open " + shown + " (" + path.string() + "): " + std::strerror(errno));
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st;
-  if (::fstat(fd, &st) != 0) fail(where, "cannot read " + shown + ": " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) fail(where, shown + " is not a regular file (a folder, device or pipe is refused)");
-  const auto too_large = [&] {
-    fail(where, shown + " is larger than " + std::to_string(limits::kMaxObjBytes) +
-                    " bytes, the most an OBJ file may have (EMBRA_MAX_OBJ_BYTES)");
-  };
-  if (st.st_size > limits::kMaxObjBytes) too_large();
-  std::string text;
-  text.resize(static_cast<size_t>(st.st_size) + 1);  // one byte more shows a file that grew
-  size_t got = 0;
-  for (;;) {
-    if (got == text.size()) {
-      if (text.size() > static_cast<size_t>(limits::kMaxObjBytes)) too_large();
-      text.resize(std::min(2 * text.size(), static_cast<size_t>(limits::kMaxObjBytes) + 1));
-    }
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) fail(where, "cannot read " + shown + ": " + std::strerror(errno));
-    if (n == 0) break;
-    got += static_cast<size_t>(n);
-  }
-  if (got > static_cast<size_t>(limits::kMaxObjBytes)) too_large();
-  text.resize(got);
+  std::string text, error;
+  if (!read_regular_file(path.string(), limits::kMaxObjBytes, text, error))
+    fail(where, shown + (error.starts_with("could not") ? " (" + path.string() + ")" : "") + " " + error);
   return text;
 }
 
@@ -1174,6 +1148,42 @@ std::unique_ptr<World> load_scene(std::string_view text, const std::string& base
   return load_scene(text, options, out_meta);
 }
 
+bool read_regular_file(const std::string& path, int64_t max_bytes, std::string& out, std::string& error) {
+  const auto refuse = [&](std::string why) {
+    error = std::move(why);
+    return false;
+  };
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) return refuse(std::string("could not be opened: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st;
+  if (::fstat(fd, &st) != 0) return refuse(std::string("could not be read: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) return refuse("is not a regular file (a folder, device or pipe is refused)");
+  const std::string too_large = "is larger than " + std::to_string(max_bytes) + " bytes, the most it may have";
+  if (st.st_size > max_bytes) return refuse(too_large);
+  const size_t cap = static_cast<size_t>(max_bytes) + 1;  // one byte more shows a file that grew
+  std::string text;
+  text.resize(std::min(static_cast<size_t>(st.st_size) + 1, cap));
+  size_t got = 0;
+  for (;;) {
+    if (got == text.size()) {
+      if (text.size() >= cap) return refuse(too_large);
+      text.resize(std::min(2 * text.size(), cap));
+    }
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return refuse(std::string("could not be read: ") + std::strerror(errno));
+    if (n == 0) break;
+    got += static_cast<size_t>(n);
+  }
+  text.resize(got);
+  out = std::move(text);
+  return true;
+}
+
 std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& options, SceneMeta& out_meta) {
   const json doc = parse(text);
   // What the document is comes first: the schema alone would only say a `const` did not match.
@@ -1350,10 +1360,10 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                                             {"shape", kColliderShapeNames[static_cast<int>(c.desc.shape)]},
                                             {"position", vec_json(c.desc.position)},
                                             {"rotation", {q.w(), q.x(), q.y(), q.z()}},
-                                            {"radius", c.desc.radius},
                                             {"thickness", c.desc.thickness},
                                             {"friction_static", c.desc.friction_static},
                                             {"friction_dynamic", c.desc.friction_dynamic}});
+    if (c.desc.shape == ColliderShape::sphere || c.desc.shape == ColliderShape::capsule) out["radius"] = c.desc.radius;
     if (c.desc.shape == ColliderShape::box) out["half_extents"] = vec_json(c.desc.half_extents);
     if (c.desc.shape == ColliderShape::capsule) out["half_length"] = c.desc.half_length;
     if (c.desc.shape == ColliderShape::convex || c.desc.shape == ColliderShape::mesh) {

@@ -15,6 +15,9 @@ inline constexpr double kMaxAbsValue = 1e300;
 /// dt): its inverse (an inverse mass) stays finite.
 inline constexpr double kMinPositive = 1e-300;
 
+/// How far a rotation quaternion's length may be from 1 (collider poses, collider_pose keys).
+inline constexpr double kUnitQuaternionTolerance = 1e-6;
+
 /// Largest tolerances unit_scale (mm per metre of panel per model unit).
 inline constexpr double kMaxUnitScale = 1e12;
 /// Seconds per frame, at most.
@@ -26,6 +29,8 @@ inline constexpr int64_t kMaxParticles = int64_t{1} << 21;
 inline constexpr int64_t kMaxConstraints = int64_t{1} << 24;
 /// Work per step: substeps x iterations (each iteration a pass over every group).
 inline constexpr int64_t kMaxPassesPerStep = 100000;
+/// A scene file embra_world_load_file reads (2 GiB): larger files are refused before they are read.
+inline constexpr int64_t kMaxSceneBytes = int64_t{1} << 31;
 /// An OBJ file a scene names: larger files are refused before they are read.
 inline constexpr int64_t kMaxObjBytes = int64_t{256} << 20;
 
