@@ -23,28 +23,13 @@ const { EmbraError, errorFor, check } = require('./errors');
 
 const { lib } = capi;
 
-const SHAPES = Object.freeze({
-  plane: capi.COLLIDER_PLANE, sphere: capi.COLLIDER_SPHERE, box: capi.COLLIDER_BOX, capsule: capi.COLLIDER_CAPSULE,
-  convex: capi.COLLIDER_CONVEX, mesh: capi.COLLIDER_MESH,
-});
-const KINDS = Object.freeze({
-  distance: capi.CONSTRAINT_DISTANCE, edge_angle: capi.CONSTRAINT_EDGE_ANGLE, dihedral: capi.CONSTRAINT_DIHEDRAL,
-  tet_volume: capi.CONSTRAINT_TET_VOLUME, weld: capi.CONSTRAINT_WELD, tether: capi.CONSTRAINT_TETHER,
-  planarity: capi.CONSTRAINT_PLANARITY, plane_offset: capi.CONSTRAINT_PLANE_OFFSET,
-});
-const GENERATE = Object.freeze({
-  stretch: capi.GENERATE_STRETCH, shear: capi.GENERATE_SHEAR, bend: capi.GENERATE_BEND,
-  volume: capi.GENERATE_VOLUME,
-});
-const PANEL_PINS = Object.freeze({
-  none: capi.PANEL_PINS_NONE, top_corners: capi.PANEL_PINS_TOP_CORNERS,
-  top_and_bottom_corners: capi.PANEL_PINS_TOP_AND_BOTTOM_CORNERS,
-});
-const PANEL_METRICS = Object.freeze({
-  planarity: capi.PANEL_METRIC_PLANARITY, thickness: capi.PANEL_METRIC_THICKNESS, miter: capi.PANEL_METRIC_MITER,
-  corner_distance: capi.PANEL_METRIC_CORNER_DISTANCE, conical: capi.PANEL_METRIC_CONICAL,
-});
-const CUTS_FORMATS = Object.freeze({ json: capi.CUTS_JSON, csv: capi.CUTS_CSV });
+// The names each enum's values go by here and in scenes: generated from embra.h with the enums.
+const SHAPES = capi.COLLIDER_NAMES;
+const KINDS = capi.CONSTRAINT_NAMES;
+const GENERATE = capi.GENERATE_NAMES;
+const PANEL_PINS = capi.PANEL_PINS_NAMES;
+const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
+const CUTS_FORMATS = capi.CUTS_NAMES;
 
 // --- ids ------------------------------------------------------------------------------------------
 

@@ -21,20 +21,13 @@ from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef
                     Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
-SHAPES = {"plane": _capi.COLLIDER_PLANE, "sphere": _capi.COLLIDER_SPHERE, "box": _capi.COLLIDER_BOX,
-          "capsule": _capi.COLLIDER_CAPSULE, "convex": _capi.COLLIDER_CONVEX, "mesh": _capi.COLLIDER_MESH}
-KINDS = {"distance": _capi.CONSTRAINT_DISTANCE, "edge_angle": _capi.CONSTRAINT_EDGE_ANGLE,
-         "dihedral": _capi.CONSTRAINT_DIHEDRAL, "tet_volume": _capi.CONSTRAINT_TET_VOLUME,
-         "weld": _capi.CONSTRAINT_WELD, "tether": _capi.CONSTRAINT_TETHER,
-         "planarity": _capi.CONSTRAINT_PLANARITY, "plane_offset": _capi.CONSTRAINT_PLANE_OFFSET}
-GENERATE = {"stretch": _capi.GENERATE_STRETCH, "shear": _capi.GENERATE_SHEAR, "bend": _capi.GENERATE_BEND,
-            "volume": _capi.GENERATE_VOLUME}
-PANEL_PINS = {"none": _capi.PANEL_PINS_NONE, "top_corners": _capi.PANEL_PINS_TOP_CORNERS,
-              "top_and_bottom_corners": _capi.PANEL_PINS_TOP_AND_BOTTOM_CORNERS}
-PANEL_METRICS = {"planarity": _capi.PANEL_METRIC_PLANARITY, "thickness": _capi.PANEL_METRIC_THICKNESS,
-                 "miter": _capi.PANEL_METRIC_MITER, "corner_distance": _capi.PANEL_METRIC_CORNER_DISTANCE,
-                 "conical": _capi.PANEL_METRIC_CONICAL}
-CUTS_FORMATS = {"json": _capi.CUTS_JSON, "csv": _capi.CUTS_CSV}
+# The names each enum's values go by here and in scenes: generated from embra.h with the enums.
+SHAPES = dict(_capi.COLLIDER_NAMES)
+KINDS = dict(_capi.CONSTRAINT_NAMES)
+GENERATE = dict(_capi.GENERATE_NAMES)
+PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
+PANEL_METRICS = dict(_capi.PANEL_METRIC_NAMES)
+CUTS_FORMATS = dict(_capi.CUTS_NAMES)
 
 
 def as_dict(struct):

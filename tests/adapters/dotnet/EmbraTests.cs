@@ -972,72 +972,20 @@ namespace Embra.Tests
     public class ApiTests
     {
         [Test]
-        public void EveryHeaderFunctionIsBound()
+        public void EveryExternIsExported()
         {
-            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
-            var declared = new HashSet<string>(Regex.Matches(header, @"EMBRA_API[^;(]*?\b(embra_\w+)\s*\(").Cast<Match>().Select(m => m.Groups[1].Value));
-            var bound = new HashSet<string>(typeof(Native).GetMethods(BindingFlags.Public | BindingFlags.Static)
-                .Where(m => m.GetCustomAttributes(typeof(DllImportAttribute), false).Length > 0)
-                .Select(m => m.Name));
-            Assert.Greater(declared.Count, 40);
-            CollectionAssert.AreEquivalent(declared, bound);
+            // Each generated DllImport binds: Marshal.Prelink loads the symbol (a library older than the
+            // bindings fails here, by name)
+            var externs = typeof(Native).GetMethods(BindingFlags.Public | BindingFlags.Static)
+                .Where(m => m.GetCustomAttributes(typeof(DllImportAttribute), false).Length > 0).ToList();
+            Assert.Greater(externs.Count, 40);
+            foreach (var m in externs)
+                Marshal.Prelink(m);
         }
 
         static string Pascal(string upper)
         {
             return string.Concat(upper.ToLowerInvariant().Split('_').Select(w => char.ToUpperInvariant(w[0]) + w.Substring(1)));
-        }
-
-        [Test]
-        public void EveryHeaderConstantIsMirrored()
-        {
-            // EMBRA_ERROR_STALE_ID -> Status.StaleId, EMBRA_CONSTRAINT_EDGE_ANGLE -> ConstraintKind.EdgeAngle, ...
-            string header = File.ReadAllText(Path.Combine(Env.Source, "capi", "include", "embra", "embra.h"));
-            var constants = Regex.Matches(header, @"\bEMBRA_([A-Z0-9_]+)\s*=\s*(-?\d+)").Cast<Match>()
-                .ToDictionary(m => m.Groups[1].Value, m => int.Parse(m.Groups[2].Value));
-            Assert.GreaterOrEqual(constants.Count, 25);
-            var mirrors = new[] {
-                Tuple.Create("ERROR_", typeof(Status)), Tuple.Create("OK", typeof(Status)),
-                Tuple.Create("CONSTRAINT_", typeof(ConstraintKind)), Tuple.Create("COLLIDER_", typeof(ColliderShape)),
-                Tuple.Create("GENERATE_", typeof(Generate)), Tuple.Create("PANEL_PINS_", typeof(PanelPins)),
-                Tuple.Create("PANEL_METRIC_", typeof(PanelMetric)), Tuple.Create("CUTS_", typeof(CutsFormat)) };
-            foreach (var c in constants)
-            {
-                var mirror = mirrors.FirstOrDefault(m => c.Key.StartsWith(m.Item1));
-                Assert.IsNotNull(mirror, "EMBRA_" + c.Key + " has no C# mirror");
-                string name = Pascal(mirror.Item1 == "OK" ? "OK" : c.Key.Substring(mirror.Item1.Length));
-                int value;
-                if (mirror.Item2.IsEnum)
-                    value = (int)Enum.Parse(mirror.Item2, name);
-                else
-                    value = (int)mirror.Item2.GetField(name).GetValue(null);
-                Assert.AreEqual(c.Value, value, "EMBRA_" + c.Key);
-            }
-            Assert.That(constants.Keys, Has.Member("ERROR_CANCELLED"));
-            // EMBRA_MAX_ABS_VALUE -> Limits.MaxAbsValue, EMBRA_MIN_POSITIVE -> Limits.MinPositive, ... (same value and kind)
-            var limits = Regex.Matches(header, @"^#define\s+EMBRA_((?:MAX|MIN)_[A-Z0-9_]+)\s+([-+0-9.eE]+)\s*$", RegexOptions.Multiline)
-                .Cast<Match>().ToList();
-            Assert.GreaterOrEqual(limits.Count, 8);
-            var mirrored = typeof(Limits).GetFields(BindingFlags.Public | BindingFlags.Static).ToDictionary(f => f.Name);
-            foreach (Match m in limits)
-            {
-                string name = Pascal(m.Groups[1].Value), text = m.Groups[2].Value;
-                Assert.IsTrue(mirrored.ContainsKey(name), "EMBRA_" + m.Groups[1].Value + " has no Limits." + name);
-                object value = mirrored[name].GetValue(null);
-                bool integer = Regex.IsMatch(text, @"^-?\d+$");
-                Assert.AreEqual(integer, !(value is double), "EMBRA_" + m.Groups[1].Value + " is " + (integer ? "an integer" : "a double"));
-                Assert.AreEqual(double.Parse(text, CultureInfo.InvariantCulture), Convert.ToDouble(value), "EMBRA_" + m.Groups[1].Value);
-            }
-            Assert.AreEqual(limits.Count, mirrored.Count, "Limits has a constant embra.h does not define");
-            // EMBRA_PANEL_MESH_DEF_VERSION -> PanelMeshDef.CurrentVersion, EMBRA_TOLERANCES_VERSION -> Tolerances...
-            var versions = Regex.Matches(header, @"#define\s+EMBRA_([A-Z0-9_]+)_VERSION\s+(\d+)").Cast<Match>().ToList();
-            Assert.GreaterOrEqual(versions.Count, 10);
-            foreach (Match m in versions)
-            {
-                var def = typeof(Native).Assembly.GetType("Embra." + Pascal(m.Groups[1].Value));
-                Assert.IsNotNull(def, "no struct for EMBRA_" + m.Groups[1].Value + "_VERSION");
-                Assert.AreEqual(int.Parse(m.Groups[2].Value), (int)def.GetField("CurrentVersion").GetValue(null));
-            }
         }
 
         static string Snake(string pascal)

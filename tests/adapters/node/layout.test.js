@@ -1,5 +1,5 @@
 'use strict';
-// Every koffi struct of lib/capi.js has the size and field offsets the C compiler gives the struct of
+// Every koffi struct of lib/capi_generated.js has the size and field offsets the C compiler gives the struct of
 // embra.h (a small C program prints them).
 
 const assert = require('node:assert/strict');
