@@ -10,6 +10,7 @@
 #include "embra/core/world.hpp"
 
 #include "collider_shapes.hpp"
+#include "kind_traits.hpp"
 #include "lanes.hpp"
 #include "self_collision.hpp"
 
@@ -35,11 +36,6 @@ const double* coords(const std::vector<Vec3>& x) {
 }
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are packed xyz triples");
-
-template <Kind K>
-constexpr int arity_of() {
-  return K == Kind::distance || K == Kind::tether || K == Kind::weld ? 2 : K == Kind::edge_angle ? 3 : 4;
-}
 
 // --- projection kernels ------------------------------------------------------------------------
 //
@@ -798,41 +794,16 @@ void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std
   }
 }
 
-template <Kind K>
-auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
-  if constexpr (K == Kind::distance || K == Kind::tether)
-    return eval_distance(x[p[0]], x[p[1]]);
-  else if constexpr (K == Kind::edge_angle)
-    return eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]);
-  else if constexpr (K == Kind::dihedral)
-    return eval_dihedral(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-  else if constexpr (K == Kind::planarity)
-    return eval_quad_planarity(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-  else if constexpr (K == Kind::plane_offset)
-    return eval_plane_offset(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-  else
-    return eval_tet_volume(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-}
-
-/// C(x) - rest, with angles wrapped so a hinge never takes the long way round.
-template <Kind K>
-double deviation(double value, double rest) {
-  if constexpr (K == Kind::dihedral)
-    return wrap_angle(value - rest);
-  else
-    return value - rest;
-}
-
 /// The generic pass, through constraint_math.hpp (edge angle, tet volume).
 template <Kind K>
 void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
-  constexpr int N = arity_of<K>();
+  constexpr int N = arity(K);
   const size_t n = a.size();
   for (size_t i = 0; i < n; ++i) {
     const int32_t* p = &a.ids[i * N];
-    const auto e = evaluate<K>(p, x);
+    const auto e = KindTraits<K>::evaluate(p, x);
     if (!e.valid) continue;
-    const double c = deviation<K>(e.value, a.rest[i]);
+    const double c = KindTraits<K>::deviation(e.value, a.rest[i]);
     const double alpha = a.compliance[i] * inv_h2;
     double denom = alpha;
     for (int k = 0; k < N; ++k) denom += w[p[k]] * e.grad[k].squaredNorm();
@@ -850,7 +821,7 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
 template <Kind K>
 void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq,
                std::vector<double>& values) {
-  constexpr int N = arity_of<K>();
+  constexpr int N = arity(K);
   constexpr bool kLanes = K == Kind::distance || K == Kind::tether || K == Kind::dihedral;
   if constexpr (kLanes) {
     values.resize(a.size());
@@ -862,8 +833,8 @@ void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, 
     if constexpr (kLanes)
       value = values[i];
     else
-      value = evaluate<K>(&a.ids[i * N], x).value;
-    const double c = deviation<K>(value, a.rest[i]);
+      value = KindTraits<K>::evaluate(&a.ids[i * N], x).value;
+    const double c = KindTraits<K>::deviation(value, a.rest[i]);
     double r = c + a.compliance[i] * inv_h2 * a.lambda[i];
     if constexpr (K == Kind::tether)
       if (a.lambda[i] == 0.0) r = std::max(c, 0.0);
@@ -1131,11 +1102,11 @@ double contact_gap(const Collider& c, const Contact& ct, const Vec3& x, const Ve
 template <Kind K>
 void add_corrections(const SolverArray& a, const std::vector<Vec3>& x, const std::vector<double>& w,
                      std::vector<Vec3>& out) {
-  constexpr int N = arity_of<K>();
+  constexpr int N = arity(K);
   for (size_t i = 0; i < a.size(); ++i) {
     if (a.lambda[i] == 0.0) continue;
     const int32_t* p = &a.ids[i * N];
-    const auto e = evaluate<K>(p, x);
+    const auto e = KindTraits<K>::evaluate(p, x);
     if (!e.valid) continue;
     for (int k = 0; k < N; ++k) out[p[k]] += (w[p[k]] * a.lambda[i]) * e.grad[k];
   }
@@ -1587,7 +1558,7 @@ void World::step(const StepControl& control) {
   for (Group& g : groups_)
     for (int k = 0; k < kKindCount; ++k) {
       const SolverArray& a = g.solve[k];
-      const int per = k == static_cast<int>(Kind::weld) ? 3 : 1;
+      const int per = multipliers(static_cast<Kind>(k));
       for (size_t i = 0; i < a.size(); ++i)
         for (int c = 0; c < per; ++c) g.arrays[k].lambda[per * a.source[i] + c] = a.lambda[per * i + c];
     }

@@ -4,6 +4,7 @@
 
 #include "check.hpp"
 #include "collider_shapes.hpp"
+#include "kind_traits.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -66,49 +67,6 @@ void check_elements(std::span<const int32_t> ids, int n, int64_t vertex_count, c
 }
 
 }  // namespace
-
-int arity(Kind kind) {
-  switch (kind) {
-    case Kind::distance:
-      return 2;
-    case Kind::edge_angle:
-      return 3;
-    case Kind::dihedral:
-      return 4;
-    case Kind::tet_volume:
-      return 4;
-    case Kind::weld:
-      return 2;
-    case Kind::tether:
-      return 2;
-    case Kind::planarity:
-    case Kind::plane_offset:
-      return 4;
-  }
-  return 0;
-}
-
-const char* kind_name(Kind kind) {
-  switch (kind) {
-    case Kind::distance:
-      return "distance";
-    case Kind::edge_angle:
-      return "edge_angle";
-    case Kind::dihedral:
-      return "dihedral";
-    case Kind::tet_volume:
-      return "tet_volume";
-    case Kind::weld:
-      return "weld";
-    case Kind::tether:
-      return "tether";
-    case Kind::planarity:
-      return "planarity";
-    case Kind::plane_offset:
-      return "plane_offset";
-  }
-  return "unknown";
-}
 
 World::World(const Settings& settings) {
   Settings s = settings;
@@ -264,76 +222,20 @@ namespace {
 /// degenerate element, for which no rest value can be measured.
 double measure_rest(Kind kind, const int32_t* p, const std::vector<Vec3>& x, int64_t i) {
   const std::string name = element_name(kind_name(kind), i);
-  switch (kind) {
-    case Kind::distance:
-    case Kind::tether: {
-      const double len = (x[p[0]] - x[p[1]]).norm();
-      if (!(len > 0.0)) invalid(name + " is degenerate: its particles coincide (zero length)");
-      return len;
-    }
-    case Kind::edge_angle: {
-      const auto e = eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]);
-      if ((x[p[1]] - x[p[0]]).norm() == 0.0 || (x[p[2]] - x[p[0]]).norm() == 0.0)
-        invalid(name + " is degenerate: an edge has zero length");
-      return e.value;
-    }
-    case Kind::dihedral: {
-      const auto e = eval_dihedral(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-      if (!e.valid) invalid(name + " is degenerate: a triangle has zero area");
-      return e.value;
-    }
-    case Kind::tet_volume: {
-      const auto e = eval_tet_volume(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-      const double scale =
-          std::max({(x[p[1]] - x[p[0]]).norm(), (x[p[2]] - x[p[0]]).norm(), (x[p[3]] - x[p[0]]).norm()});
-      if (!(std::abs(e.value) > 1e-12 * scale * scale * scale)) invalid(name + " is degenerate: zero volume");
-      return e.value;
-    }
-    case Kind::weld:
-      return 0.0;
-    case Kind::planarity: {
-      const auto e = eval_quad_planarity(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-      if (!e.valid) invalid(name + " is degenerate: the quad's diagonals are parallel");
-      return e.value;
-    }
-    case Kind::plane_offset: {
-      const auto e = eval_plane_offset(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
-      if (!e.valid) invalid(name + " is degenerate: the plane's triangle has zero area");
-      return e.value;
-    }
-  }
-  return 0.0;
+  return visit_kind(kind, [&](auto k) { return KindTraits<k>::measure_rest(p, x, name); });
 }
 
 void check_rest(Kind kind, double rest, int64_t i) {
   const std::string name = element_name(kind_name(kind), i);
   check_finite(rest, (name + " rest value").c_str());
-  switch (kind) {
-    case Kind::distance:
-    case Kind::tether:
-      if (rest < 0.0) invalid(name + " rest length must be >= 0");
-      break;
-    case Kind::edge_angle:
-      if (rest < 0.0 || rest > std::numbers::pi) invalid(name + " rest angle must be in [0, pi]");
-      break;
-    case Kind::dihedral:
-      if (rest <= -std::numbers::pi || rest > std::numbers::pi) invalid(name + " rest angle must be in (-pi, pi]");
-      break;
-    case Kind::weld:
-      if (rest != 0.0) invalid(name + ": a weld has no rest value other than 0");
-      break;
-    case Kind::tet_volume:
-    case Kind::planarity:
-    case Kind::plane_offset:
-      break;
-  }
+  visit_kind(kind, [&](auto k) { KindTraits<k>::check_rest(rest, name); });
 }
 
 }  // namespace
 
 int64_t World::add_constraints(const ConstraintDesc& desc) {
   const int k = static_cast<int>(desc.kind);
-  if (k < 0 || k >= kKindCount) invalid("unknown constraint kind " + std::to_string(k));
+  if (!is_kind(k)) invalid("unknown constraint kind " + std::to_string(k));
   const int n = arity(desc.kind);
   const Id gid = resolve_group(desc.group);
   if (desc.particles.empty()) invalid("no constraints given (particle array is empty)");
@@ -376,7 +278,7 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     a.body.push_back(-1);
     a.compliance.push_back(desc.compliance.empty() ? desc.uniform_compliance : desc.compliance[i]);
     a.rest_now.push_back(rest[i]);
-    for (int c = 0; c < (desc.kind == Kind::weld ? 3 : 1); ++c) a.lambda.push_back(0.0);
+    for (int c = 0; c < multipliers(desc.kind); ++c) a.lambda.push_back(0.0);
   }
   rest_dirty_ = true;
   solver_dirty_ = true;
@@ -730,23 +632,10 @@ void World::refresh_rest() {
     if (!g.alive) continue;
     for (int k = 0; k < kKindCount; ++k) {
       ConstraintArray& a = g.arrays[k];
-      for (size_t i = 0; i < a.size(); ++i) {
-        if (a.body[i] < 0) {
-          a.rest_now[i] = a.rest[i];
-          continue;
-        }
-        const BodyInfo& b = bodies_[a.body[i]];
-        if (k == static_cast<int>(Kind::distance)) {
-          const double ru = a.rest_u[i] * b.rest_scale_u, rv = a.rest_v[i] * b.rest_scale_v;
-          const double rn2 =
-              std::max(0.0, a.rest[i] * a.rest[i] - a.rest_u[i] * a.rest_u[i] - a.rest_v[i] * a.rest_v[i]);
-          a.rest_now[i] = b.rest_scale * std::sqrt(ru * ru + rv * rv + rn2);
-        } else if (k == static_cast<int>(Kind::tet_volume)) {
-          a.rest_now[i] = a.rest[i] * b.rest_scale * b.rest_scale * b.rest_scale;
-        } else {
-          a.rest_now[i] = a.rest[i];
-        }
-      }
+      visit_kind(static_cast<Kind>(k), [&](auto kind) {
+        for (size_t i = 0; i < a.size(); ++i)
+          a.rest_now[i] = a.body[i] < 0 ? a.rest[i] : KindTraits<kind>::scaled_rest(a, i, bodies_[a.body[i]]);
+      });
       SolverArray& sa = g.solve[k];
       for (size_t i = 0; i < sa.size(); ++i) sa.rest[i] = a.rest_now[sa.source[i]];
     }
@@ -1135,7 +1024,7 @@ void World::rebuild_solver() {
       const ConstraintArray& a = g.arrays[k];
       SolverArray& sa = g.solve[k];
       const int n = arity(static_cast<Kind>(k));
-      const int per = k == static_cast<int>(Kind::weld) ? 3 : 1;
+      const int per = multipliers(static_cast<Kind>(k));
       sa = SolverArray{};
       colour_order(a.ids.data(), a.size(), n, x_.size(), none, order, sa.colour_start, sa.shared_tail);
       for (int32_t i : order) {

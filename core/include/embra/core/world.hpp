@@ -9,6 +9,7 @@
 
 #include "embra/core/constraint_math.hpp"
 #include "embra/core/fields.hpp"
+#include "embra/core/kinds.hpp"
 
 #include <array>
 #include <atomic>
@@ -50,21 +51,6 @@ struct Id {
   bool is_null() const { return generation == 0; }
   friend bool operator==(const Id&, const Id&) = default;
 };
-
-/// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
-enum class Kind : int32_t {
-  distance = 0,      // |x0 - x1| = rest                          (stretch)
-  edge_angle = 1,    // angle at x0 between x1 - x0 and x2 - x0  (shear)
-  dihedral = 2,      // angle between (x0,x1,x2) and (x1,x0,x3)  (bend)
-  tet_volume = 3,    // signed volume of (x0,x1,x2,x3) = rest
-  weld = 4,          // x0 = x1
-  tether = 5,        // |x0 - x1| <= rest  (long-range attachment, unilateral)
-  planarity = 6,     // distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)
-  plane_offset = 7,  // signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)
-};
-constexpr int kKindCount = 8;
-int arity(Kind kind);
-const char* kind_name(Kind kind);
 
 struct Material {
   double mass = 0.0;                // kg for the whole body; used when > 0
