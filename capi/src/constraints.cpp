@@ -1,0 +1,74 @@
+// Constraints added by the host, one or a batch at a time.
+#include "guard.hpp"
+
+using namespace embra::capi;
+
+// embra_constraint_kind values are cast to embra::Kind: each is pinned to its core value.
+static_assert(static_cast<int>(embra::Kind::distance) == EMBRA_CONSTRAINT_DISTANCE);
+static_assert(static_cast<int>(embra::Kind::edge_angle) == EMBRA_CONSTRAINT_EDGE_ANGLE);
+static_assert(static_cast<int>(embra::Kind::dihedral) == EMBRA_CONSTRAINT_DIHEDRAL);
+static_assert(static_cast<int>(embra::Kind::tet_volume) == EMBRA_CONSTRAINT_TET_VOLUME);
+static_assert(static_cast<int>(embra::Kind::weld) == EMBRA_CONSTRAINT_WELD);
+static_assert(static_cast<int>(embra::Kind::tether) == EMBRA_CONSTRAINT_TETHER);
+static_assert(static_cast<int>(embra::Kind::planarity) == EMBRA_CONSTRAINT_PLANARITY);
+static_assert(static_cast<int>(embra::Kind::plane_offset) == EMBRA_CONSTRAINT_PLANE_OFFSET);
+static_assert(embra::kKindCount == EMBRA_CONSTRAINT_PLANE_OFFSET + 1, "a core kind the C ABI does not number");
+
+extern "C" {
+
+int32_t embra_constraint_arity(embra_constraint_kind kind) {
+  if (kind < 0 || kind >= embra::kKindCount) return 0;
+  return embra::arity(static_cast<embra::Kind>(kind));
+}
+
+embra_constraint_def embra_default_constraint_def(void) {
+  embra_constraint_def d{};
+  d.version = EMBRA_CONSTRAINT_DEF_VERSION;
+  d.kind = EMBRA_CONSTRAINT_DISTANCE;
+  d.rest_from_current = 1;
+  return d;
+}
+
+embra_status embra_constraint_add(embra_world* world, const embra_constraint_def* def) {
+  return guard("embra_constraint_add", world, [&] {
+    need(def, "def");
+    need_version(def->version, EMBRA_CONSTRAINT_DEF_VERSION, "embra_constraint_def");
+    const int32_t n = embra_constraint_arity(def->kind);
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + num(def->kind));
+    need_flag(def->rest_from_current, "def.rest_from_current");
+    embra::ConstraintDesc d;
+    d.kind = static_cast<embra::Kind>(def->kind);
+    d.group = to_id(def->group);
+    d.particles = std::span<const int32_t>(def->particles, static_cast<size_t>(n));
+    if (!def->rest_from_current) d.rest = std::span<const double>(&def->rest, 1);
+    d.uniform_compliance = def->compliance;
+    world->world.add_constraints(d);
+  });
+}
+
+embra_constraint_batch_def embra_default_constraint_batch_def(void) {
+  embra_constraint_batch_def d{};
+  d.version = EMBRA_CONSTRAINT_BATCH_DEF_VERSION;
+  d.kind = EMBRA_CONSTRAINT_DISTANCE;
+  return d;
+}
+
+embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def) {
+  return guard("embra_constraints_add", world, [&] {
+    need(def, "def");
+    need_version(def->version, EMBRA_CONSTRAINT_BATCH_DEF_VERSION, "embra_constraint_batch_def");
+    const int32_t n = embra_constraint_arity(def->kind);
+    if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + num(def->kind));
+    if (def->count <= 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.count must be > 0");
+    embra::ConstraintDesc d;
+    d.kind = static_cast<embra::Kind>(def->kind);
+    d.group = to_id(def->group);
+    d.particles = view(def->particles, static_cast<int64_t>(def->count) * n, "def.particles");
+    if (def->rest) d.rest = std::span<const double>(def->rest, static_cast<size_t>(def->count));
+    if (def->compliances) d.compliance = std::span<const double>(def->compliances, static_cast<size_t>(def->count));
+    d.uniform_compliance = def->compliance;
+    world->world.add_constraints(d);
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,65 @@
+// Pins: hard or soft attachments of a particle to a target.
+#include "copy.hpp"
+#include "guard.hpp"
+
+using namespace embra::capi;
+
+namespace {
+constexpr std::tuple kPinCopies{Copy{&embra_pin_def::particle, &embra::PinDesc::particle},
+                                Copy{&embra_pin_def::target, &embra::PinDesc::target},
+                                Copy{&embra_pin_def::compliance, &embra::PinDesc::compliance}};
+}  // namespace
+
+extern "C" {
+
+embra_pin_def embra_default_pin_def(void) {
+  embra_pin_def d{};
+  d.version = EMBRA_PIN_DEF_VERSION;
+  const embra::PinDesc core;
+  to_c(kPinCopies, core, d);
+  return d;
+}
+
+embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin) {
+  return guard("embra_pin_create", world, [&] {
+    need(def, "def");
+    need(out_pin, "out_pin");
+    need_version(def->version, EMBRA_PIN_DEF_VERSION, "embra_pin_def");
+    embra::PinDesc d;
+    to_core(kPinCopies, *def, d);
+    d.group = to_id(def->group);
+    *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
+  });
+}
+
+embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
+  return guard("embra_pin_destroy", world, [&] {
+    world->world.destroy_pin(to_id(pin));
+    drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
+  });
+}
+
+embra_status embra_pin_set_target(embra_world* world, embra_pin_id pin, const double target[3]) {
+  return guard("embra_pin_set_target", world, [&] {
+    need(target, "target");
+    world->world.set_pin_target(to_id(pin), vec(target));
+    drop_actions(world->meta, embra::io::Action::Type::pin_target, to_id(pin));
+  });
+}
+
+embra_status embra_pin_get_target(const embra_world* world, embra_pin_id pin, double out_target[3]) {
+  return guard("embra_pin_get_target", world, [&] {
+    need(out_target, "out_target");
+    const embra::Vec3& t = world->world.pin(to_id(pin)).target;
+    for (int k = 0; k < 3; ++k) out_target[k] = t[k];
+  });
+}
+
+embra_status embra_pin_get_particle(const embra_world* world, embra_pin_id pin, int32_t* out_particle) {
+  return guard("embra_pin_get_particle", world, [&] {
+    need(out_particle, "out_particle");
+    *out_particle = world->world.pin(to_id(pin)).particle;
+  });
+}
+
+}  // extern "C"

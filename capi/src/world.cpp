@@ -1,0 +1,248 @@
+// The world: creation, solver settings, counts and id listings, stepping, particle state.
+#include "copy.hpp"
+#include "guard.hpp"
+
+#include <thread>
+
+using namespace embra::capi;
+
+namespace {
+
+constexpr std::tuple kSolverCopies{Copy{&embra_solver_def::dt, &embra::Settings::dt},
+                                   Copy{&embra_solver_def::substeps, &embra::Settings::substeps},
+                                   Copy{&embra_solver_def::iterations, &embra::Settings::iterations},
+                                   Copy{&embra_solver_def::gravity, &embra::Settings::gravity},
+                                   Copy{&embra_solver_def::damping, &embra::Settings::damping},
+                                   Copy{&embra_solver_def::settle_speed, &embra::Settings::settle_speed},
+                                   Copy{&embra_solver_def::tethers, &embra::Settings::tethers},
+                                   Copy{&embra_solver_def::realign_passes, &embra::Settings::realign_passes},
+                                   Copy{&embra_solver_def::chebyshev_rho_milli, &embra::Settings::chebyshev_rho_milli},
+                                   Copy{&embra_solver_def::self_collision, &embra::Settings::self_collision},
+                                   Copy{&embra_solver_def::chain_solve, &embra::Settings::chain_solve}};
+
+embra::Settings to_settings(const embra_solver_def& d) {
+  embra::Settings s;
+  to_core(kSolverCopies, d, s);
+  return s;
+}
+
+embra_solver_def from_settings(const embra::Settings& s) {
+  embra_solver_def d{};
+  d.version = EMBRA_SOLVER_DEF_VERSION;
+  to_c(kSolverCopies, s, d);
+  return d;
+}
+
+void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t count, const double* out) {
+  need(out, "out_xyz");
+  if (first < 0 || count < 0 || static_cast<int64_t>(first) + count > w.particle_count())
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particle range [" + num(first) + ", " +
+                                             num(static_cast<int64_t>(first) + count) + ") is outside [0, " +
+                                             num(w.particle_count()) + ")");
+  if (capacity < 3 * static_cast<int64_t>(count))
+    refuse(EMBRA_ERROR_BUFFER_TOO_SMALL,
+           "buffer holds " + num(capacity) + " doubles, " + num(3 * static_cast<int64_t>(count)) + " needed");
+}
+
+/// The two-call id listing of embra_world_get_bodies/groups/pins/colliders: of `slots` slots, the
+/// live ones (`generation(i)` nonzero) as {slot index, generation}, in slot order (creation order).
+template <class IdT, class Generation>
+void list_ids(size_t slots, Generation generation, IdT* out, int32_t capacity, int32_t* out_count) {
+  need(out_count, "out_count");
+  need_count(capacity, "capacity");
+  int32_t n = 0;
+  for (size_t i = 0; i < slots; ++i) n += generation(i) != 0 ? 1 : 0;
+  if (!fits(out, capacity, n, "ids")) {
+    *out_count = n;
+    return;
+  }
+  int32_t k = 0;
+  for (size_t i = 0; i < slots; ++i)
+    if (const uint32_t g = generation(i); g != 0) out[k++] = IdT{static_cast<uint32_t>(i), g};
+  *out_count = n;
+}
+
+/// A slot's generation if it is alive, else 0.
+template <class T>
+auto live_generation(const std::vector<T>& slots) {
+  return [&slots](size_t i) { return slots[i].alive ? slots[i].generation : 0u; };
+}
+
+}  // namespace
+
+extern "C" {
+
+embra_solver_def embra_default_solver_def(void) {
+  return from_settings(embra::Settings());
+}
+
+embra_status embra_world_create(embra_world** out_world, const embra_solver_def* def) {
+  if (out_world != nullptr) *out_world = nullptr;
+  return guard("embra_world_create", [&] {
+    need(out_world, "out_world");
+    const embra_solver_def d = def ? *def : embra_default_solver_def();
+    need_version(d.version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
+    *out_world = new embra_world{embra::World(to_settings(d)), {}};
+  });
+}
+
+void embra_world_destroy(embra_world* world) {
+  if (world == nullptr) return;
+  // A call still running on another thread finishes first (destroying under it would free what it
+  // uses); later calls with this pointer are the host's use after free.
+  while (world->busy.exchange(true, std::memory_order_acquire)) std::this_thread::yield();
+  delete world;
+}
+
+embra_status embra_world_get_solver(const embra_world* world, embra_solver_def* out_def) {
+  return guard("embra_world_get_solver", world, [&] {
+    need(out_def, "out_def");
+    const embra_solver_def d = from_settings(world->world.settings());
+    *out_def = d;
+  });
+}
+
+embra_status embra_world_set_solver(embra_world* world, const embra_solver_def* def) {
+  return guard("embra_world_set_solver", world, [&] {
+    need(def, "def");
+    need_version(def->version, EMBRA_SOLVER_DEF_VERSION, "embra_solver_def");
+    world->world.set_settings(to_settings(*def));
+  });
+}
+
+embra_status embra_world_set_gravity(embra_world* world, const double gravity[3]) {
+  return guard("embra_world_set_gravity", world, [&] {
+    need(gravity, "gravity");
+    world->world.set_gravity(vec(gravity));
+    drop_actions(world->meta, embra::io::Action::Type::gravity, embra::Id{});
+  });
+}
+
+embra_status embra_world_get_counts(const embra_world* world, embra_world_counts* out_counts) {
+  return guard("embra_world_get_counts", world, [&] {
+    need(out_counts, "out_counts");
+    const embra::World& w = world->world;
+    embra_world_counts c{};
+    c.particles = w.particle_count();
+    c.bodies = static_cast<int32_t>(w.body_count());
+    c.groups = static_cast<int32_t>(w.group_count());
+    c.pins = static_cast<int32_t>(w.pin_count());
+    c.colliders = static_cast<int32_t>(w.collider_count());
+    c.constraints = w.constraint_count();
+    *out_counts = c;
+  });
+}
+
+embra_status embra_world_get_bodies(const embra_world* world, embra_body_id* out, int32_t capacity,
+                                    int32_t* out_count) {
+  return guard("embra_world_get_bodies", world, [&] {
+    // Bodies are never destroyed: each keeps generation 1.
+    list_ids(
+        world->world.body_count(), [](size_t) { return 1u; }, out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_groups(const embra_world* world, embra_group_id* out, int32_t capacity,
+                                    int32_t* out_count) {
+  return guard("embra_world_get_groups", world, [&] {
+    list_ids(world->world.groups().size(), live_generation(world->world.groups()), out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_pins(const embra_world* world, embra_pin_id* out, int32_t capacity, int32_t* out_count) {
+  return guard("embra_world_get_pins", world, [&] {
+    list_ids(world->world.pins().size(), live_generation(world->world.pins()), out, capacity, out_count);
+  });
+}
+
+embra_status embra_world_get_colliders(const embra_world* world, embra_collider_id* out, int32_t capacity,
+                                       int32_t* out_count) {
+  return guard("embra_world_get_colliders", world, [&] {
+    list_ids(world->world.colliders().size(), live_generation(world->world.colliders()), out, capacity, out_count);
+  });
+}
+
+// --- stepping ----------------------------------------------------------------------------------
+
+embra_status embra_world_step(embra_world* world) {
+  const embra_status status = guard("embra_world_step", world, [&] {
+    embra::StepControl control;
+    if (!world->meta.actions.empty())
+      control.before_frame = [world](embra::World& w) {
+        embra::io::apply_actions(w, world->meta, w.report().frame + 1);
+      };
+    control.cancel = &world->cancel;
+    world->world.step(control);
+  });
+  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+  return status;
+}
+
+embra_status embra_world_cancel(embra_world* world) {
+  return guard("embra_world_cancel", [&] {
+    need(world, "world");
+    world->cancel.store(true, std::memory_order_relaxed);
+  });
+}
+
+embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report) {
+  return guard("embra_world_get_report", world, [&] {
+    need(out_report, "out_report");
+    const embra::StepReport& r = world->world.report();
+    embra_step_report o{};
+    o.frame = r.frame;
+    o.time = r.time;
+    o.kinetic_energy = r.kinetic_energy;
+    o.max_speed = r.max_speed;
+    o.residual_max = r.residual_max;
+    o.residual_rms = r.residual_rms;
+    o.constraint_count = r.constraint_count;
+    o.contact_count = r.contact_count;
+    o.settled = r.settled ? 1 : 0;
+    *out_report = o;
+  });
+}
+
+embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
+  return guard("embra_world_get_warning", world, [&] {
+    need(out_warning, "out_warning");
+    const embra::Warning& w = world->world.warning();
+    *out_warning = embra_warning{w.frame, w.particle, 0};
+  });
+}
+
+embra_status embra_world_get_positions(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                       int32_t count) {
+  return guard("embra_world_get_positions", world, [&] {
+    read_range(world->world, capacity, first, count, out_xyz);
+    const auto& x = world->world.positions();
+    for (int32_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = x[first + i][k];
+  });
+}
+
+embra_status embra_world_get_velocities(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                        int32_t count) {
+  return guard("embra_world_get_velocities", world, [&] {
+    read_range(world->world, capacity, first, count, out_xyz);
+    const auto& v = world->world.velocities();
+    for (int32_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = v[first + i][k];
+  });
+}
+
+embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count) {
+  return guard("embra_world_set_positions", world, [&] {
+    need_count(count, "count");
+    world->world.set_positions(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count) {
+  return guard("embra_world_set_velocities", world, [&] {
+    need_count(count, "count");
+    world->world.set_velocities(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+}  // extern "C"
