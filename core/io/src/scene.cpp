@@ -2,6 +2,7 @@
 // through embra::World, and save back.
 #include "embra/io/scene.hpp"
 
+#include "embra/core/kinds.hpp"
 #include "embra/core/limits.hpp"
 
 #include "closed_meshes.hpp"
@@ -32,6 +33,8 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <type_traits>
 
 namespace embra::io {
 
@@ -314,6 +317,168 @@ T value_or(const json& obj, const char* key, T fallback) {
   const auto it = obj.find(key);
   return it == obj.end() ? fallback : it->get<T>();
 }
+
+json vec_json(const Vec3& v) {
+  return json::array({v[0], v[1], v[2]});
+}
+
+// --- the defs' settings, one table per def ------------------------------------------------------
+// A row is a setting's key in the scene format and its member in the core's struct, whose default
+// initialiser is the setting's default. read_rows fills in the keys a document gives (the others
+// keep their defaults); write_rows writes every row (unless its `saved` says the setting does not
+// apply). Adding a setting to a def: its member (with its default) in the core's struct, one row
+// here, its key in schemas/scene.schema.json, and its copy in the C ABI's table (capi/src).
+
+/// One setting of the def S: its key and its member.
+template <class S, class T>
+struct Row {
+  const char* key;
+  T S::*member;
+  bool (*saved)(const S&) = nullptr;  // null: always written
+};
+
+template <class T>
+T value_of(const json& j) {
+  if constexpr (std::is_same_v<T, Vec3>)
+    return vec3(j);
+  else if constexpr (std::is_same_v<T, Tolerance>)
+    return Tolerance{j["target"].get<double>(), j["max"].get<double>()};
+  else
+    return j.get<T>();
+}
+
+json json_of(double v) {
+  return v;
+}
+json json_of(int32_t v) {
+  return v;
+}
+json json_of(const Vec3& v) {
+  return vec_json(v);
+}
+json json_of(const Tolerance& t) {
+  return json{{"target", t.target}, {"max", t.max}};
+}
+
+/// The settings `j` gives into `s` (a tuple of rows); the others keep their values.
+template <class Rows, class S>
+void read_rows(const Rows& rows, const json& j, S& s) {
+  std::apply(
+      [&](const auto&... row) {
+        const auto read = [&](const auto& r) {
+          const auto it = j.find(r.key);
+          if (it != j.end()) s.*r.member = value_of<std::remove_cvref_t<decltype(s.*r.member)>>(*it);
+        };
+        (read(row), ...);
+      },
+      rows);
+}
+
+/// Every setting of `s` that applies into `out` (a tuple of rows).
+template <class Rows, class S>
+void write_rows(const Rows& rows, const S& s, json& out) {
+  std::apply(
+      [&](const auto&... row) {
+        const auto write = [&](const auto& r) {
+          if (r.saved == nullptr || r.saved(s)) out[r.key] = json_of(s.*r.member);
+        };
+        (write(row), ...);
+      },
+      rows);
+}
+
+constexpr std::tuple kSolverRows{Row{"dt", &Settings::dt},
+                                 Row{"substeps", &Settings::substeps},
+                                 Row{"iterations", &Settings::iterations},
+                                 Row{"gravity", &Settings::gravity},
+                                 Row{"damping", &Settings::damping},
+                                 Row{"settle_speed", &Settings::settle_speed},
+                                 Row{"tethers", &Settings::tethers},
+                                 Row{"realign_passes", &Settings::realign_passes},
+                                 Row{"chebyshev_rho_milli", &Settings::chebyshev_rho_milli},
+                                 Row{"self_collision", &Settings::self_collision},
+                                 Row{"chain_solve", &Settings::chain_solve}};
+
+constexpr std::tuple kMaterialRows{Row{"mass", &Material::mass},
+                                   Row{"density", &Material::density},
+                                   Row{"stretch_compliance", &Material::stretch_compliance},
+                                   Row{"shear_compliance", &Material::shear_compliance},
+                                   Row{"bend_compliance", &Material::bend_compliance},
+                                   Row{"volume_compliance", &Material::volume_compliance},
+                                   Row{"damping", &Material::damping},
+                                   Row{"thickness", &Material::thickness},
+                                   Row{"friction_static", &Material::friction_static},
+                                   Row{"friction_dynamic", &Material::friction_dynamic}};
+
+constexpr std::tuple kGroupRows{Row{"order", &GroupDesc::order}, Row{"weight", &GroupDesc::weight}};
+
+/// A pin's particle (a number or a body's vertex) and group (a name) are read and written beside these.
+constexpr std::tuple kPinRows{Row{"target", &PinDesc::target}, Row{"compliance", &PinDesc::compliance}};
+
+/// A collider's shape, rotation, vertices and triangles are read and written beside these.
+constexpr std::tuple kColliderRows{
+    Row{"position", &ColliderDesc::position},
+    Row{"radius", &ColliderDesc::radius,
+        +[](const ColliderDesc& d) { return d.shape == ColliderShape::sphere || d.shape == ColliderShape::capsule; }},
+    Row{"half_extents", &ColliderDesc::half_extents,
+        +[](const ColliderDesc& d) { return d.shape == ColliderShape::box; }},
+    Row{"half_length", &ColliderDesc::half_length,
+        +[](const ColliderDesc& d) { return d.shape == ColliderShape::capsule; }},
+    Row{"thickness", &ColliderDesc::thickness},
+    Row{"friction_static", &ColliderDesc::friction_static},
+    Row{"friction_dynamic", &ColliderDesc::friction_dynamic}};
+
+constexpr std::tuple kWindRows{Row{"direction", &WindDesc::direction}, Row{"speed", &WindDesc::speed},
+                               Row{"air_density", &WindDesc::air_density}, Row{"drag", &WindDesc::drag},
+                               Row{"lift", &WindDesc::lift}};
+
+constexpr std::tuple kPressureRows{
+    Row{"inside_pressure", &PressureDesc::inside_pressure}, Row{"outside_pressure", &PressureDesc::outside_pressure},
+    Row{"keep_volume", &PressureDesc::keep_volume}, Row{"volume_compliance", &PressureDesc::volume_compliance},
+    Row{"rest_volume", &PressureDesc::rest_volume}};
+
+constexpr std::tuple kSurfaceTensionRows{Row{"tension", &SurfaceTensionDesc::tension},
+                                         Row{"regularisation", &SurfaceTensionDesc::regularisation}};
+
+constexpr std::tuple kVortexRows{Row{"center", &VortexDesc::center},        Row{"axis", &VortexDesc::axis},
+                                 Row{"strength", &VortexDesc::strength},    Row{"radius", &VortexDesc::radius},
+                                 Row{"twist", &VortexDesc::twist},          Row{"decay", &VortexDesc::decay},
+                                 Row{"start_time", &VortexDesc::start_time}};
+
+/// The field kinds' names in the scene format, by FieldKind.
+constexpr const char* kFieldKindNames[kFieldKindCount] = {"wind", "pressure", "surface_tension", "vortex"};
+
+/// Calls `f(desc, rows)` with the settings of `d`'s kind and their table.
+template <class D, class F>
+void visit_field(D& d, F&& f) {
+  switch (d.kind) {
+    case FieldKind::wind:
+      return f(d.wind, kWindRows);
+    case FieldKind::pressure:
+      return f(d.pressure, kPressureRows);
+    case FieldKind::surface_tension:
+      return f(d.surface_tension, kSurfaceTensionRows);
+    case FieldKind::vortex:
+      return f(d.vortex, kVortexRows);
+  }
+}
+
+/// A generated panel mesh's settings (a saved scene keeps the body and layout it made instead).
+constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
+                                    Row{"mass", &PanelMeshDesc::mass},
+                                    Row{"density", &PanelMeshDesc::density},
+                                    Row{"damping", &PanelMeshDesc::damping},
+                                    Row{"friction_static", &PanelMeshDesc::friction_static},
+                                    Row{"friction_dynamic", &PanelMeshDesc::friction_dynamic},
+                                    Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
+
+/// The panel pins' names in the scene format, by PanelPins.
+constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
+
+constexpr std::tuple kTolerancesRows{Row{"unit_scale", &Tolerances::unit_scale},
+                                     Row{"planarity", &Tolerances::planarity},
+                                     Row{"planarity_distance", &Tolerances::planarity_distance},
+                                     Row{"thickness", &Tolerances::thickness}, Row{"miter", &Tolerances::miter}};
 
 /// A body's vertices, elements and named vertex sets before it becomes part of the world.
 struct Mesh {
@@ -618,36 +783,17 @@ Mesh inline_mesh(const json& s) {
 
 Material material(const json& j) {
   Material m;
-  if (j.is_null()) return m;
-  m.mass = value_or(j, "mass", m.mass);
-  m.density = value_or(j, "density", m.density);
-  m.stretch_compliance = value_or(j, "stretch_compliance", m.stretch_compliance);
-  m.shear_compliance = value_or(j, "shear_compliance", m.shear_compliance);
-  m.bend_compliance = value_or(j, "bend_compliance", m.bend_compliance);
-  m.volume_compliance = value_or(j, "volume_compliance", m.volume_compliance);
-  m.damping = value_or(j, "damping", m.damping);
-  m.thickness = value_or(j, "thickness", m.thickness);
-  m.friction_static = value_or(j, "friction_static", m.friction_static);
-  m.friction_dynamic = value_or(j, "friction_dynamic", m.friction_dynamic);
+  if (!j.is_null()) read_rows(kMaterialRows, j, m);
   return m;
 }
 
 json material_json(const Material& m) {
-  return json{{"mass", m.mass},
-              {"density", m.density},
-              {"stretch_compliance", m.stretch_compliance},
-              {"shear_compliance", m.shear_compliance},
-              {"bend_compliance", m.bend_compliance},
-              {"volume_compliance", m.volume_compliance},
-              {"damping", m.damping},
-              {"thickness", m.thickness},
-              {"friction_static", m.friction_static},
-              {"friction_dynamic", m.friction_dynamic}};
+  json out = json::object();
+  write_rows(kMaterialRows, m, out);
+  return out;
 }
 
 const char* const kGenerateNames[] = {"stretch", "shear", "bend", "volume"};
-const char* const kKindNames[] = {"distance", "edge_angle", "dihedral",  "tet_volume",
-                                  "weld",     "tether",     "planarity", "plane_offset"};
 
 /// Builds the world from a validated document, section by section; every error names its place.
 class Builder {
@@ -657,24 +803,13 @@ class Builder {
   std::unique_ptr<World> build() {
     Settings s;
     if (doc_.contains("solver")) {
-      const json& j = doc_["solver"];
-      s.dt = value_or(j, "dt", s.dt);
-      s.substeps = value_or(j, "substeps", s.substeps);
-      s.iterations = value_or(j, "iterations", s.iterations);
-      if (j.contains("gravity")) s.gravity = vec3(j["gravity"]);
-      s.damping = value_or(j, "damping", s.damping);
-      s.settle_speed = value_or(j, "settle_speed", s.settle_speed);
-      s.tethers = value_or(j, "tethers", s.tethers);
-      s.realign_passes = value_or(j, "realign_passes", s.realign_passes);
-      s.chebyshev_rho_milli = value_or(j, "chebyshev_rho_milli", s.chebyshev_rho_milli);
-      s.self_collision = value_or(j, "self_collision", s.self_collision);
-      s.chain_solve = value_or(j, "chain_solve", s.chain_solve);
+      read_rows(kSolverRows, doc_["solver"], s);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });
     World& w = *world;
     meta_.name = value_or(doc_, "name", std::string());
     meta_.description = value_or(doc_, "description", std::string());
-    meta_.frames = value_or(doc_, "frames", int64_t{600});
+    meta_.frames = value_or(doc_, "frames", meta_.frames);
     groups_["default"] = w.default_group();
     groups_["contacts"] = w.contact_group();
     meta_.group_names[w.default_group().index] = "default";
@@ -682,8 +817,7 @@ class Builder {
     section("groups", [&](const json& g, const std::string& at) {
       const std::string name = g["name"].get<std::string>();
       GroupDesc d;
-      d.order = value_or(g, "order", 0);
-      d.weight = value_or(g, "weight", 1);
+      read_rows(kGroupRows, g, d);
       d.name = name;
       const auto it = groups_.find(name);
       if (it != groups_.end()) {
@@ -708,14 +842,8 @@ class Builder {
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
-      if (c.contains("position")) d.position = vec3(c["position"]);
       if (c.contains("rotation")) d.rotation = quat(c["rotation"], at + "/rotation");
-      d.radius = value_or(c, "radius", d.radius);
-      d.thickness = value_or(c, "thickness", d.thickness);
-      d.friction_static = value_or(c, "friction_static", d.friction_static);
-      d.friction_dynamic = value_or(c, "friction_dynamic", d.friction_dynamic);
-      if (c.contains("half_extents")) d.half_extents = vec3(c["half_extents"]);
-      d.half_length = value_or(c, "half_length", d.half_length);
+      read_rows(kColliderRows, c, d);
       if (c.contains("vertices"))
         for (const json& v : c["vertices"])
           for (const json& k : v) d.vertices.push_back(k.get<double>());
@@ -855,9 +983,8 @@ class Builder {
 
   void constraints(World& w, const json& c, const std::string& at) {
     const std::string kind = c["kind"].get<std::string>();
-    int k = 0;
-    while (kind != kKindNames[k]) ++k;
-    const int n = arity(static_cast<Kind>(k));
+    const Kind k = *kind_from_name(kind);  // the schema has checked it names a kind
+    const int n = arity(k);
     std::vector<int32_t> ids;
     const json& list = c["particles"];
     for (size_t i = 0; i < list.size(); ++i) {
@@ -876,7 +1003,7 @@ class Builder {
              "has " + std::to_string(rest.size()) + " values for " + std::to_string(list.size()) + " constraints");
     }
     ConstraintDesc d;
-    d.kind = static_cast<Kind>(k);
+    d.kind = k;
     d.group = group(c, "group", at);
     d.particles = ids;
     d.rest = rest;
@@ -887,7 +1014,7 @@ class Builder {
                                      std::to_string(list.size()) + " constraints");
       d.compliance = compliance;
     } else {
-      d.uniform_compliance = value_or(c, "compliance", 0.0);
+      d.uniform_compliance = value_or(c, "compliance", d.uniform_compliance);
     }
     guard(at, [&] { return w.add_constraints(d); });
   }
@@ -965,17 +1092,10 @@ class Builder {
     PanelMeshDesc d;
     d.positions = positions;
     d.quads = quads;
-    d.thickness = value_or(p, "thickness", d.thickness);
-    d.mass = value_or(p, "mass", d.mass);
-    d.density = value_or(p, "density", d.density);
-    d.damping = value_or(p, "damping", d.damping);
-    d.friction_static = value_or(p, "friction_static", d.friction_static);
-    d.friction_dynamic = value_or(p, "friction_dynamic", d.friction_dynamic);
-    d.slide_compliance = value_or(p, "slide_compliance", d.slide_compliance);
-    const std::string pins = value_or(p, "pins", std::string("none"));
-    d.pins = pins == "top_corners"              ? PanelPins::top_corners
-             : pins == "top_and_bottom_corners" ? PanelPins::top_and_bottom_corners
-                                                : PanelPins::none;
+    read_rows(kPanelMeshRows, p, d);
+    if (p.contains("pins"))  // the schema has checked it is one of kPanelPinsNames
+      for (int k = 0; k < static_cast<int>(std::size(kPanelPinsNames)); ++k)
+        if (p["pins"] == kPanelPinsNames[k]) d.pins = static_cast<PanelPins>(k);
     d.group = group(p, "group", at);
     std::vector<bool> had(w.pins().size());
     for (size_t i = 0; i < w.pins().size(); ++i) had[i] = w.pins()[i].alive;
@@ -1007,8 +1127,8 @@ class Builder {
     for (size_t i = 0; i < particles.size(); ++i) {
       PinDesc d;
       d.particle = particles[i];
-      d.target = p.contains("target") ? vec3(p["target"]) : w.positions()[particles[i]];
-      d.compliance = value_or(p, "compliance", 0.0);
+      d.target = w.positions()[particles[i]];
+      read_rows(kPinRows, p, d);
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1065,34 +1185,9 @@ class Builder {
     const std::string type = f["type"].get<std::string>();
     FieldDesc d;
     if (f.contains("body")) d.body = static_cast<int32_t>(named(bodies_, f, "body", at).index);
-    if (type == "wind") {
-      d.kind = FieldKind::wind;
-      if (f.contains("direction")) d.wind.direction = vec3(f["direction"]);
-      d.wind.speed = value_or(f, "speed", d.wind.speed);
-      d.wind.air_density = value_or(f, "air_density", d.wind.air_density);
-      d.wind.drag = value_or(f, "drag", d.wind.drag);
-      d.wind.lift = value_or(f, "lift", d.wind.lift);
-    } else if (type == "pressure") {
-      d.kind = FieldKind::pressure;
-      d.pressure.inside_pressure = value_or(f, "inside_pressure", d.pressure.inside_pressure);
-      d.pressure.outside_pressure = value_or(f, "outside_pressure", d.pressure.outside_pressure);
-      d.pressure.keep_volume = value_or(f, "keep_volume", d.pressure.keep_volume);
-      d.pressure.volume_compliance = value_or(f, "volume_compliance", d.pressure.volume_compliance);
-      d.pressure.rest_volume = value_or(f, "rest_volume", d.pressure.rest_volume);
-    } else if (type == "surface_tension") {
-      d.kind = FieldKind::surface_tension;
-      d.surface_tension.tension = value_or(f, "tension", d.surface_tension.tension);
-      d.surface_tension.regularisation = value_or(f, "regularisation", d.surface_tension.regularisation);
-    } else {
-      d.kind = FieldKind::vortex;
-      if (f.contains("center")) d.vortex.center = vec3(f["center"]);
-      if (f.contains("axis")) d.vortex.axis = vec3(f["axis"]);
-      d.vortex.strength = value_or(f, "strength", d.vortex.strength);
-      d.vortex.radius = value_or(f, "radius", d.vortex.radius);
-      d.vortex.twist = value_or(f, "twist", d.vortex.twist);
-      d.vortex.decay = value_or(f, "decay", d.vortex.decay);
-      d.vortex.start_time = value_or(f, "start_time", d.vortex.start_time);
-    }
+    for (int k = 0; k < kFieldKindCount; ++k)  // the schema has checked the type is one of them
+      if (type == kFieldKindNames[k]) d.kind = static_cast<FieldKind>(k);
+    visit_field(d, [&](auto& desc, const auto& rows) { read_rows(rows, f, desc); });
     const Id id = guard(at, [&] { return w.create_field(d); });
     if (f.contains("name")) name_once(fields_, meta_.field_names, f["name"], id, at, "field");
   }
@@ -1105,10 +1200,6 @@ class Builder {
   std::set<std::string> seen_groups_;
   std::map<uint32_t, std::map<std::string, std::vector<int32_t>>> sets_;
 };
-
-json vec_json(const Vec3& v) {
-  return json::array({v[0], v[1], v[2]});
-}
 
 /// The names a scene gave (unique per kind: the loader refuses duplicates), reserved so that the
 /// invented names of unnamed objects never take one of them.
@@ -1217,17 +1308,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   if (!meta.description.empty()) doc["description"] = meta.description;
   doc["frames"] = meta.frames;
   const Settings& s = w.settings();
-  doc["solver"] = {{"dt", s.dt},
-                   {"substeps", s.substeps},
-                   {"iterations", s.iterations},
-                   {"gravity", vec_json(s.gravity)},
-                   {"damping", s.damping},
-                   {"settle_speed", s.settle_speed},
-                   {"tethers", s.tethers},
-                   {"realign_passes", s.realign_passes},
-                   {"chebyshev_rho_milli", s.chebyshev_rho_milli},
-                   {"self_collision", s.self_collision},
-                   {"chain_solve", s.chain_solve}};
+  write_rows(kSolverRows, s, doc["solver"]);
 
   // Groups in creation order, so that equal orders resolve the same way when loaded.
   std::vector<uint32_t> slots;
@@ -1243,8 +1324,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   json groups = json::array();
   for (uint32_t slot : slots) {
     if (!gname.count(slot)) gname[slot] = name_for(meta.group_names, slot, "group", used);
-    groups.push_back(
-        {{"name", gname[slot]}, {"order", w.groups()[slot].desc.order}, {"weight", w.groups()[slot].desc.weight}});
+    json& g = groups.emplace_back(json{{"name", gname[slot]}});
+    write_rows(kGroupRows, w.groups()[slot].desc, g);
   }
   doc["groups"] = groups;
   auto group_name = [&](Id id) { return gname.at(id.is_null() ? w.default_group().index : id.index); };
@@ -1319,7 +1400,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
         rest.push_back(a.rest[i]);
         compliance.push_back(a.compliance[i]);
       }
-      constraints.push_back({{"kind", kKindNames[k]},
+      constraints.push_back({{"kind", kind_name(static_cast<Kind>(k))},
                              {"group", gname[slot]},
                              {"particles", particles},
                              {"rest", rest},
@@ -1341,8 +1422,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   for (uint32_t i : pin_order) {
     const Pin& p = w.pins()[i];
     pin_name[i] = name_for(meta.pin_names, i, "pin", used_pins);
-    json j = {
-        {"name", pin_name[i]}, {"particle", p.particle}, {"target", vec_json(p.target)}, {"compliance", p.compliance}};
+    json j = {{"name", pin_name[i]}, {"particle", p.particle}};
+    write_rows(kPinRows, PinDesc{p.particle, p.target, p.compliance, p.group}, j);
     if (p.compliance > 0.0) j["group"] = group_name(p.group);
     pins.push_back(j);
   }
@@ -1358,14 +1439,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     collider_name[i] = name_for(meta.collider_names, i, "collider", used_colliders);
     json& out = colliders.emplace_back(json{{"name", collider_name[i]},
                                             {"shape", kColliderShapeNames[static_cast<int>(c.desc.shape)]},
-                                            {"position", vec_json(c.desc.position)},
-                                            {"rotation", {q.w(), q.x(), q.y(), q.z()}},
-                                            {"thickness", c.desc.thickness},
-                                            {"friction_static", c.desc.friction_static},
-                                            {"friction_dynamic", c.desc.friction_dynamic}});
-    if (c.desc.shape == ColliderShape::sphere || c.desc.shape == ColliderShape::capsule) out["radius"] = c.desc.radius;
-    if (c.desc.shape == ColliderShape::box) out["half_extents"] = vec_json(c.desc.half_extents);
-    if (c.desc.shape == ColliderShape::capsule) out["half_length"] = c.desc.half_length;
+                                            {"rotation", {q.w(), q.x(), q.y(), q.z()}}});
+    write_rows(kColliderRows, c.desc, out);
     if (c.desc.shape == ColliderShape::convex || c.desc.shape == ColliderShape::mesh) {
       json v = json::array();
       for (size_t k = 0; k + 2 < c.desc.vertices.size(); k += 3)
@@ -1386,37 +1461,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     const Field& f = w.fields()[i];
     if (!f.alive) continue;
     const FieldDesc& d = f.desc;
-    json j;
-    switch (d.kind) {
-      case FieldKind::wind:
-        j = {{"type", "wind"},        {"direction", vec_json(d.wind.direction)},
-             {"speed", d.wind.speed}, {"air_density", d.wind.air_density},
-             {"drag", d.wind.drag},   {"lift", d.wind.lift}};
-        break;
-      case FieldKind::pressure:
-        j = {{"type", "pressure"},
-             {"inside_pressure", d.pressure.inside_pressure},
-             {"outside_pressure", d.pressure.outside_pressure},
-             {"keep_volume", d.pressure.keep_volume},
-             {"volume_compliance", d.pressure.volume_compliance},
-             {"rest_volume", d.pressure.rest_volume}};
-        break;
-      case FieldKind::surface_tension:
-        j = {{"type", "surface_tension"},
-             {"tension", d.surface_tension.tension},
-             {"regularisation", d.surface_tension.regularisation}};
-        break;
-      case FieldKind::vortex:
-        j = {{"type", "vortex"},
-             {"center", vec_json(d.vortex.center)},
-             {"axis", vec_json(d.vortex.axis)},
-             {"strength", d.vortex.strength},
-             {"radius", d.vortex.radius},
-             {"twist", d.vortex.twist},
-             {"decay", d.vortex.decay},
-             {"start_time", d.vortex.start_time}};
-        break;
-    }
+    json j = {{"type", kFieldKindNames[static_cast<int>(d.kind)]}};
+    visit_field(d, [&](const auto& desc, const auto& rows) { write_rows(rows, desc, j); });
     if (d.body >= 0) j["body"] = bodies[d.body]["name"];
     const auto named_field = meta.field_names.find(i);
     if (named_field != meta.field_names.end()) j["name"] = named_field->second;
@@ -1461,29 +1507,14 @@ Tolerances parse_tolerances(const std::string& text) {
   Tolerances t;
   if (text.empty()) return t;
   const json doc = json::parse(text);
-  t.unit_scale = value_or(doc, "unit_scale", t.unit_scale);
-  auto read = [&](const char* key, Tolerance& out) {
-    if (!doc.contains(key)) return;
-    out.target = doc[key]["target"].get<double>();
-    out.max = doc[key]["max"].get<double>();
-  };
-  read("planarity", t.planarity);
-  read("planarity_distance", t.planarity_distance);
-  read("thickness", t.thickness);
-  read("miter", t.miter);
+  read_rows(kTolerancesRows, doc, t);
   return t;
 }
 
 std::string tolerances_json(const Tolerances& t) {
-  auto one = [](const Tolerance& x) { return json{{"target", x.target}, {"max", x.max}}; };
-  return json{{"format", "embra-tolerances"},
-              {"version", 1},
-              {"unit_scale", t.unit_scale},
-              {"planarity", one(t.planarity)},
-              {"planarity_distance", one(t.planarity_distance)},
-              {"thickness", one(t.thickness)},
-              {"miter", one(t.miter)}}
-      .dump();
+  json doc = {{"format", "embra-tolerances"}, {"version", 1}};
+  write_rows(kTolerancesRows, t, doc);
+  return doc.dump();
 }
 
 void apply_actions(World& w, const SceneMeta& meta, int64_t frame) {
