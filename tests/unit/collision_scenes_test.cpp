@@ -5,7 +5,7 @@
 //  - a 64 x 64 cloth dropped on a sphere and over the edge of a box, self-collision on: after every
 //    frame no particle is inside a collider and no edge of the cloth crosses one of its triangles
 //    (counted exactly).
-#include "self_collision.hpp"
+#include "collision/self_collision.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The kind table (kinds.hpp) and the per-kind traits (kind_traits.hpp): names round-trip, numbers
 // and arities agree with the functions the solver projects, and the traits' finite differences agree
 // with their gradients for every kind that has a function.
-#include "kind_traits.hpp"
+#include "model/kind_traits.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>

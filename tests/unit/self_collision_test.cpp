@@ -1,7 +1,7 @@
 // Self-collision (issue 4): the narrow phase against hand-computed distances and times of contact,
 // the exact crossing count, and a folded cloth dropped on a plane that must never pass through
 // itself (no edge of the cloth crossing one of its triangles after any frame, counted exactly).
-#include "self_collision.hpp"
+#include "collision/self_collision.hpp"
 
 #include "test_support.hpp"
 

@@ -1,7 +1,7 @@
 // Constraint functions C(x) and their gradients, one small function per kind.
 //
 // Every function here is pure: it reads particle positions and writes the constraint value and the
-// gradient with respect to each operand. The solver (solver.cpp) projects with them; the tests
+// gradient with respect to each operand. The solver (core/src/solver) projects with them; the tests
 // check each gradient against finite differences. Units: lengths in model units (metres by
 // convention), angles in radians, volumes in cubed length units.
 #pragma once

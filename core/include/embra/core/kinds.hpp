@@ -1,7 +1,7 @@
 // The constraint kinds, listed once. Everything that names, numbers or counts kinds derives from
 // EMBRA_CONSTRAINT_KINDS: the enum embra::Kind, kKindCount, arity(), multipliers(), kind_name()
 // and kind_from_name(). The per-kind math (function, rest checks, rest scaling) is KindTraits<K>
-// (core/src/kind_traits.hpp), dispatched from one place (visit_kind).
+// (core/src/model/kind_traits.hpp), dispatched from one place (visit_kind).
 //
 // Adding a kind: one line here (its scene-format name, its number in the C ABI's
 // embra_constraint_kind, its arity, its multipliers per constraint and what it holds), a

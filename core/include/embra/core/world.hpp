@@ -23,7 +23,7 @@
 
 namespace embra {
 
-struct ColliderGeometry;  // collider_shapes.hpp
+struct ColliderGeometry;  // collision/collider_shapes.hpp
 
 /// Error categories; the C ABI maps them one to one onto its status codes.
 enum class ErrorCode : int32_t {
@@ -489,7 +489,7 @@ class World {
   void find_self_contacts();
   void find_face_contacts();
   void project_face_contacts();
-  /// One Chebyshev acceleration step after iteration `iteration` of a substep (solver.cpp).
+  /// One Chebyshev acceleration step after iteration `iteration` of a substep (solver/step.cpp).
   void chebyshev_step(int iteration, double rho, double& omega);
   /// Inverse of the joint mass of a panel corner and its partner across the slab (0: one is fixed).
   double slab_weight(int32_t a, int32_t b) const;
@@ -501,9 +501,16 @@ class World {
   void project_contact(Contact& ct);
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
-  void project_group(Group& g, double h);
+  /// Projects a group once; `first`: its first projection in the substep (the chain solve's turn).
+  void project_group(Group& g, double h, bool first);
   void project_contacts(Group& g, double h);
-  int32_t update_velocities(double h);  // the first particle left with a non-finite x or v, or -1
+  // The step's stages (step.cpp lists them in order).
+  void begin_frame(const StepControl& control);
+  void solve(double h, const StepControl& control);
+  void apply_friction();
+  void update_velocities(double h);
+  void check_state_finite();  // throws Error(numerical), with a Warning, at the first non-finite particle
+  void end_frame();
   void measure();
   /// What a frame that does not complete restores (step): the state, and the pin targets,
   /// collider poses, gravity and rest scales that StepControl::before_frame may change.
@@ -517,8 +524,8 @@ class World {
   };
   FrameStart frame_start() const;
   void restore(const FrameStart& start);
-  void apply_fields(double h, double time);  // fields.cpp: field forces into v_ (movable particles)
-  void project_volumes(double h);            // fields.cpp: the pressure fields' volume constraints
+  void apply_fields(double h, double time);  // fields/fields.cpp: field forces into v_ (movable particles)
+  void project_volumes(double h);            // fields/fields.cpp: the pressure fields' volume constraints
 
   Settings settings_;
   // particle state and per-particle model
@@ -550,16 +557,14 @@ class World {
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
-  bool first_projection_ = false;  // the group now projected has not been projected this substep
-  std::vector<Vec3> detected_;     // positions when this substep's contacts were found
+  std::vector<Vec3> detected_;  // positions when this substep's contacts were found
   /// Settings::chain_solve's scratch: per link of the longest chain, 9 values for each of (at most)
-  /// 4 lanes, and per particle 4 for each lane (the chain step, solver.cpp).
+  /// 4 lanes, and per particle 4 for each lane (the chain step, solver/kernels.cpp).
   static constexpr size_t kChainScratch = 52;
   std::vector<double> measure_values_;                // measure(): one array's constraint values
   std::vector<double> chain_scratch_;                 // kChainScratch per link of the longest chain, + 1
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
-  std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)  // constraints, pins or
-                                           // bodies changed: rebuild the solver arrays
+  std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
   StepReport report_;
   Warning warning_;
   std::vector<Field> fields_;

@@ -4,7 +4,8 @@
 // groups in every pass.
 #include "embra/core/world.hpp"
 
-#include "check.hpp"
+#include "common/check.hpp"
+#include "common/slots.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -125,34 +126,22 @@ Id World::create_field(const FieldDesc& desc) {
       f.ring_start.push_back(static_cast<int32_t>(f.ring.size()));
     }
   }
-  size_t slot = fields_.size();
-  for (size_t i = 0; i < fields_.size(); ++i)
-    if (!fields_[i].alive) {
-      slot = i;
-      break;
-    }
-  if (slot == fields_.size()) fields_.emplace_back();
-  const uint32_t generation = fields_[slot].generation + 1;
-  f.generation = generation;
-  f.alive = true;
-  fields_[slot] = std::move(f);
-  return Id{static_cast<uint32_t>(slot), generation};
+  return slots::create(fields_, std::move(f));
 }
 
 const Field& World::field(Id id) const {
-  if (id.index >= fields_.size() || !fields_[id.index].alive || fields_[id.index].generation != id.generation)
-    throw Error(ErrorCode::stale_id, "field id does not name a live field of this world");
-  return fields_[id.index];
+  const Field* f = slots::find(fields_, id);
+  if (f == nullptr) throw Error(ErrorCode::stale_id, "field id does not name a live field of this world");
+  return *f;
 }
 
 void World::destroy_field(Id id) {
-  const uint32_t generation = field(id).generation;
-  fields_[id.index] = Field{};
-  fields_[id.index].generation = generation;
+  field(id);
+  slots::destroy(fields_, id);
 }
 
 size_t World::field_count() const {
-  return static_cast<size_t>(std::count_if(fields_.begin(), fields_.end(), [](const Field& f) { return f.alive; }));
+  return slots::live_count(fields_);
 }
 
 void World::apply_fields(double h, double time) {

@@ -11,7 +11,7 @@
 //   scaled_rest(a, i, body)       the rest of constraint i of `a` under its body's rest scales
 #pragma once
 
-#include "check.hpp"
+#include "common/check.hpp"
 #include "embra/core/constraint_math.hpp"
 #include "embra/core/kinds.hpp"
 #include "embra/core/world.hpp"

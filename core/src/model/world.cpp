@@ -1,10 +1,11 @@
-// World construction and editing: everything but the step (solver.cpp). Each mutating call
+// World construction and editing: everything but the step (core/src/solver). Each mutating call
 // validates everything first and only then changes the world.
 #include "embra/core/world.hpp"
 
-#include "check.hpp"
-#include "collider_shapes.hpp"
-#include "kind_traits.hpp"
+#include "collision/collider_shapes.hpp"
+#include "common/check.hpp"
+#include "common/slots.hpp"
+#include "model/kind_traits.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -111,10 +112,7 @@ void World::set_gravity(const Vec3& g) {
 // --- groups ------------------------------------------------------------------------------------
 
 const Group* World::find_group(Id id) const {
-  if (id.index >= groups_.size()) return nullptr;
-  const Group& g = groups_[id.index];
-  if (!g.alive || g.generation != id.generation) return nullptr;
-  return &g;
+  return slots::find(groups_, id);
 }
 
 const Group& World::group(Id id) const {
@@ -134,27 +132,17 @@ Id World::resolve_group(Id id) const {
 }
 
 size_t World::group_count() const {
-  return static_cast<size_t>(std::count_if(groups_.begin(), groups_.end(), [](const Group& g) { return g.alive; }));
+  return slots::live_count(groups_);
 }
 
 Id World::create_group(const GroupDesc& desc) {
   if (desc.weight < 1 || desc.weight > 1000) invalid("group weight must be in [1, 1000]");
-  size_t slot = groups_.size();
-  for (size_t i = 0; i < groups_.size(); ++i)
-    if (!groups_[i].alive) {
-      slot = i;
-      break;
-    }
-  if (slot == groups_.size()) groups_.emplace_back();
-  Group& g = groups_[slot];
-  const uint32_t generation = g.generation + 1;
-  g = Group{};
+  Group g;
   g.desc = desc;
-  g.generation = generation;
-  g.alive = true;
   g.serial = serial_++;
+  const Id id = slots::create(groups_, std::move(g));
   rebuild_order();
-  return Id{static_cast<uint32_t>(slot), generation};
+  return id;
 }
 
 void World::destroy_group(Id id) {
@@ -178,9 +166,7 @@ void World::destroy_group(Id id) {
   for (BodyInfo& b : bodies_)
     for (Id* named : {&b.stretch_group, &b.shear_group, &b.bend_group, &b.volume_group})
       if (*named == id) *named = Id{};
-  const uint32_t generation = g.generation;
-  g = Group{};
-  g.generation = generation;
+  slots::destroy(groups_, id);
   rebuild_order();
   solver_dirty_ = true;
 }
@@ -1125,36 +1111,27 @@ Id World::create_pin(const PinDesc& desc) {
   } else {
     gid = resolve_group(desc.group);
   }
-  size_t slot = pins_.size();
-  for (size_t i = 0; i < pins_.size(); ++i)
-    if (!pins_[i].alive) {
-      slot = i;
-      break;
-    }
-  if (slot == pins_.size()) pins_.emplace_back();
-  Pin& p = pins_[slot];
-  const uint32_t generation = p.generation + 1;
-  p = Pin{};
+  Pin p;
   p.particle = desc.particle;
   p.target = desc.target;
   p.compliance = desc.compliance;
   p.group = gid;
-  p.generation = generation;
-  p.alive = true;
+  const Id id = slots::create(pins_, p);
+  const int32_t slot = static_cast<int32_t>(id.index);
   if (desc.compliance == 0.0) {
-    hard_pin_of_[desc.particle] = static_cast<int32_t>(slot);
+    hard_pin_of_[desc.particle] = slot;
     w_[desc.particle] = 0.0;
     solver_dirty_ = true;  // automatic tethers attach to hard pins
   } else {
-    group_mut(gid).soft_pins.push_back(static_cast<int32_t>(slot));
+    group_mut(gid).soft_pins.push_back(slot);
   }
-  return Id{static_cast<uint32_t>(slot), generation};
+  return id;
 }
 
 const Pin& World::pin(Id id) const {
-  if (id.index >= pins_.size() || !pins_[id.index].alive || pins_[id.index].generation != id.generation)
-    fail(ErrorCode::stale_id, "pin id does not name a live pin of this world");
-  return pins_[id.index];
+  const Pin* p = slots::find(pins_, id);
+  if (p == nullptr) fail(ErrorCode::stale_id, "pin id does not name a live pin of this world");
+  return *p;
 }
 
 void World::destroy_pin(Id id) {
@@ -1167,9 +1144,7 @@ void World::destroy_pin(Id id) {
     auto& list = group_mut(p.group).soft_pins;
     list.erase(std::find(list.begin(), list.end(), static_cast<int32_t>(id.index)));
   }
-  const uint32_t generation = p.generation;
-  pins_[id.index] = Pin{};
-  pins_[id.index].generation = generation;
+  slots::destroy(pins_, id);
 }
 
 void World::set_pin_target(Id id, const Vec3& target) {
@@ -1179,7 +1154,7 @@ void World::set_pin_target(Id id, const Vec3& target) {
 }
 
 size_t World::pin_count() const {
-  return static_cast<size_t>(std::count_if(pins_.begin(), pins_.end(), [](const Pin& p) { return p.alive; }));
+  return slots::live_count(pins_);
 }
 
 // --- colliders ---------------------------------------------------------------------------------
@@ -1202,36 +1177,24 @@ Id World::create_collider(const ColliderDesc& desc) {
   check_non_negative(desc.friction_dynamic, "collider friction_dynamic");
   if (desc.shape == ColliderShape::sphere) check_positive(desc.radius, "sphere radius");
   std::shared_ptr<const ColliderGeometry> geometry = build_collider_geometry(desc);  // validates the shape
-  size_t slot = colliders_.size();
-  for (size_t i = 0; i < colliders_.size(); ++i)
-    if (!colliders_[i].alive) {
-      slot = i;
-      break;
-    }
-  if (slot == colliders_.size()) colliders_.emplace_back();
-  Collider& c = colliders_[slot];
-  const uint32_t generation = c.generation + 1;
-  c = Collider{};
+  Collider c;
   c.desc = desc;
   c.desc.rotation.normalize();
   c.geometry = std::move(geometry);
   c.frame_position = c.position = c.position_prev = desc.position;
   c.frame_rotation = c.rotation = c.rotation_prev = c.desc.rotation;
-  c.generation = generation;
-  c.alive = true;
-  return Id{static_cast<uint32_t>(slot), generation};
+  return slots::create(colliders_, std::move(c));
 }
 
 const Collider& World::collider(Id id) const {
-  if (id.index >= colliders_.size() || !colliders_[id.index].alive || colliders_[id.index].generation != id.generation)
-    fail(ErrorCode::stale_id, "collider id does not name a live collider of this world");
-  return colliders_[id.index];
+  const Collider* c = slots::find(colliders_, id);
+  if (c == nullptr) fail(ErrorCode::stale_id, "collider id does not name a live collider of this world");
+  return *c;
 }
 
 void World::destroy_collider(Id id) {
-  const uint32_t generation = collider(id).generation;
-  colliders_[id.index] = Collider{};
-  colliders_[id.index].generation = generation;
+  collider(id);
+  slots::destroy(colliders_, id);
 }
 
 void World::set_collider_transform(Id id, const Vec3& position, const Eigen::Quaterniond& rotation) {
@@ -1242,8 +1205,7 @@ void World::set_collider_transform(Id id, const Vec3& position, const Eigen::Qua
 }
 
 size_t World::collider_count() const {
-  return static_cast<size_t>(
-      std::count_if(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; }));
+  return slots::live_count(colliders_);
 }
 
 // --- particles ---------------------------------------------------------------------------------

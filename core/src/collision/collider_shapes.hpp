@@ -1,6 +1,6 @@
 // Collider geometry in the collider's own frame: signed distances, outward normals and the swept
 // (space-time) first contact of a particle path, for every collider shape but the plane and the
-// sphere (which solver.cpp handles in closed form).
+// sphere (which solver/contacts.cpp handles in closed form).
 //
 //   box      |p| <= half_extents componentwise
 //   capsule  points within `radius` of the segment (0, 0, -half_length) - (0, 0, half_length)

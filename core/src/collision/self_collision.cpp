@@ -1,5 +1,5 @@
 // Self-collision: broad phase, narrow phase in space-time, projection and friction (see the header).
-#include "self_collision.hpp"
+#include "collision/self_collision.hpp"
 
 #include <algorithm>
 #include <array>

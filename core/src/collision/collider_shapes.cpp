@@ -1,7 +1,7 @@
-#include "collider_shapes.hpp"
+#include "collision/collider_shapes.hpp"
 
-#include "check.hpp"
-#include "self_collision.hpp"
+#include "collision/self_collision.hpp"
+#include "common/check.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // Panel meshes (Planar Offset Quads): the builder, the metrics and the cut list. See panels.hpp.
 #include "embra/core/panels.hpp"
 
-#include "check.hpp"
+#include "common/check.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,0 +1,356 @@
+// Contacts: finding them (colliders, panel faces), projecting them, friction, and settling swept
+// contacts on the surface (the step's contact stages, step.cpp).
+#include "solver/contacts.hpp"
+
+#include "collision/collider_shapes.hpp"
+#include "collision/self_collision.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace embra {
+
+namespace {
+/// Signed gap of a particle to a collider's surface, and the outward normal there.
+double collider_gap(const Collider& c, const Vec3& x, const Vec3& from, Vec3& normal) {
+  if (c.desc.shape == ColliderShape::plane) {
+    normal = c.rotation * Vec3::UnitZ();
+    return normal.dot(x - c.position);
+  }
+  const Vec3 d = x - c.position;
+  const Vec3 back = from - c.position;
+  // A particle that crossed the centre within the substep is pushed back out the side it came from.
+  if (d.norm() < 1e-12 || d.dot(back) < 0.0) {
+    normal = back.norm() > 1e-12 ? Vec3(back.normalized()) : Vec3(Vec3::UnitZ());
+    return normal.dot(x - c.position) - c.desc.radius;
+  }
+  const double len = d.norm();
+  normal = d / len;
+  return len - c.desc.radius;
+}
+
+}  // namespace
+
+/// Signed gap of a contact's particle at `x` beyond the clearance `r` (the particle's radius plus
+/// the collider's thickness), and the outward normal it is pushed along.
+double contact_gap(const Collider& c, const Contact& ct, const Vec3& x, const Vec3& from, double r, Vec3& normal) {
+  if (!c.geometry) return collider_gap(c, x, from, normal) - r;
+  const Vec3 local = c.rotation.conjugate() * (x - c.position);
+  if (ct.swept) {
+    normal = c.rotation * ct.normal;
+    return ct.normal.dot(local) - ct.offset;
+  }
+  Vec3 n;
+  const double d = shape_distance(c.desc, *c.geometry, local, n);
+  normal = c.rotation * n;
+  return d - r;
+}
+
+/// Position of the collider's material point now at `x`, as it was at the start of the substep.
+Vec3 collider_point_before(const Collider& c, const Vec3& x) {
+  const Vec3 local = c.rotation.conjugate() * (x - c.position);
+  return c.position_prev + c.rotation_prev * local;
+}
+
+void World::find_contacts() {
+  Group& g = groups_[settings_.contact_group.index];
+  g.contacts.clear();
+  for (size_t c = 0; c < colliders_.size(); ++c)
+    if (colliders_[c].alive) find_collider_contacts(static_cast<int32_t>(c), nullptr, g.contacts);
+  if (!colliders_.empty()) detected_ = x_;
+}
+
+void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) const {
+  const Collider& col = colliders_[index];
+  if (col.geometry) {
+    find_shape_contacts(index, only, out);
+    return;
+  }
+  const Vec3 normal = col.rotation * Vec3::UnitZ();
+  const size_t count = only ? only->size() : x_.size();
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = only ? static_cast<size_t>((*only)[k]) : k;
+    if (w_[i] == 0.0) continue;
+    // The clearance, plus the path, plus the clearance again as a margin (see find_shape_contacts).
+    const double reach = 2.0 * (radius_[i] + col.desc.thickness) + (x_[i] - x_prev_[i]).norm();
+    double gap;
+    if (col.desc.shape == ColliderShape::plane) {
+      gap = normal.dot(x_[i] - col.position);
+    } else {
+      // The closest point of the swept segment to the sphere's centre catches a particle that
+      // crosses the whole sphere within one substep.
+      const Vec3 a = x_prev_[i], d = x_[i] - x_prev_[i];
+      const double len2 = d.squaredNorm();
+      const double t = len2 > 0.0 ? std::clamp((col.position - a).dot(d) / len2, 0.0, 1.0) : 1.0;
+      gap = (a + t * d - col.position).norm() - col.desc.radius;
+    }
+    if (gap < reach) out.push_back(Contact{static_cast<int32_t>(i), index, 0.0});
+  }
+}
+
+void World::catch_late_contacts() {
+  // find_contacts looked along each particle's predicted path, with its clearance as a margin; a
+  // projection that carried a particle further (a chain solve pulling a whole run at once, a band
+  // shrinking onto a pole) can have taken it into a collider no contact watched. Such particles are
+  // looked at again along their path as it now ends, and any contact found is projected once more:
+  // colliders keep the final word.
+  // Only when the contacts are projected last: a host that orders a group after them (the paper's
+  // evaluation order) has said that group wins.
+  if (colliders_.empty() || order_.empty() || order_.back() != static_cast<int32_t>(settings_.contact_group.index))
+    return;
+  Group& g = groups_[settings_.contact_group.index];
+  const size_t before = g.contacts.size();
+  std::vector<int32_t> moved;
+  std::vector<uint8_t> watched(x_.size());
+  for (size_t c = 0; c < colliders_.size(); ++c) {
+    const Collider& col = colliders_[c];
+    if (!col.alive) continue;
+    std::fill(watched.begin(), watched.end(), 0);
+    for (size_t k = 0; k < before; ++k)
+      if (g.contacts[k].collider == static_cast<int32_t>(c)) watched[g.contacts[k].particle] = 1;
+    moved.clear();
+    for (size_t i = 0; i < x_.size(); ++i)
+      if (w_[i] != 0.0 && !watched[i] && (x_[i] - detected_[i]).norm() > radius_[i] + col.desc.thickness)
+        moved.push_back(static_cast<int32_t>(i));
+    if (!moved.empty()) find_collider_contacts(static_cast<int32_t>(c), &moved, g.contacts);
+  }
+  for (size_t k = before; k < g.contacts.size(); ++k) project_contact(g.contacts[k]);
+}
+
+/// Panel faces against sphere colliders: a flat panel touching a sphere with its corners only would
+/// cut into it (a 0.8 panel over a sphere of radius 1 by 0.175), so the triangles of every panel
+/// mesh (both layers) take contacts of their own, at the point closest to the centre.
+void World::find_face_contacts() {
+  face_contacts_.clear();
+  if (panel_layouts_.empty()) return;
+  for (size_t c = 0; c < colliders_.size(); ++c) {
+    const Collider& col = colliders_[c];
+    if (!col.alive || col.desc.shape != ColliderShape::sphere) continue;
+    const double r = col.desc.radius + col.desc.thickness;
+    const double move = (col.position - col.position_prev).norm();
+    for (const PanelLayout& l : panel_layouts_)
+      for (int32_t p = 0; p < l.panel_count(); ++p)
+        for (int layer = 0; layer < 2; ++layer)
+          for (int half = 0; half < 2; ++half) {
+            const int32_t o = l.first_particle + 8 * p + 4 * layer;
+            const int32_t across = layer == 0 ? 4 : -4;
+            const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
+            const int32_t partner[3] = {ids[0] + across, ids[1] + across, ids[2] + across};
+            if (slab_weight(ids[0], partner[0]) == 0.0 && slab_weight(ids[1], partner[1]) == 0.0 &&
+                slab_weight(ids[2], partner[2]) == 0.0)
+              continue;
+            double moved = 0.0;
+            for (int32_t i : ids) moved = std::max(moved, (x_[i] - x_prev_[i]).norm());
+            const Vec3 b = closest_barycentric(col.position, x_[ids[0]], x_[ids[1]], x_[ids[2]]);
+            const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
+            if ((q - col.position).norm() - r < moved + move)
+              face_contacts_.push_back(FaceContact{
+                  {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), 0.0});
+          }
+  }
+}
+
+double World::slab_weight(int32_t a, int32_t b) const {
+  const double wa = w_[a], wb = w_[b];
+  return wa > 0.0 && wb > 0.0 ? 1.0 / (1.0 / wa + 1.0 / wb) : 0.0;  // 1 / (m_a + m_b), no overflow
+}
+
+void World::project_face_contacts() {
+  for (FaceContact& fc : face_contacts_) {
+    const Collider& col = colliders_[fc.collider];
+    const Vec3& a = x_[fc.ids[0]];
+    const Vec3& b = x_[fc.ids[1]];
+    const Vec3& c = x_[fc.ids[2]];
+    const Vec3 bary = closest_barycentric(col.position, a, b, c);
+    const Vec3 q = bary[0] * a + bary[1] * b + bary[2] * c;
+    const Vec3 d = q - col.position;
+    const double len = d.norm();
+    if (!(len > 1e-12)) continue;
+    const Vec3 n = d / len;
+    const double gap = len - (col.desc.radius + col.desc.thickness);
+    double ws[3], denom = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      ws[k] = slab_weight(fc.ids[k], fc.partner[k]);
+      denom += ws[k] * bary[k] * bary[k];
+    }
+    if (denom <= 0.0) continue;
+    // Hard, unilateral: C = gap >= 0, grad_k C = b_k n, corner k and its partner moving as one.
+    const double lambda = std::max(fc.lambda - gap / denom, 0.0);
+    const double dl = lambda - fc.lambda;
+    fc.lambda = lambda;
+    if (dl == 0.0) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 step = (ws[k] * bary[k] * dl) * n;
+      x_[fc.ids[k]] += step;
+      x_[fc.partner[k]] += step;
+    }
+  }
+}
+
+void World::find_shape_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) const {
+  const Collider& col = colliders_[index];
+  const ColliderGeometry& geo = *col.geometry;
+  // Convex solids have a convex distance along any straight path, so a Newton step towards the
+  // surface never passes it; a mesh advances by the distance alone (the distance changes at most
+  // as fast as the point moves).
+  const bool convex = col.desc.shape != ColliderShape::mesh;
+  Vec3 lo, hi;
+  shape_bounds(col.desc, geo, lo, hi);
+  const Eigen::Quaterniond inv_prev = col.rotation_prev.conjugate(), inv = col.rotation.conjugate();
+  const size_t count = only ? only->size() : x_.size();
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = only ? static_cast<size_t>((*only)[k]) : k;
+    if (w_[i] == 0.0) continue;
+    // The particle's path in the collider's frame, from where it was against the collider's pose at
+    // the start of the substep to where it is against the pose at the end: the collider's motion is
+    // part of the path.
+    const Vec3 a0 = inv_prev * (x_prev_[i] - col.position_prev);
+    const Vec3 a1 = inv * (x_[i] - col.position);
+    const double r = radius_[i] + col.desc.thickness;
+    const Vec3 seg = a1 - a0;
+    const double len = seg.norm();
+    // As far out as a contact can be kept (the near-surface reach below: the path plus the clearance
+    // twice).
+    const double margin = 2.0 * r + (x_[i] - x_prev_[i]).norm();
+    if ((a0.cwiseMin(a1).array() > hi.array() + margin).any() || (a0.cwiseMax(a1).array() < lo.array() - margin).any())
+      continue;
+    const int32_t particle = static_cast<int32_t>(i);
+    Vec3 n;
+    double d = shape_distance(col.desc, geo, a0, n) - r;
+    if (d < 0.0) {  // inside at the start (if only by rounding): out by the way nearest to where it was
+      out.push_back(Contact{particle, index, 0.0, true, n, n.dot(a0) - d});
+      continue;
+    }
+    // Conservative advancement along the path to its first contact with the clearance surface.
+    const double tol = 1e-13 * (1.0 + a0.cwiseAbs().maxCoeff() + len + r);
+    double t = 0.0;
+    bool hit = d <= tol;
+    for (int it = 0; it < 200 && !hit && len > 0.0; ++it) {
+      double rate = len;
+      if (convex) {
+        rate = -n.dot(seg);
+        if (rate <= 0.0) break;  // moving away from a convex solid: no contact on this path
+      }
+      t += d / rate;
+      if (t > 1.0) break;
+      d = shape_distance(col.desc, geo, a0 + t * seg, n) - r;
+      hit = d <= tol || it == 199;
+    }
+    if (hit) {
+      // Held on the tangent plane where the path met the surface: it leaves the way it came.
+      const Vec3 p = a0 + t * seg;
+      out.push_back(Contact{particle, index, 0.0, true, n, n.dot(p) - d});
+      continue;
+    }
+    // Near the surface at the end of the path: a contact that acts only if the particle gets within
+    // its clearance. The groups projected before the contacts can move a particle further than its
+    // path (cloth pulled over a box's edge by its stretch), so the reach is the path plus the
+    // clearance again as a margin; an inactive contact costs one distance per projection.
+    d = shape_distance(col.desc, geo, a1, n) - r;
+    if (d < (x_[i] - x_prev_[i]).norm() + r) out.push_back(Contact{particle, index, 0.0, false, Vec3::Zero(), 0.0});
+  }
+}
+
+void World::project_contact(Contact& ct) {
+  const Collider& c = colliders_[ct.collider];
+  const int32_t i = ct.particle;
+  Vec3 n;
+  const double gap = contact_gap(c, ct, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
+  // Hard, unilateral: C = gap >= 0; lambda accumulates the push (a length, as w_i cancels).
+  const double dl = std::max(ct.lambda - gap, 0.0) - ct.lambda;
+  ct.lambda += dl;
+  x_[i] += dl * n;
+}
+
+void World::project_contacts(Group& g, double /*h*/) {
+  for (Contact& ct : g.contacts) project_contact(ct);
+}
+
+void World::settle_contacts_on_surface() {
+  // A swept contact holds its particle on the tangent plane where the particle's path met the
+  // clearance surface. A particle that slides along that plane within the substep (a chain step
+  // moves a whole run at once; friction along a plane met near an edge) can end below the surface's
+  // curve or edge beside it; on a convex collider it is pushed out along the closest point (a mesh
+  // keeps the plane: the closest point of a thin mesh can lie on its far side). A contact at the
+  // closest point is projected once more as it is at every projection: friction after the contacts
+  // (between the layers of a cloth folded on a cube) can have moved its particle inside. Only when
+  // the contacts are projected last, as catch_late_contacts.
+  if (colliders_.empty() || order_.empty() || order_.back() != static_cast<int32_t>(settings_.contact_group.index))
+    return;
+  Group& g = groups_[settings_.contact_group.index];
+  for (Contact& ct : g.contacts) {
+    const Collider& c = colliders_[ct.collider];
+    if (ct.swept && c.desc.shape == ColliderShape::mesh) continue;
+    Contact closest = ct;
+    closest.swept = false;
+    Vec3 n;
+    const int32_t i = ct.particle;
+    const double gap = contact_gap(c, closest, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
+    // A swept contact never out through the far side (a thin plate): only when the closest point's
+    // normal faces the way the particle came in.
+    if (gap < 0.0 && (!ct.swept || n.dot(c.rotation * ct.normal) > 0.0)) x_[i] -= gap * n;
+  }
+}
+
+void World::apply_friction() {
+  // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
+  // it is below mu_s times the normal push, else reduced by mu_k times it.
+  Group& g = groups_[settings_.contact_group.index];
+  for (const Contact& ct : g.contacts) {
+    if (ct.lambda <= 0.0) continue;
+    const Collider& c = colliders_[ct.collider];
+    const int32_t i = ct.particle;
+    Vec3 n;
+    contact_gap(c, ct, x_[i], x_prev_[i], 0.0, n);
+    const Vec3 slip = (x_[i] - x_prev_[i]) - (x_[i] - collider_point_before(c, x_[i]));
+    const Vec3 tangential = slip - slip.dot(n) * n;
+    const double len = tangential.norm();
+    const double mu_s = std::sqrt(mu_s_[i] * c.desc.friction_static);
+    const double mu_k = std::sqrt(mu_k_[i] * c.desc.friction_dynamic);
+    if (len < mu_s * ct.lambda)
+      x_[i] -= tangential;
+    else if (len > 0.0)
+      x_[i] -= tangential * std::min(mu_k * ct.lambda / len, 1.0);
+  }
+  self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
+  // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
+  // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the
+  // inverse of their joint mass).
+  for (const FaceContact& fc : face_contacts_) {
+    if (fc.lambda <= 0.0) continue;
+    const Collider& c = colliders_[fc.collider];
+    const Vec3 bary = closest_barycentric(c.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
+    Vec3 q = Vec3::Zero(), moved = Vec3::Zero();
+    double denom = 0.0, mu_s = 0.0, mu_k = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t i = fc.ids[k];
+      q += bary[k] * x_[i];
+      moved += bary[k] * (x_[i] - x_prev_[i]);
+      denom += slab_weight(i, fc.partner[k]) * bary[k] * bary[k];
+      mu_s += bary[k] * mu_s_[i];
+      mu_k += bary[k] * mu_k_[i];
+    }
+    if (denom <= 0.0) continue;
+    const Vec3 n = (q - c.position).normalized();
+    const Vec3 slip = moved - (q - collider_point_before(c, q));
+    const Vec3 tangential = slip - slip.dot(n) * n;
+    const double len = tangential.norm();
+    mu_s = std::sqrt(mu_s * c.desc.friction_static);
+    mu_k = std::sqrt(mu_k * c.desc.friction_dynamic);
+    // lambda is the push of the contact point (in length: sum_k w_k b_k^2 lambda moves it by that).
+    const double push = fc.lambda * denom;
+    Vec3 remove = Vec3::Zero();
+    if (len < mu_s * push)
+      remove = tangential;
+    else if (len > 0.0)
+      remove = tangential * std::min(mu_k * push / len, 1.0);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 step = (slab_weight(fc.ids[k], fc.partner[k]) * bary[k] / denom) * remove;
+      x_[fc.ids[k]] -= step;
+      x_[fc.partner[k]] -= step;
+    }
+  }
+}
+
+}  // namespace embra
