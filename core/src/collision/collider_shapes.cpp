@@ -2,6 +2,7 @@
 
 #include "collision/self_collision.hpp"
 #include "common/check.hpp"
+#include "common/triangle.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,45 +15,27 @@ namespace embra {
 
 namespace {
 
-/// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection 5.1.5) and the
-/// feature it lies on: 0..2 vertex k, 3..5 edge (k, k+1), 6 the face.
+/// Closest point of triangle (a, b, c) to p and the feature it lies on: 0..2 vertex k, 3..5 edge
+/// (k, k+1), 6 the face (TriangleRegion's numbering).
 Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int& feature) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) {
-    feature = 0;
-    return a;
+  const TriangleRegion r = triangle_region(p, a, b, c);
+  feature = r.feature;
+  switch (r.feature) {
+    case TriangleRegion::vertex_a:
+      return a;
+    case TriangleRegion::vertex_b:
+      return b;
+    case TriangleRegion::vertex_c:
+      return c;
+    case TriangleRegion::edge_ab:
+      return a + r.t * (b - a);
+    case TriangleRegion::edge_ac:
+      return a + r.t * (c - a);
+    case TriangleRegion::edge_bc:
+      return b + r.t * (c - b);
+    default:
+      return a + (b - a) * r.v + (c - a) * r.w;
   }
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) {
-    feature = 1;
-    return b;
-  }
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    feature = 3;
-    return a + (d1 / (d1 - d3)) * ab;
-  }
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) {
-    feature = 2;
-    return c;
-  }
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    feature = 5;
-    return a + (d2 / (d2 - d6)) * ac;
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    feature = 4;
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  }
-  const double denom = 1.0 / (va + vb + vc);
-  feature = 6;
-  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Self-collision: broad phase, narrow phase in space-time, projection and friction (see the header).
 #include "collision/self_collision.hpp"
 
+#include "common/triangle.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -354,32 +356,24 @@ double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, cons
     bary[2] = w;
     return (p - (u * a + v * b + w * c)).norm();
   };
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return set(1, 0, 0);
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return set(0, 1, 0);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double v = d1 / (d1 - d3);
-    return set(1 - v, v, 0);
+  const TriangleRegion r = triangle_region(p, a, b, c);
+  switch (r.feature) {
+    case TriangleRegion::vertex_a:
+      return set(1, 0, 0);
+    case TriangleRegion::vertex_b:
+      return set(0, 1, 0);
+    case TriangleRegion::vertex_c:
+      return set(0, 0, 1);
+    case TriangleRegion::edge_ab:
+      return set(1 - r.t, r.t, 0);
+    case TriangleRegion::edge_ac:
+      return set(1 - r.t, 0, r.t);
+    case TriangleRegion::edge_bc:
+      return set(0, 1 - r.t, r.t);
+    default:
+      break;
   }
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return set(0, 0, 1);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double w = d2 / (d2 - d6);
-    return set(1 - w, 0, w);
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return set(0, 1 - w, w);
-  }
-  const double sum = va + vb + vc;
-  if (!(sum > 0.0)) {  // degenerate triangle: the nearest of its edges
+  if (!(r.sum > 0.0)) {  // degenerate triangle: the nearest of its edges
     double best = std::numeric_limits<double>::infinity(), s, t;
     const Vec3* v[3] = {&a, &b, &c};
     for (int k = 0; k < 3; ++k) {
@@ -396,9 +390,7 @@ double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, cons
     }
     return best;
   }
-  const double denom = 1.0 / sum;
-  const double v = vb * denom, w = vc * denom;
-  return set(1.0 - v - w, v, w);
+  return set(1.0 - r.v - r.w, r.v, r.w);
 }
 
 double edge_edge_distance(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, double& s, double& t) {
