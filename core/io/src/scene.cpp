@@ -850,9 +850,23 @@ class Builder {
       if (c.contains("triangles"))
         for (const json& t : c["triangles"])
           for (const json& k : t) d.triangles.push_back(k.get<int32_t>());
+      // A collider moved since the last step is created at its pose at the start of the frame and
+      // then moved, so the next step sweeps it as the world saved would have.
+      const json* start = c.contains("name") ? frame_start_pose(c["name"].get<std::string>()) : nullptr;
+      const Vec3 position = d.position;
+      const Eigen::Quaterniond rotation = d.rotation;
+      if (start != nullptr) {
+        d.position = vec3((*start)["position"]);
+        d.rotation = quat((*start)["rotation"], "/state/colliders");
+      }
       const Id id = guard(at, [&] { return w.create_collider(d); });
+      if (start != nullptr) guard(at, [&] { w.set_collider_transform(id, position, rotation); });
       if (c.contains("name")) name_once(colliders_, meta_.collider_names, c["name"], id, at, "collider");
     });
+    if (doc_.contains("state") && doc_["state"].contains("colliders"))
+      for (size_t i = 0; i < doc_["state"]["colliders"].size(); ++i)
+        if (!frame_starts_used_.contains(i))
+          fail("/state/colliders/" + std::to_string(i) + "/collider", "names no collider of the scene");
     section("fields", [&](const json& f, const std::string& at) { field(w, f, at); });
     section("actions", [&](const json& a, const std::string& at) { action(a, at); });
     if (doc_.contains("tolerances")) meta_.tolerances = doc_["tolerances"].dump();
@@ -860,6 +874,22 @@ class Builder {
   }
 
  private:
+  /// The pose at the start of the frame that /state/colliders gives the collider `name`, or null.
+  /// An entry naming no collider of the scene is refused once the colliders are built.
+  const json* frame_start_pose(const std::string& name) {
+    if (!doc_.contains("state") || !doc_["state"].contains("colliders")) return nullptr;
+    const json& list = doc_["state"]["colliders"];
+    const json* found = nullptr;
+    for (size_t i = 0; i < list.size(); ++i)
+      if (list[i]["collider"].get<std::string>() == name) {
+        if (found != nullptr)
+          fail("/state/colliders/" + std::to_string(i) + "/collider", "names collider \"" + name + "\" again");
+        found = &list[i];
+        frame_starts_used_.insert(i);
+      }
+    return found;
+  }
+
   template <class F>
   auto guard(const std::string& at, F&& f) -> decltype(f()) {
     try {
@@ -1198,6 +1228,7 @@ class Builder {
   std::map<std::string, Id> groups_, bodies_, pins_, colliders_;
   std::map<std::string, Id> fields_;
   std::set<std::string> seen_groups_;
+  std::set<size_t> frame_starts_used_;  // entries of /state/colliders matched to a collider
   std::map<uint32_t, std::map<std::string, std::vector<int32_t>>> sets_;
 };
 
@@ -1500,6 +1531,17 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   for (const Vec3& v : w.velocities()) velocities.push_back(vec_json(v));
   doc["state"] = {
       {"frame", w.report().frame}, {"time", w.report().time}, {"positions", positions}, {"velocities", velocities}};
+  json moved = json::array();  // colliders moved since the last step: where the next step sweeps them from
+  for (uint32_t i = 0; i < w.colliders().size(); ++i) {
+    const Collider& c = w.colliders()[i];
+    if (!c.alive || (c.frame_position == c.desc.position && c.frame_rotation.coeffs() == c.desc.rotation.coeffs()))
+      continue;
+    const Eigen::Quaterniond& q = c.frame_rotation;
+    moved.push_back({{"collider", collider_name.at(i)},
+                     {"position", vec_json(c.frame_position)},
+                     {"rotation", {q.w(), q.x(), q.y(), q.z()}}});
+  }
+  if (!moved.empty()) doc["state"]["colliders"] = moved;
   return doc.dump(1) + "\n";
 }
 
