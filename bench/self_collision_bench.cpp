@@ -1,9 +1,9 @@
-// Self-collision cost: an n x n cloth, 1 m square, 1 kg, folded along its diagonal over a
-// half cylinder (radius 6 cm, upper layer turned over onto the lower one) and dropped from 5 cm onto
-// a ground plane, so the layers land on each other; thickness half the grid spacing; embra's default
-// solver settings (SolverSettings{}: 16 substeps x 1 iteration, tethers) with self-collision on (or off, for the
-// reference). Times 30 frames of World::step from the release (the fall, the landing and the upper
-// layer settling on the lower). Linear cost means ms_per_frame x 4 from one n to 2n.
+// Self-collision cost: an n x n cloth, 1 m square, 1 kg, folded along its diagonal over a half
+// cylinder (radius 6 cm, upper layer turned over onto the lower one) and dropped from 5 cm onto a
+// ground plane, so the layers land on each other; thickness half the grid spacing; embra's default
+// solver settings (embra::Settings{}: 16 substeps x 1 iteration, tethers) with self-collision on (or
+// off, for the reference). Times 30 frames of World::step from the release (the fall, the landing
+// and the upper layer settling on the lower). Linear cost means ms_per_frame x 4 from one n to 2n.
 #include "embra/core/world.hpp"
 
 #include <benchmark/benchmark.h>
