@@ -19,6 +19,10 @@ struct Copy {
   A C::*c;
   B Core::*core;
 };
+// A deduction guide for the aggregate (clang before 17, which builds the sanitizer runs, deduces
+// no aggregate's arguments by itself).
+template <class C, class A, class Core, class B>
+Copy(A C::*, B Core::*) -> Copy<C, A, Core, B>;
 
 inline void assign(double& to, double from) {
   to = from;

@@ -336,6 +336,12 @@ struct Row {
   T S::*member;
   bool (*saved)(const S&) = nullptr;  // null: always written
 };
+// Deduction guides for the aggregate (clang before 17, which builds the sanitizer runs, deduces no
+// aggregate's arguments by itself).
+template <class S, class T>
+Row(const char*, T S::*) -> Row<S, T>;
+template <class S, class T>
+Row(const char*, T S::*, bool (*)(const S&)) -> Row<S, T>;
 
 template <class T>
 T value_of(const json& j) {
