@@ -293,7 +293,8 @@ function startServer(options) {
         }
         if (msg && HEAVY.has(msg.type) && !bucket.take(limits.heavyMessageCost - 1)) return drop();
         if (closed) return;
-        const result = await session.handle(msg, ws);
+        let result = session.handle(msg, ws); // a refusal throws here, answered before the next message
+        if (result instanceof Promise) result = await result;
         for (const r of result.replies || []) send(ws, r);
         if (result.broadcast) for (const other of clients) if (other !== ws) for (const r of result.replies || []) send(other, r);
         if (result.scene) {

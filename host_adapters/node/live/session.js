@@ -265,9 +265,11 @@ class Session {
   /**
    * Applies one page message (already parsed JSON). Returns the replies to send to the sender
    * (objects) and whether everyone needs a new `scene`. Refusals throw RefusedMessage or EmbraError,
-   * after which nothing has changed.
+   * after which nothing has changed. Synchronous, so a refusal is answered before the page's next
+   * message is read (a next message that closes the connection cannot swallow the answer); only an
+   * export returns a promise of its result.
    */
-  async handle(msg, page = 'page') {
+  handle(msg, page = 'page') {
     if (msg === null || typeof msg !== 'object' || Array.isArray(msg)) refuse('a message must be a JSON object');
     const w = this.world;
     switch (msg.type) {
@@ -355,9 +357,10 @@ class Session {
         const metric = msg.metric ?? 'planarity';
         if (!FIELDS.includes(metric)) refuse(`metric must be one of ${FIELDS.join(', ')}`);
         const frame = this.record.frame;
-        const bytes = await this.exportBytes(msg.format, metric);
-        const file = this.writeOutput(msg.format, bytes, frame);
-        return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
+        return this.exportBytes(msg.format, metric).then((bytes) => {
+          const file = this.writeOutput(msg.format, bytes, frame);
+          return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
+        });
       }
       default:
         refuse(`unknown message type ${JSON.stringify(msg.type)}`);
