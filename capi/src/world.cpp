@@ -33,7 +33,10 @@ embra_solver_def from_settings(const embra::Settings& s) {
   return d;
 }
 
-void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t count, const double* out) {
+/// Copies particles [first, first + count) of `values` (positions or velocities) to out as xyz,
+/// after checking the range and the buffer.
+void read_particles(const embra::World& w, const std::vector<embra::Vec3>& values, int64_t capacity, int32_t first,
+                    int32_t count, double* out) {
   need(out, "out_xyz");
   if (first < 0 || count < 0 || static_cast<int64_t>(first) + count > w.particle_count())
     refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particle range [" + num(first) + ", " +
@@ -42,6 +45,8 @@ void read_range(const embra::World& w, int64_t capacity, int32_t first, int32_t 
   if (capacity < 3 * static_cast<int64_t>(count))
     refuse(EMBRA_ERROR_BUFFER_TOO_SMALL,
            "buffer holds " + num(capacity) + " doubles, " + num(3 * static_cast<int64_t>(count)) + " needed");
+  for (int32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) out[3 * i + k] = values[first + i][k];
 }
 
 /// The two-call id listing of embra_world_get_bodies/groups/pins/colliders: of `slots` slots, the
@@ -213,22 +218,14 @@ embra_status embra_world_get_warning(const embra_world* world, embra_warning* ou
 
 embra_status embra_world_get_positions(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
                                        int32_t count) {
-  return guard("embra_world_get_positions", world, [&] {
-    read_range(world->world, capacity, first, count, out_xyz);
-    const auto& x = world->world.positions();
-    for (int32_t i = 0; i < count; ++i)
-      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = x[first + i][k];
-  });
+  return guard("embra_world_get_positions", world,
+               [&] { read_particles(world->world, world->world.positions(), capacity, first, count, out_xyz); });
 }
 
 embra_status embra_world_get_velocities(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
                                         int32_t count) {
-  return guard("embra_world_get_velocities", world, [&] {
-    read_range(world->world, capacity, first, count, out_xyz);
-    const auto& v = world->world.velocities();
-    for (int32_t i = 0; i < count; ++i)
-      for (int k = 0; k < 3; ++k) out_xyz[3 * i + k] = v[first + i][k];
-  });
+  return guard("embra_world_get_velocities", world,
+               [&] { read_particles(world->world, world->world.velocities(), capacity, first, count, out_xyz); });
 }
 
 embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count) {

@@ -13,6 +13,7 @@
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "embra/embra.h"
@@ -32,6 +33,20 @@ static inline int capi_test_record(int ok, const char* file, int line, const cha
             capi_test_context, what);
   }
   return ok;
+}
+
+/* The world as scene JSON (malloc'd; NULL on failure). */
+static inline char* capi_test_save(const embra_world* w) {
+  int64_t n = 0;
+  char* text;
+  if (embra_world_save_json(w, NULL, 0, &n) != EMBRA_OK) return NULL;
+  text = (char*)malloc((size_t)n);
+  if (text == NULL) return NULL;
+  if (embra_world_save_json(w, text, n, &n) != EMBRA_OK) {
+    free(text);
+    return NULL;
+  }
+  return text;
 }
 
 #define CAPI_CONTEXT(...) snprintf(capi_test_context, sizeof capi_test_context, __VA_ARGS__)

@@ -13,20 +13,6 @@
 
 #include "capi_test.h"
 
-/* The world as scene JSON (malloc'd; NULL on failure). */
-static char* save(const embra_world* w) {
-  int64_t n = 0;
-  char* text;
-  if (embra_world_save_json(w, NULL, 0, &n) != EMBRA_OK) return NULL;
-  text = (char*)malloc((size_t)n);
-  if (text == NULL) return NULL;
-  if (embra_world_save_json(w, text, n, &n) != EMBRA_OK) {
-    free(text);
-    return NULL;
-  }
-  return text;
-}
-
 /* A rod of 4 particles along x, 0.1 m apart, stretch constraints generated. */
 static void rod(embra_world* w) {
   static const int32_t edges[] = {0, 1, 1, 2, 2, 3};
@@ -61,12 +47,12 @@ static void test_moved_hard_pin_steps_the_same_after_save_and_load(void) {
   CHECK_OK(embra_world_step(w)); /* the pin's target is where the frame ended */
   CHECK_OK(embra_world_set_positions(w, moved, 0, 1));
 
-  text = save(w);
+  text = capi_test_save(w);
   CHECK(text != NULL);
   if (text == NULL) return;
   CHECK_OK(embra_world_load_json(&copy, text, (int64_t)strlen(text), NULL));
   if (copy == NULL) return;
-  again = save(copy);
+  again = capi_test_save(copy);
   CHECK(again != NULL && strcmp(text, again) == 0);
 
   CHECK_OK(embra_world_step(w));
@@ -84,8 +70,8 @@ static void test_moved_hard_pin_steps_the_same_after_save_and_load(void) {
   /* It glided from where the host put it, a quarter of the way back in each of the 4 substeps:
    * its velocity is (target - moved) / dt. */
   for (i = 0; i < 3; ++i) CHECK_NEAR(a[i], ((i == 2 ? 1.0 : 0.0) - moved[i]) / s.dt, 1e-9);
-  after_a = save(w);
-  after_b = save(copy);
+  after_a = capi_test_save(w);
+  after_b = capi_test_save(copy);
   CHECK(after_a != NULL && after_b != NULL && strcmp(after_a, after_b) == 0);
 
   free(text);
@@ -99,7 +85,7 @@ static void test_moved_hard_pin_steps_the_same_after_save_and_load(void) {
 /* The world and its saved-and-loaded copy step once and must agree to the byte. */
 static void check_twins_step_alike(embra_world* w) {
   embra_world* copy = NULL;
-  char* text = save(w);
+  char* text = capi_test_save(w);
   char *again, *after_a, *after_b;
   CHECK(text != NULL);
   if (text == NULL) return;
@@ -108,12 +94,12 @@ static void check_twins_step_alike(embra_world* w) {
     free(text);
     return;
   }
-  again = save(copy);
+  again = capi_test_save(copy);
   CHECK(again != NULL && strcmp(text, again) == 0);
   CHECK_OK(embra_world_step(w));
   CHECK_OK(embra_world_step(copy));
-  after_a = save(w);
-  after_b = save(copy);
+  after_a = capi_test_save(w);
+  after_b = capi_test_save(copy);
   CHECK(after_a != NULL && after_b != NULL && strcmp(after_a, after_b) == 0);
   free(text);
   free(again);
@@ -141,7 +127,7 @@ static void test_moved_collider_sweeps_the_same_after_save_and_load(void) {
   CHECK_OK(embra_collider_create(w, &col, &cid));
   CHECK_OK(embra_world_step(w));
   CHECK_OK(embra_collider_set_transform(w, cid, up, rot)); /* up through the rod's particle 1 */
-  text = save(w);
+  text = capi_test_save(w);
   CHECK(text != NULL && strstr(strstr(text, "\"state\""), "\"colliders\"") != NULL);
   free(text);
   check_twins_step_alike(w);
@@ -152,7 +138,7 @@ static void test_moved_collider_sweeps_the_same_after_save_and_load(void) {
     CHECK_MSG(dx * dx + dy * dy + dz * dz >= 0.2 * 0.2 * (1.0 - 1e-6), "particle %d is inside the sphere", i);
   }
   /* After the step the collider is where it was put: nothing more to sweep, nothing more saved. */
-  text = save(w);
+  text = capi_test_save(w);
   CHECK(text != NULL && strstr(strstr(text, "\"state\""), "\"colliders\"") == NULL);
   free(text);
   embra_world_destroy(w);

@@ -14,23 +14,9 @@
 
 #include "capi_test.h"
 
-/* The world as scene JSON (malloc'd; NULL on failure). */
-static char* save(const embra_world* w) {
-  int64_t n = 0;
-  char* text;
-  if (embra_world_save_json(w, NULL, 0, &n) != EMBRA_OK) return NULL;
-  text = (char*)malloc((size_t)n);
-  if (text == NULL) return NULL;
-  if (embra_world_save_json(w, text, n, &n) != EMBRA_OK) {
-    free(text);
-    return NULL;
-  }
-  return text;
-}
-
 /* Saves `w`, loads the text back and saves again: both texts must be the same bytes. */
 static void check_round_trip(const embra_world* w, const char* what) {
-  char* first = save(w);
+  char* first = capi_test_save(w);
   embra_world* loaded = NULL;
   char* second = NULL;
   CAPI_CONTEXT("%s", what);
@@ -38,7 +24,7 @@ static void check_round_trip(const embra_world* w, const char* what) {
   if (first == NULL) return;
   CHECK_OK(embra_world_load_json(&loaded, first, (int64_t)strlen(first), NULL));
   if (loaded != NULL) {
-    second = save(loaded);
+    second = capi_test_save(loaded);
     CHECK(second != NULL && strcmp(first, second) == 0);
     embra_world_destroy(loaded);
   }
@@ -154,7 +140,7 @@ static void test_sizes_below_the_smallest_are_refused(void) {
   char* before;
   char* after;
   CHECK_OK(embra_world_create(&w, NULL));
-  before = save(w);
+  before = capi_test_save(w);
   col.shape = EMBRA_COLLIDER_SPHERE;
   col.radius = below;
   CHECK_STATUS(embra_collider_create(w, &col, &cid), EMBRA_ERROR_INVALID_ARGUMENT);
@@ -178,7 +164,7 @@ static void test_sizes_below_the_smallest_are_refused(void) {
   panels.panel_size = below;
   CHECK_STATUS(embra_panel_mesh_create(w, &panels, &pb, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_CONTAINS(embra_last_error_message(), "panel size");
-  after = save(w);
+  after = capi_test_save(w);
   CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
   free(before);
   free(after);
@@ -200,7 +186,7 @@ static void test_values_beyond_the_ranges_are_refused(void) {
   char* before;
   char* after;
   CHECK_OK(embra_world_create(&w, NULL));
-  before = save(w);
+  before = capi_test_save(w);
   CHECK_STATUS(embra_world_set_gravity(w, g), EMBRA_ERROR_INVALID_ARGUMENT);
   d.vertex_count = 3;
   d.positions = xyz;
@@ -241,7 +227,7 @@ static void test_values_beyond_the_ranges_are_refused(void) {
   CHECK_OK(embra_world_set_solver(w, &s));
   s = embra_default_solver_def();
   CHECK_OK(embra_world_set_solver(w, &s));
-  after = save(w);
+  after = capi_test_save(w);
   CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
   free(before);
   free(after);
@@ -308,17 +294,17 @@ static void test_destroyed_group_still_saves(void) {
   d.bend_group = bend;
   CHECK_OK(embra_body_create(w, &d, &b, NULL));
   CHECK_OK(embra_group_destroy(w, bend));
-  text = save(w);
+  text = capi_test_save(w);
   CHECK_MSG(text != NULL, "save_json after destroying a named, unused group: %s", embra_last_error_message());
   free(text);
   CHECK_OK(embra_world_step(w));
   check_round_trip(w, "a world whose bend group was destroyed");
   /* The group holding the body's generated stretch constraints stays. */
-  text = save(w);
+  text = capi_test_save(w);
   CHECK_STATUS(embra_group_destroy(w, stretch), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_CONTAINS(embra_last_error_message(), "stretch");
   {
-    char* again = save(w);
+    char* again = capi_test_save(w);
     CHECK(text != NULL && again != NULL && strcmp(text, again) == 0);
     free(again);
   }
@@ -345,10 +331,10 @@ static void test_failed_step_with_actions_changes_nothing(void) {
   CHECK_OK(embra_world_load_json(&w, scene, (int64_t)strlen(scene), NULL));
   if (w == NULL) return;
   for (frame = 0; frame < 4 && st == EMBRA_OK; ++frame) {
-    char* before = save(w);
+    char* before = capi_test_save(w);
     st = embra_world_step(w);
     if (st != EMBRA_OK) {
-      char* after = save(w);
+      char* after = capi_test_save(w);
       CHECK_INT(st, EMBRA_ERROR_NUMERICAL);
       CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
       free(after);
@@ -385,9 +371,9 @@ static void test_huge_dt_with_self_collision(void) {
   CHECK_OK(embra_world_create(&w, &s));
   cloth(w, 0.1, 1.0, &first);
   CHECK_OK(embra_world_set_gravity(w, g));
-  before = save(w);
+  before = capi_test_save(w);
   CHECK_STATUS(embra_world_step(w), EMBRA_ERROR_NUMERICAL);
-  after = save(w);
+  after = capi_test_save(w);
   CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
   free(before);
   free(after);
@@ -404,11 +390,11 @@ static void test_cancel_before_a_step(void) {
   CHECK_OK(embra_world_create(&w, NULL));
   cloth(w, 0.1, 1.0, &first);
   CHECK_OK(embra_world_step(w));
-  before = save(w);
+  before = capi_test_save(w);
   CHECK_OK(embra_world_cancel(w));
   CHECK_STATUS(embra_world_step(w), EMBRA_ERROR_CANCELLED);
   CHECK_STR(embra_status_name(EMBRA_ERROR_CANCELLED), "EMBRA_ERROR_CANCELLED");
-  after = save(w);
+  after = capi_test_save(w);
   CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
   CHECK_OK(embra_world_step(w)); /* the request was consumed */
   CHECK_OK(embra_world_get_report(w, &r));
