@@ -10,6 +10,8 @@ Generated from capi/include/embra/embra.h (the one source of truth):
   host_adapters/node/lib/capi_generated.js        constants, enums, koffi structs, PROTOTYPES
   host_adapters/dotnet/NativeGenerated.cs         Status, Limits, enums, structs, the DllImports
   schemas/scene.schema.json                       the "enum" arrays listed in SCHEMA_ENUMS (in place)
+  capi/src/enum_pins_generated.hpp                static_asserts pinning the core enums of CORE_ENUMS
+                                                  to the C values, and the counts to the C lists
 The hand-written rest of each adapter (library loading, errors, the World classes) imports these.
 
 The parser is strict: embra.h is written in a small regular subset of C (numeric #defines,
@@ -33,6 +35,7 @@ PYTHON_OUT = os.path.join("host_adapters", "python", "embra", "_capi_generated.p
 NODE_OUT = os.path.join("host_adapters", "node", "lib", "capi_generated.js")
 DOTNET_OUT = os.path.join("host_adapters", "dotnet", "NativeGenerated.cs")
 SCHEMA = os.path.join("schemas", "scene.schema.json")
+PINS_OUT = os.path.join("capi", "src", "enum_pins_generated.hpp")
 
 # The schema's enum arrays that list a C enum's names (the enumerator's suffix after the group
 # prefix, lowercased): JSON path in the schema -> the C enum's group prefix.
@@ -42,6 +45,16 @@ SCHEMA_ENUMS: List[Tuple[Tuple[str, ...], str]] = [
     (("definitions", "constraint_batch", "properties", "kind", "enum"), "CONSTRAINT"),
     (("definitions", "collider", "properties", "shape", "enum"), "COLLIDER"),
 ]
+
+# The C enums the C ABI casts to a core enum: group prefix -> (core enum, core count constant or
+# None). Each enumerator's core name is its scene name (EMBRA_CONSTRAINT_PLANE_OFFSET ->
+# embra::Kind::plane_offset).
+CORE_ENUMS: Dict[str, Tuple[str, Optional[str]]] = {
+    "CONSTRAINT": ("embra::Kind", "embra::kKindCount"),
+    "COLLIDER": ("embra::ColliderShape", "embra::kColliderShapeCount"),
+    "PANEL_PINS": ("embra::PanelPins", None),
+    "PANEL_METRIC": ("embra::PanelMetric", "embra::kPanelMetricCount"),
+}
 
 # C# names of enum groups where the PascalCase of the prefix is not the name.
 DOTNET_ENUM_NAMES = {"CUTS": "CutsFormat"}
@@ -576,13 +589,36 @@ def gen_schema(h: Header, text: str, path: str) -> str:
     return text
 
 
+# --- the C ABI's pins of the core enums ----------------------------------------------------------
+
+def gen_pins(h: Header) -> str:
+    """static_asserts: each core enumerator equals its C value; a count equals the C list's length."""
+    names = enum_names(h)
+    out = [banner("//"),
+           "// Included by capi/src/status.cpp: the C ABI casts these C enums to the core's, so each core",
+           "// value is pinned to its C value, and a core enum's count to the length of the C list.",
+           "// clang-format off", "#pragma once", "",
+           '#include "embra/core/kinds.hpp"', '#include "embra/core/panels.hpp"', '#include "embra/core/world.hpp"', ""]
+    for prefix, (core, count) in CORE_ENUMS.items():
+        if prefix not in names:
+            raise ParseError(f"CORE_ENUMS names EMBRA_{prefix}_*, which embra.h lacks")
+        for name, value in names[prefix].items():
+            out.append(f"static_assert(static_cast<int>({core}::{name}) == {value}, "
+                       f'"{core}::{name} is EMBRA_{prefix}_{name.upper()} = {value}");')
+        if count:
+            n = len(names[prefix])
+            out.append(f'static_assert({count} == {n}, "{core} and the {n} EMBRA_{prefix}_* values differ");')
+        out.append("")
+    return "\n".join(out)
+
+
 # --- main -------------------------------------------------------------------------------------------
 
 def outputs(h: Header) -> Dict[str, str]:
     with open(os.path.join(ROOT, SCHEMA), encoding="utf-8") as f:
         schema = f.read()
     return {PYTHON_OUT: gen_python(h), NODE_OUT: gen_node(h), DOTNET_OUT: gen_dotnet(h),
-            SCHEMA: gen_schema(h, schema, SCHEMA)}
+            SCHEMA: gen_schema(h, schema, SCHEMA), PINS_OUT: gen_pins(h)}
 
 
 def shown(path: str) -> str:

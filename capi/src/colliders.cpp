@@ -6,14 +6,7 @@
 
 using namespace embra::capi;
 
-// embra_collider_shape values are cast to embra::ColliderShape: each is pinned to its core value.
-static_assert(static_cast<int>(embra::ColliderShape::plane) == EMBRA_COLLIDER_PLANE);
-static_assert(static_cast<int>(embra::ColliderShape::sphere) == EMBRA_COLLIDER_SPHERE);
-static_assert(static_cast<int>(embra::ColliderShape::box) == EMBRA_COLLIDER_BOX);
-static_assert(static_cast<int>(embra::ColliderShape::capsule) == EMBRA_COLLIDER_CAPSULE);
-static_assert(static_cast<int>(embra::ColliderShape::convex) == EMBRA_COLLIDER_CONVEX);
-static_assert(static_cast<int>(embra::ColliderShape::mesh) == EMBRA_COLLIDER_MESH);
-static_assert(embra::kColliderShapeCount == EMBRA_COLLIDER_MESH + 1, "a core shape the C ABI does not number");
+// The C values cast to core enums here are pinned to them in enum_pins_generated.hpp.
 
 namespace {
 constexpr std::tuple kColliderCopies{

@@ -3,16 +3,7 @@
 
 using namespace embra::capi;
 
-// embra_constraint_kind values are cast to embra::Kind: each is pinned to its core value.
-static_assert(static_cast<int>(embra::Kind::distance) == EMBRA_CONSTRAINT_DISTANCE);
-static_assert(static_cast<int>(embra::Kind::edge_angle) == EMBRA_CONSTRAINT_EDGE_ANGLE);
-static_assert(static_cast<int>(embra::Kind::dihedral) == EMBRA_CONSTRAINT_DIHEDRAL);
-static_assert(static_cast<int>(embra::Kind::tet_volume) == EMBRA_CONSTRAINT_TET_VOLUME);
-static_assert(static_cast<int>(embra::Kind::weld) == EMBRA_CONSTRAINT_WELD);
-static_assert(static_cast<int>(embra::Kind::tether) == EMBRA_CONSTRAINT_TETHER);
-static_assert(static_cast<int>(embra::Kind::planarity) == EMBRA_CONSTRAINT_PLANARITY);
-static_assert(static_cast<int>(embra::Kind::plane_offset) == EMBRA_CONSTRAINT_PLANE_OFFSET);
-static_assert(embra::kKindCount == EMBRA_CONSTRAINT_PLANE_OFFSET + 1, "a core kind the C ABI does not number");
+// The C values cast to core enums here are pinned to them in enum_pins_generated.hpp.
 
 extern "C" {
 

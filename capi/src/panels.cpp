@@ -9,16 +9,7 @@
 
 using namespace embra::capi;
 
-// EMBRA_PANEL_PINS_* and EMBRA_PANEL_METRIC_* values are cast to the core's enums: each is pinned.
-static_assert(static_cast<int>(embra::PanelPins::none) == EMBRA_PANEL_PINS_NONE);
-static_assert(static_cast<int>(embra::PanelPins::top_corners) == EMBRA_PANEL_PINS_TOP_CORNERS);
-static_assert(static_cast<int>(embra::PanelPins::top_and_bottom_corners) == EMBRA_PANEL_PINS_TOP_AND_BOTTOM_CORNERS);
-static_assert(static_cast<int>(embra::PanelMetric::planarity) == EMBRA_PANEL_METRIC_PLANARITY);
-static_assert(static_cast<int>(embra::PanelMetric::thickness) == EMBRA_PANEL_METRIC_THICKNESS);
-static_assert(static_cast<int>(embra::PanelMetric::miter) == EMBRA_PANEL_METRIC_MITER);
-static_assert(static_cast<int>(embra::PanelMetric::corner_distance) == EMBRA_PANEL_METRIC_CORNER_DISTANCE);
-static_assert(static_cast<int>(embra::PanelMetric::conical) == EMBRA_PANEL_METRIC_CONICAL);
-static_assert(embra::kPanelMetricCount == EMBRA_PANEL_METRIC_CONICAL + 1, "a core metric the C ABI does not number");
+// The C values cast to core enums here are pinned to them in enum_pins_generated.hpp.
 
 namespace {
 constexpr std::tuple kPanelMeshCopies{

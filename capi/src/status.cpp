@@ -1,4 +1,5 @@
 // Statuses, the last-error message, versions, and the helpers of guard.hpp that are not templates.
+#include "enum_pins_generated.hpp"  // the C enums cast to the core's, every value pinned
 #include "guard.hpp"
 
 #include "embra/core/limits.hpp"

@@ -38,7 +38,7 @@ namespace Embra
     public enum Generate { None = 0, Stretch = 1, Shear = 2, Bend = 4, Volume = 8 }
 
     /// <summary>EMBRA_CONSTRAINT_*.</summary>
-    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7 }
+    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8 }
 
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }

@@ -204,6 +204,22 @@ TEST(ConstraintMath, PlaneOffsetValueAndGradient) {
   EXPECT_FALSE(eval_plane_offset(Vec3(0, 0, 1), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)).valid);
 }
 
+// Two edges x0-x1 and x2-x3: C = |x0 - x1| - |x2 - x3|; also when they share a particle.
+TEST(ConstraintMath, EqualLengthValueAndGradient) {
+  Rng rng(8);
+  for (int i = 0; i < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    EXPECT_NEAR(eval_equal_length(x[0], x[1], x[2], x[3]).value, (x[0] - x[1]).norm() - (x[2] - x[3]).norm(), 1e-15);
+    check_gradient<4>([](const Points<4>& p) { return eval_equal_length(p[0], p[1], p[2], p[3]); }, x, "equal_length",
+                      i);
+  }
+  // A 3-4-5 right angle: the legs differ by 1, the hypotenuse and a leg by 2 (the edges share x1).
+  EXPECT_NEAR(eval_equal_length(Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(0, 0, 0), Vec3(0, 4, 0)).value, -1.0, 1e-15);
+  EXPECT_NEAR(eval_equal_length(Vec3(3, 0, 0), Vec3(0, 4, 0), Vec3(3, 0, 0), Vec3(0, 0, 0)).value, 2.0, 1e-15);
+  EXPECT_FALSE(eval_equal_length(Vec3(1, 2, 3), Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(1, 0, 0)).valid);
+  EXPECT_FALSE(eval_equal_length(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 2, 3), Vec3(1, 2, 3)).valid);
+}
+
 TEST(ConstraintMath, WrapAngle) {
   constexpr double pi = std::numbers::pi;
   EXPECT_NEAR(wrap_angle(0.25), 0.25, 1e-16);

@@ -30,9 +30,9 @@ TEST(Kinds, NamesRoundTrip) {
 
 TEST(Kinds, SceneFormatNamesAndNumbers) {
   // The scene format's names and the C ABI's numbers (embra_constraint_kind).
-  const char* const names[] = {"distance", "edge_angle", "dihedral",  "tet_volume",
-                               "weld",     "tether",     "planarity", "plane_offset"};
-  ASSERT_EQ(kKindCount, 8);
+  const char* const names[] = {"distance", "edge_angle", "dihedral",     "tet_volume",  "weld",
+                               "tether",   "planarity",  "plane_offset", "equal_length"};
+  ASSERT_EQ(kKindCount, 9);
   for (int k = 0; k < kKindCount; ++k) EXPECT_EQ(kind_from_name(names[k]), static_cast<Kind>(k)) << names[k];
 }
 
@@ -68,6 +68,49 @@ TEST(Kinds, TraitsAgreeWithTheTable) {
       }
     });
   }
+}
+
+/// Four links on a line between two fixed ends, held equal pairwise (neighbouring links share a
+/// particle): they must end a quarter of the span each, on the line. Shared operands move once, along
+/// the sum of their slots' gradients; counted twice, the projection would overshoot and oscillate.
+TEST(Kinds, EqualLengthSplitsAPinnedLineEvenly) {
+  Settings s = test::settings(4, 4, Vec3::Zero(), 20.0);
+  s.tethers = 0;
+  World w(s);
+  const std::vector<Vec3> x{{0, 0, 0}, {0.1, 0, 0}, {0.5, 0, 0}, {0.6, 0, 0}, {1.0, 0, 0}};
+  test::add_particles(w, x, {0.0, 1.0, 2.0, 0.5, 0.0});
+  const std::vector<int32_t> pairs{0, 1, 1, 2, 1, 2, 2, 3, 2, 3, 3, 4};
+  const std::vector<double> rest(3, 0.0);
+  ConstraintDesc d;
+  d.kind = Kind::equal_length;
+  d.particles = pairs;
+  d.rest = rest;
+  ASSERT_EQ(w.add_constraints(d), 3);
+  for (int frame = 0; frame < 200; ++frame) w.step();
+  const auto& p = w.positions();
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR((p[k + 1] - p[k]).norm(), 0.25, 1e-9) << "link " << k;
+    EXPECT_NEAR(p[k].y(), 0.0, 1e-15);
+    EXPECT_NEAR(p[k].z(), 0.0, 1e-15);
+  }
+  EXPECT_LT(w.report().residual_max, 1e-9);
+}
+
+/// One edge may not join a particle to itself; two edges may share one.
+TEST(Kinds, EqualLengthRefusesAnEdgeOnOneParticle) {
+  World w(test::settings(1, 1));
+  test::add_particles(w, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1.0, 1.0, 1.0, 1.0});
+  const auto add = [&](std::vector<int32_t> ids) {
+    ConstraintDesc d;
+    d.kind = Kind::equal_length;
+    d.particles = ids;
+    return w.add_constraints(d);
+  };
+  EXPECT_THROW(add({0, 0, 1, 2}), Error);
+  EXPECT_THROW(add({0, 1, 2, 2}), Error);
+  EXPECT_EQ(add({0, 1, 1, 2}), 1);
+  EXPECT_EQ(add({0, 1, 2, 0}), 1);
+  EXPECT_EQ(w.constraint_count(), 2);
 }
 
 }  // namespace

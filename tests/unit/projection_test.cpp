@@ -61,6 +61,11 @@ std::vector<Vec3> random_config(Kind kind, Rng& rng) {
             std::abs(eval_plane_offset(x[0], x[1], x[2], x[3]).value) > 0.05)
           return x;
         break;
+      case Kind::equal_length:  // two edges of some length, clearly unequal
+        if ((x[1] - x[0]).norm() > 0.3 && (x[3] - x[2]).norm() > 0.3 &&
+            std::abs(eval_equal_length(x[0], x[1], x[2], x[3]).value) > 0.05)
+          return x;
+        break;
     }
   }
 }
@@ -93,6 +98,8 @@ double rest_of(Kind kind, const std::vector<Vec3>& x) {
       return eval_quad_planarity(x[0], x[1], x[2], x[3]).value;
     case Kind::plane_offset:
       return eval_plane_offset(x[0], x[1], x[2], x[3]).value;
+    case Kind::equal_length:
+      return eval_equal_length(x[0], x[1], x[2], x[3]).value;
   }
   return 0.0;
 }
@@ -122,8 +129,12 @@ double residual(const Single& s, Kind kind) {
   return std::abs(test::deviation(kind, s.world.positions(), s.ids.data(), s.rest));
 }
 
-const Kind kKinds[] = {Kind::distance, Kind::edge_angle, Kind::dihedral,  Kind::tet_volume,
-                       Kind::weld,     Kind::tether,     Kind::planarity, Kind::plane_offset};
+/// Every kind of the table (kinds.hpp).
+std::vector<Kind> every_kind() {
+  std::vector<Kind> kinds;
+  for (const KindInfo& k : embra::kKinds) kinds.push_back(k.kind);
+  return kinds;
+}
 
 // (b) One step with substeps = 1, iterations = 1 is exactly one projection. The residual must drop,
 // both for a hard constraint and for a soft one (compliance alpha with alpha / h^2 = 1, comparable
@@ -131,7 +142,7 @@ const Kind kKinds[] = {Kind::distance, Kind::edge_angle, Kind::dihedral,  Kind::
 // the world's report (|C|, since alpha = 0) must agree with the residual computed here.
 TEST(Projection, OneProjectionReducesTheResidualOfEveryKind) {
   const double h = 1.0 / 60.0;
-  for (Kind kind : kKinds) {
+  for (Kind kind : every_kind()) {
     Rng rng(100 + static_cast<int>(kind));
     for (double compliance : {0.0, h * h}) {
       double worst_ratio = 0.0;
@@ -296,7 +307,7 @@ TEST(Projection, PinProjectionIsExact) {
 // away from 0 here), and 1 (one length unit, the size of the configurations) for weld and pins,
 // whose rest value is 0.
 TEST(Projection, HardConstraintsConvergeToTheirRestValue) {
-  for (Kind kind : kKinds) {
+  for (Kind kind : every_kind()) {
     Rng rng(200 + static_cast<int>(kind));
     double worst = 0.0;
     for (int c = 0; c < kCases; ++c) {

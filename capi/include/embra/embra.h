@@ -274,7 +274,8 @@ EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra
  * `iterations` times. Put collisions last so they take precedence (the contact group's order is
  * 1000); give a group a higher weight to make it win over the others. Within one group the kinds
  * go in a fixed order: soft pins, welds, bending (edge angle, dihedral), tethers, stretch
- * (distance), volume, panels (planarity, offsets), contacts; a later kind has the final word.
+ * (distance), volume, equal lengths, panels (planarity, offsets), contacts; a later kind has the
+ * final word.
  * ------------------------------------------------------------------------------------------- */
 
 #define EMBRA_GROUP_DEF_VERSION 1
@@ -373,21 +374,25 @@ EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_
 
 typedef int32_t embra_constraint_kind;
 enum {
-  EMBRA_CONSTRAINT_DISTANCE = 0,    /* 2 particles: |x0 - x1| = rest (m). Stretch */
-  EMBRA_CONSTRAINT_EDGE_ANGLE = 1,  /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 = rest
-                                       (rad, [0, pi]). Shear */
-  EMBRA_CONSTRAINT_DIHEDRAL = 2,    /* 4 particles: angle between triangles (x0,x1,x2) and (x1,x0,x3)
-                                       across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
-  EMBRA_CONSTRAINT_TET_VOLUME = 3,  /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
-  EMBRA_CONSTRAINT_WELD = 4,        /* 2 particles: x0 = x1 (rest must be 0) */
-  EMBRA_CONSTRAINT_TETHER = 5,      /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
-                                       pulls only when overstretched */
-  EMBRA_CONSTRAINT_PLANARITY = 6,   /* 4 particles, a quad x0 x1 x2 x3 in order round it: signed
-                                       distance between its diagonals x0-x2 and x1-x3 = rest (m; 0 =
-                                       planar). (x1 - x0) . n / |n|, n = (x2 - x0) x (x3 - x1) */
-  EMBRA_CONSTRAINT_PLANE_OFFSET = 7 /* 4 particles: signed distance of x0 from the plane through
-                                      x1, x2, x3 = rest (m; positive on the side of the normal
-                                      (x2 - x1) x (x3 - x1)). x0 may slide along the plane */
+  EMBRA_CONSTRAINT_DISTANCE = 0,     /* 2 particles: |x0 - x1| = rest (m). Stretch */
+  EMBRA_CONSTRAINT_EDGE_ANGLE = 1,   /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 = rest
+                                        (rad, [0, pi]). Shear */
+  EMBRA_CONSTRAINT_DIHEDRAL = 2,     /* 4 particles: angle between triangles (x0,x1,x2) and (x1,x0,x3)
+                                        across edge x0-x1 = rest (rad, (-pi, pi]; 0 = flat). Bend */
+  EMBRA_CONSTRAINT_TET_VOLUME = 3,   /* 4 particles: signed volume (x1-x0).((x2-x0)x(x3-x0))/6 = rest */
+  EMBRA_CONSTRAINT_WELD = 4,         /* 2 particles: x0 = x1 (rest must be 0) */
+  EMBRA_CONSTRAINT_TETHER = 5,       /* 2 particles: |x0 - x1| <= rest (m). A long-range attachment:
+                                        pulls only when overstretched */
+  EMBRA_CONSTRAINT_PLANARITY = 6,    /* 4 particles, a quad x0 x1 x2 x3 in order round it: signed
+                                        distance between its diagonals x0-x2 and x1-x3 = rest (m; 0 =
+                                        planar). (x1 - x0) . n / |n|, n = (x2 - x0) x (x3 - x1) */
+  EMBRA_CONSTRAINT_PLANE_OFFSET = 7, /* 4 particles: signed distance of x0 from the plane through
+                                        x1, x2, x3 = rest (m; positive on the side of the normal
+                                        (x2 - x1) x (x3 - x1)). x0 may slide along the plane */
+  EMBRA_CONSTRAINT_EQUAL_LENGTH = 8  /* 4 particles, two edges x0-x1 and x2-x3: |x0 - x1| - |x2 - x3|
+                                        = rest (m; 0 = equal). The edges may share a particle (x1 =
+                                        x2); an edge may not join a particle to itself. A set of
+                                        edges held equal (gridshells): pair each with the next */
 };
 /* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
 EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);

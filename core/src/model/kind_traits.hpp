@@ -8,6 +8,8 @@
 //   measure_rest(p, x, name)      the rest value measured at x ("rest from current"); throws
 //                                 Error(invalid_argument) for a degenerate element
 //   check_rest(rest, name)        throws Error(invalid_argument) for a rest value the kind refuses
+//   may_share(a, b)               whether operand slots a and b may hold the same particle (equal
+//                                 length's two edges may share one); by default every operand differs
 //   scaled_rest(a, i, body)       the rest of constraint i of `a` under its body's rest scales
 #pragma once
 
@@ -42,8 +44,10 @@ decltype(auto) visit_kind(Kind kind, F&& f) {
   invalid("unknown constraint kind " + std::to_string(static_cast<int>(kind)));
 }
 
-/// What most kinds share: C(x) - rest unwrapped, any finite rest, the rest not scaled.
+/// What most kinds share: C(x) - rest unwrapped, any finite rest, the rest not scaled, every
+/// operand a different particle.
 struct KindDefaults {
+  static constexpr bool may_share(int, int) { return false; }
   static double deviation(double value, double rest) { return value - rest; }
   static void check_rest(double, const std::string&) {}
   static double scaled_rest(const ConstraintArray& a, size_t i, const BodyInfo&) { return a.rest[i]; }
@@ -159,6 +163,32 @@ struct KindTraits<Kind::plane_offset> : KindDefaults {
     return e.value;
   }
 };
+
+/// The two edges may share a particle (x1 = x2: the links either side of it held equal), but an
+/// edge may not join a particle to itself.
+template <>
+struct KindTraits<Kind::equal_length> : KindDefaults {
+  static constexpr bool may_share(int a, int b) { return a / 2 != b / 2; }
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_equal_length(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    const auto e = evaluate(p, x);
+    if (!e.valid) invalid(name + " is degenerate: an edge's particles coincide (zero length)");
+    return e.value;
+  }
+  /// A difference of lengths scales with the body's overall rest scale.
+  static double scaled_rest(const ConstraintArray& a, size_t i, const BodyInfo& b) { return a.rest[i] * b.rest_scale; }
+};
+
+/// Whether any two operand slots of kind K may hold the same particle (KindTraits<K>::may_share).
+template <Kind K>
+constexpr bool shares_operands() {
+  for (int a = 0; a < arity(K); ++a)
+    for (int b = 0; b < a; ++b)
+      if (KindTraits<K>::may_share(a, b)) return true;
+  return false;
+}
 
 #define EMBRA_KIND_HAS_TRAITS(name, number, arity, multipliers, what) \
   static_assert(sizeof(KindTraits<Kind::name>) > 0, "every kind has its KindTraits");

@@ -242,7 +242,7 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     for (int a = 0; a < n; ++a) {
       check_particle(p[a], (element_name(kind_name(desc.kind), static_cast<int64_t>(i)) + " particle").c_str());
       for (int b = 0; b < a; ++b)
-        if (p[a] == p[b])
+        if (p[a] == p[b] && !visit_kind(desc.kind, [&](auto kt) { return KindTraits<kt>::may_share(a, b); }))
           invalid(element_name(kind_name(desc.kind), static_cast<int64_t>(i)) + " is degenerate: particle " +
                   std::to_string(p[a]) + " appears twice");
     }

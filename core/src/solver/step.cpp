@@ -49,15 +49,26 @@ void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std
   }
 }
 
-/// The generic pass, through constraint_math.hpp (edge angle, tet volume).
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume, equal length).
 template <Kind K>
 void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
   constexpr int N = arity(K);
   const size_t n = a.size();
   for (size_t i = 0; i < n; ++i) {
     const int32_t* p = &a.ids[i * N];
-    const auto e = KindTraits<K>::evaluate(p, x);
+    auto e = KindTraits<K>::evaluate(p, x);
     if (!e.valid) continue;
+    if constexpr (shares_operands<K>()) {
+      // A particle in two slots moves along the sum of their gradients, once: the later slot's
+      // gradient joins the earlier one's and is zeroed.
+      for (int k = 1; k < N; ++k)
+        for (int j = 0; j < k; ++j)
+          if (p[k] == p[j]) {
+            e.grad[j] += e.grad[k];
+            e.grad[k].setZero();
+            break;
+          }
+    }
     const double c = KindTraits<K>::deviation(e.value, a.rest[i]);
     const double alpha = a.compliance[i] * inv_h2;
     double denom = alpha;
@@ -164,6 +175,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
     add_corrections<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], x_, w_, corr);
     add_corrections<Kind::planarity>(g.solve[static_cast<int>(Kind::planarity)], x_, w_, corr);
     add_corrections<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], x_, w_, corr);
+    add_corrections<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], x_, w_, corr);
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
@@ -234,6 +246,7 @@ void World::project_group(Group& g, double h, bool first) {
   else
     k.chain(distance, inv_h2, x, w, chain_scratch_.data());
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
+  project_generic<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
   k.planarity(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   k.plane_offset(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.

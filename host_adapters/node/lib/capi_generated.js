@@ -56,6 +56,7 @@ const CONSTRAINT_WELD = 4;
 const CONSTRAINT_TETHER = 5;
 const CONSTRAINT_PLANARITY = 6;
 const CONSTRAINT_PLANE_OFFSET = 7;
+const CONSTRAINT_EQUAL_LENGTH = 8;
 
 // --- embra_collider_shape ---
 const COLLIDER_PLANE = 0;
@@ -83,7 +84,7 @@ const CUTS_CSV = 1;
 
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
-const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7 });
+const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
@@ -464,8 +465,8 @@ module.exports = {
   ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL, ERROR_INTERNAL,
   ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE,
   CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER,
-  CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX,
-  COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
+  CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, COLLIDER_PLANE, COLLIDER_SPHERE,
+  COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
   PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
   PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
   COLLIDER_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType,

@@ -58,6 +58,7 @@ CONSTRAINT_WELD = 4
 CONSTRAINT_TETHER = 5
 CONSTRAINT_PLANARITY = 6
 CONSTRAINT_PLANE_OFFSET = 7
+CONSTRAINT_EQUAL_LENGTH = 8
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -85,7 +86,7 @@ CUTS_CSV = 1
 
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
-CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7}
+CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}

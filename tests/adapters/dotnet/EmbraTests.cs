@@ -211,6 +211,37 @@ namespace Embra.Tests
     }
 
     [TestFixture]
+    public class ConstraintKindTests
+    {
+        /// <summary>Four links between fixed ends, neighbours held equal (sharing a particle): a quarter each.</summary>
+        [Test]
+        public void EqualLengthSplitsAPinnedLineEvenly()
+        {
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = 0.0; }
+            solver.Substeps = 4;
+            solver.Iterations = 4;
+            solver.Damping = 20.0;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0, 0, 0.1, 0, 0, 0.5, 0, 0, 0.6, 0, 0, 1, 0, 0 },
+                             masses: new[] { 0.0, 1.0, 2.0, 0.5, 0.0 }, def: def);
+                Assert.AreEqual(3, w.AddConstraints(ConstraintKind.EqualLength, new[] { 0, 1, 1, 2, 1, 2, 2, 3, 2, 3, 3, 4 },
+                                                    new double[] { 0, 0, 0 }));
+                w.Step(200);
+                var p = w.GetPositions();
+                for (int i = 0; i < 4; ++i)
+                {
+                    double dx = p[3 * i + 3] - p[3 * i], dy = p[3 * i + 4] - p[3 * i + 1], dz = p[3 * i + 5] - p[3 * i + 2];
+                    Assert.AreEqual(0.25, Math.Sqrt(dx * dx + dy * dy + dz * dz), 1e-9, "link " + i);
+                }
+            }
+        }
+    }
+
     public class ErrorTests
     {
         static World Square()

@@ -33,7 +33,7 @@ test('defaults are the documented ones', () => {
   assert.deepEqual([m.mass, m.density, m.stretch_compliance, m.bend_compliance], [0, 1, 0, 1]);
   assert.deepEqual([m.friction_static, m.friction_dynamic], [0.5, 0.3]);
   assert.deepEqual(['distance', 'edge_angle', 'dihedral', 'tet_volume', 'weld', 'tether', 'planarity',
-    'plane_offset'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4]);
+    'plane_offset', 'equal_length'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4, 4]);
   const b = embra.defaultBodyDef();
   assert.equal(b.generate, embra.GENERATE.stretch | embra.GENERATE.bend | embra.GENERATE.volume);
   assert.ok(b.stretch_group instanceof embra.GroupId && b.stretch_group.equals(new embra.GroupId()));
@@ -89,6 +89,17 @@ test('groups, bulk constraints and reports: a hard chain hangs at its rest lengt
   assert.equal(w.counts().constraints, 0);
   assert.equal(w.counts().groups, 2);
   assert.equal(w.warning().frame, -1);
+  w.close();
+});
+
+test('equal length: four links between fixed ends, neighbours held equal, end a quarter each', () => {
+  const xyz = [[0, 0, 0], [0.1, 0, 0], [0.5, 0, 0], [0.6, 0, 0], [1, 0, 0]];
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 4, damping: 20, tethers: 0 });
+  w.createBody(xyz, { generate: 0, masses: [0, 1, 2, 0.5, 0] });
+  assert.equal(w.addConstraints('equal_length', [[0, 1, 1, 2], [1, 2, 2, 3], [2, 3, 3, 4]], { rest: [0, 0, 0] }), 3);
+  w.step(200);
+  const p = w.positions();
+  for (let i = 0; i < 4; i++) assert.ok(Math.abs(dist(p, i, i + 1) - 0.25) < 1e-9, `link ${i}`);
   w.close();
 });
 

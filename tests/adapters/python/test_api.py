@@ -58,7 +58,8 @@ def test_defaults_are_the_documented_ones():
     assert (m.mass, m.density, m.stretch_compliance, m.bend_compliance) == (0.0, 1.0, 0.0, 1.0)
     assert (m.friction_static, m.friction_dynamic) == (0.5, 0.3)
     assert [embra.constraint_arity(k) for k in ("distance", "edge_angle", "dihedral", "tet_volume", "weld",
-                                                "tether")] == [2, 3, 4, 4, 2, 2]
+                                                "tether", "planarity", "plane_offset", "equal_length")] == \
+        [2, 3, 4, 4, 2, 2, 4, 4, 4]
 
 
 def test_free_fall_is_symplectic_euler_in_closed_form():
@@ -74,6 +75,18 @@ def test_free_fall_is_symplectic_euler_in_closed_form():
         r = w.report()
         assert r.frame == 30 and abs(r.time - 0.5) < 1e-12
         assert abs(r.kinetic_energy - 0.5 * 2.0 * vz * vz) < 1e-9
+
+
+def test_equal_length_splits_a_pinned_line_evenly():
+    """Four links between fixed ends, neighbours held equal (sharing a particle): a quarter each."""
+    xyz = [(0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.5, 0.0, 0.0), (0.6, 0.0, 0.0), (1.0, 0.0, 0.0)]
+    with embra.World(gravity=(0.0, 0.0, 0.0), substeps=4, iterations=4, damping=20.0, tethers=0) as w:
+        w.create_body(xyz, generate=0, masses=[0.0, 1.0, 2.0, 0.5, 0.0])
+        assert w.add_constraints("equal_length", [(0, 1, 1, 2), (1, 2, 2, 3), (2, 3, 3, 4)], rest=[0.0] * 3) == 3
+        w.step(200)
+        p = flat(w.positions())
+        for i in range(4):
+            assert abs(math.dist(p[3 * i:3 * i + 3], p[3 * i + 3:3 * i + 6]) - 0.25) < 1e-9
 
 
 def test_groups_bulk_constraints_and_reports():

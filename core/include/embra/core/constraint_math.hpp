@@ -202,4 +202,21 @@ inline ConstraintEval<4> eval_plane_offset(const Vec3& x0, const Vec3& x1, const
   return e;
 }
 
+/// Difference of two edge lengths: C = |x0 - x1| - |x2 - x3|. Zero when the edges are equal
+/// (gridshells, Chebyshev nets: a set of edges held equal by pairing each with another). The
+/// gradient is the unit direction of each edge, +/-; not valid when either edge has zero length.
+/// The two edges may share a particle (x1 = x2 is a particle between two equal links).
+inline ConstraintEval<4> eval_equal_length(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  ConstraintEval<4> e;
+  const Vec3 a = x0 - x1;
+  const Vec3 b = x2 - x3;
+  const double la = a.norm(), lb = b.norm();
+  if (!(la > 1e-300) || !(lb > 1e-300)) return e;
+  const Vec3 ua = a / la, ub = b / lb;
+  e.value = la - lb;
+  e.grad = {ua, -ua, -ub, ub};
+  e.valid = true;
+  return e;
+}
+
 }  // namespace embra

@@ -16,15 +16,16 @@
 namespace embra {
 
 // X(name, number, arity, multipliers, description). The numbers are part of the C ABI.
-#define EMBRA_CONSTRAINT_KINDS(X)                                                                   \
-  X(distance, 0, 2, 1, "|x0 - x1| = rest (stretch)")                                                \
-  X(edge_angle, 1, 3, 1, "angle at x0 between x1 - x0 and x2 - x0 (shear)")                         \
-  X(dihedral, 2, 4, 1, "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                            \
-  X(tet_volume, 3, 4, 1, "signed volume of (x0,x1,x2,x3) = rest")                                   \
-  X(weld, 4, 2, 3, "x0 = x1")                                                                       \
-  X(tether, 5, 2, 1, "|x0 - x1| <= rest (long-range attachment, unilateral)")                       \
-  X(planarity, 6, 4, 1, "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)") \
-  X(plane_offset, 7, 4, 1, "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)")
+#define EMBRA_CONSTRAINT_KINDS(X)                                                                        \
+  X(distance, 0, 2, 1, "|x0 - x1| = rest (stretch)")                                                     \
+  X(edge_angle, 1, 3, 1, "angle at x0 between x1 - x0 and x2 - x0 (shear)")                              \
+  X(dihedral, 2, 4, 1, "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                                 \
+  X(tet_volume, 3, 4, 1, "signed volume of (x0,x1,x2,x3) = rest")                                        \
+  X(weld, 4, 2, 3, "x0 = x1")                                                                            \
+  X(tether, 5, 2, 1, "|x0 - x1| <= rest (long-range attachment, unilateral)")                            \
+  X(planarity, 6, 4, 1, "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")      \
+  X(plane_offset, 7, 4, 1, "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)") \
+  X(equal_length, 8, 4, 1, "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")
 
 /// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
 enum class Kind : int32_t {
