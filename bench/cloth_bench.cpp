@@ -16,6 +16,7 @@
 // all bit-identical).
 //
 //   ./build/bench/embra_bench --benchmark_filter='BM_Cloth/'          embra's defaults, n = 128, 64, 32
+//   ./build/bench/embra_bench --benchmark_filter='BM_ClothThreads'    the defaults on 1 and 2 threads
 //   ./build/bench/embra_bench --benchmark_filter='BM_ClothConfig'     the configurations compared
 //   ./build/bench/embra_bench --benchmark_filter='BM_Kernels'         cost per constraint and substep
 //   ./build/bench/embra_bench --benchmark_filter='BM_ClothDamped'     not the acceptance case: damped
@@ -96,6 +97,23 @@ void BM_Cloth(benchmark::State& state) {
   run_cloth(state, c);
 }
 BENCHMARK(BM_Cloth)->Arg(128)->Arg(64)->Arg(32)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
+
+/// The defaults on Settings::threads threads: {n, threads}. The same bits at any count
+/// (Threads.ClothIsBitIdenticalAtAnyThreadCount); only the time differs.
+void BM_ClothThreads(benchmark::State& state) {
+  ClothCase c;
+  c.n = static_cast<int>(state.range(0));
+  c.settings.threads = static_cast<int32_t>(state.range(1));
+  run_cloth(state, c);
+}
+BENCHMARK(BM_ClothThreads)
+    ->Args({128, 1})
+    ->Args({128, 2})
+    ->Args({256, 1})
+    ->Args({256, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1);
 
 /// Configurations compared: {n, substeps, iterations, tethers per particle, stretch weight, bend
 /// weight, Chebyshev rho in thousandths, chain solve} (a weight of 0 leaves stretch or bend in the

@@ -478,10 +478,17 @@ void Session::op_body() {
   if (s == EMBRA_OK) bodies_.push_back(id);
 }
 
+/// A constraint kind, or one just outside the list (-1, or one past the last kind).
+int32_t any_kind(Bytes& in) {
+  int32_t count = 0;
+  while (embra_constraint_arity(count) > 0) ++count;
+  return static_cast<int32_t>(in.u8() % (count + 2)) - 1;
+}
+
 void Session::op_constraint() {
   embra_constraint_def d = embra_default_constraint_def();
   d.version = version(EMBRA_CONSTRAINT_DEF_VERSION);
-  d.kind = in_.u8() % 10 - 1;
+  d.kind = any_kind(in_);
   if (in_.chance(2)) d.group = pick_id(in_, groups_);
   for (int k = 0; k < 4; ++k) d.particles[k] = particle();
   if (in_.chance(2)) d.rest_from_current = in_.chance(8) ? in_.integer() : 0;
@@ -497,7 +504,7 @@ void Session::op_constraint() {
 void Session::op_constraints() {
   embra_constraint_batch_def d = embra_default_constraint_batch_def();
   d.version = version(EMBRA_CONSTRAINT_BATCH_DEF_VERSION);
-  d.kind = in_.u8() % 10 - 1;
+  d.kind = any_kind(in_);
   if (in_.chance(2)) d.group = pick_id(in_, groups_);
   const int count = in_.u8() % 7;
   std::vector<int32_t> particles;

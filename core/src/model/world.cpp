@@ -4,6 +4,7 @@
 
 #include "collision/collider_shapes.hpp"
 #include "common/check.hpp"
+#include "common/pool.hpp"
 #include "common/slots.hpp"
 #include "model/kind_traits.hpp"
 
@@ -69,6 +70,10 @@ void check_elements(std::span<const int32_t> ids, int n, int64_t vertex_count, c
 
 }  // namespace
 
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
 World::World(const Settings& settings) {
   Settings s = settings;
   s.contact_group = Id{};
@@ -95,11 +100,16 @@ void World::set_settings(const Settings& s) {
     invalid("settings.chebyshev_rho_milli must be in [0, 990]");
   if (s.self_collision != 0 && s.self_collision != 1) invalid("settings.self_collision must be 0 or 1");
   if (s.chain_solve != 0 && s.chain_solve != 1) invalid("settings.chain_solve must be 0 or 1");
+  if (s.threads < 0 || s.threads > limits::kMaxThreads) invalid("settings.threads must be in [0, 256]");
   for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
   check_non_negative(s.damping, "settings.damping");
   check_non_negative(s.settle_speed, "settings.settle_speed");
   const Id contacts = settings_.contact_group;
   if (s.tethers != settings_.tethers || s.chain_solve != settings_.chain_solve) solver_dirty_ = true;
+  if (!pool_ || s.threads != settings_.threads) {
+    pool_ = std::make_unique<ThreadPool>(s.threads);
+    solver_dirty_ = true;  // the chain scratch has one share per thread
+  }
   settings_ = s;
   settings_.contact_group = contacts;
 }
@@ -1093,7 +1103,7 @@ void World::rebuild_solver() {
       t.lambda.assign(t.size(), 0.0);
     }
   }
-  chain_scratch_.assign(kChainScratch * (longest + 1), 0.0);
+  chain_scratch_.assign(kChainScratch * (longest + 1) * static_cast<size_t>(pool_->size()), 0.0);
   solver_dirty_ = false;
   refresh_rest();
 }

@@ -398,20 +398,21 @@ EMBRA_ALWAYS_INLINE void tether_pair_block(const SolverArray& t, const int32_t* 
   }
 }
 
-/// Every automatic tether run: those of exactly two tethers (SolverArray::pair_runs) a block of
-/// lanes at a time, their remainder and the other runs one at a time. The scalar kernel set takes
-/// them all one at a time (project_tether_run), so comparing kernel sets (EMBRA_KERNELS,
-/// scenes.kernels_same_bits) checks the lanes against the one-at-a-time projection.
+/// The automatic tether runs pair_runs[begin .. end) (exactly two tethers each) a block of lanes at
+/// a time, the remainder one at a time; or, with `others`, the runs other_runs[begin .. end) one at a
+/// time. The scalar kernel set takes them all one at a time (project_tether_run), so comparing
+/// kernel sets (EMBRA_KERNELS, scenes.kernels_same_bits) checks the lanes against the one-at-a-time
+/// projection.
 template <class T>
-EMBRA_ALWAYS_INLINE void tether_runs(const SolverArray& t, double* x, const double* w) {
+EMBRA_ALWAYS_INLINE void tether_runs(const SolverArray& t, size_t i, size_t end, bool others, double* x,
+                                     const double* w) {
   constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
-  const size_t n = t.pair_runs.size();
-  size_t i = 0;
-  if constexpr (lanes_n > 1)
-    for (; i + lanes_n <= n; i += lanes_n) tether_pair_block<T>(t, &t.pair_runs[i], x, w);
   Vec3* const points = reinterpret_cast<Vec3*>(x);
-  for (; i < n; ++i) project_tether_run(t, static_cast<size_t>(t.pair_runs[i]), points, w);
-  for (int32_t r : t.other_runs) project_tether_run(t, static_cast<size_t>(r), points, w);
+  const std::vector<int32_t>& runs = others ? t.other_runs : t.pair_runs;
+  if constexpr (lanes_n > 1)
+    if (!others)
+      for (; i + lanes_n <= end; i += lanes_n) tether_pair_block<T>(t, &runs[i], x, w);
+  for (; i < end; ++i) project_tether_run(t, static_cast<size_t>(runs[i]), points, w);
 }
 
 enum class Op { distance, tether, dihedral, planarity, plane_offset };
@@ -427,20 +428,17 @@ EMBRA_ALWAYS_INLINE void block(const SolverArray& a, size_t i, double inv_h2, do
     distance_block<T, kOp == Op::tether>(&a.ids[2 * i], &a.rest[i], &a.compliance[i], lambda + i, inv_h2, x, w);
 }
 
-/// One pass over a solver array, colour by colour: blocks of T within each colour, single
-/// constraints for a colour's remainder and for the shared tail (whose constraints may overlap).
+/// The constraints [begin, end) of one colour: blocks of T (with `in_lanes`), then one at a time.
+/// Without `in_lanes` (a shared tail, whose constraints may overlap) every one is projected alone,
+/// in order.
 template <class T, Op kOp>
-EMBRA_ALWAYS_INLINE void pass(SolverArray& a, double inv_h2, double* x, const double* w) {
+EMBRA_ALWAYS_INLINE void pass(SolverArray& a, size_t i, size_t end, bool in_lanes, double inv_h2, double* x,
+                              const double* w) {
   constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
-  const size_t colours = a.colours();
   double* lambda = a.lambda.data();
-  for (size_t c = 0; c < colours; ++c) {
-    size_t i = static_cast<size_t>(a.colour_start[c]);
-    const size_t end = static_cast<size_t>(a.colour_start[c + 1]);
-    if (!(a.shared_tail && c + 1 == colours))
-      for (; i + lanes_n <= end; i += lanes_n) block<T, kOp>(a, i, inv_h2, x, w, lambda);
-    for (; i < end; ++i) block<double, kOp>(a, i, inv_h2, x, w, lambda);
-  }
+  if (in_lanes)
+    for (; i + lanes_n <= end; i += lanes_n) block<T, kOp>(a, i, inv_h2, x, w, lambda);
+  for (; i < end; ++i) block<double, kOp>(a, i, inv_h2, x, w, lambda);
 }
 
 /// The chain pass (Settings::chain_solve): each chain of distance constraints, in turn, takes one
@@ -640,18 +638,16 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
 
 /// The chain pass: colour by colour, bundles of T's lanes within each colour (single chains for the
 /// shared tail, whose chains may overlap).
+/// The chains [begin, end) of one colour: side by side in bundles of lanes (with `in_lanes`), or
+/// one after another (a shared tail).
 template <class T>
-EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) {
+EMBRA_ALWAYS_INLINE void chain_pass(SolverArray& a, size_t i, size_t end, bool in_lanes, double inv_h2, double* x,
+                                    const double* w, double* scratch) {
   constexpr int lanes_n = lanes::Lanes<T>::count;
-  const size_t colours = a.chain_colour_start.empty() ? 0 : a.chain_colour_start.size() - 1;
-  for (size_t c = 0; c < colours; ++c) {
-    size_t i = static_cast<size_t>(a.chain_colour_start[c]);
-    const size_t end = static_cast<size_t>(a.chain_colour_start[c + 1]);
-    if (!(a.chain_shared_tail && c + 1 == colours))
-      for (; i < end; i += lanes_n)
-        chain_bundle<T>(a, i, static_cast<int>(std::min<size_t>(lanes_n, end - i)), inv_h2, x, w, scratch);
-    for (; i < end; ++i) chain_bundle<double>(a, i, 1, inv_h2, x, w, scratch);
-  }
+  if (in_lanes)
+    for (; i < end; i += lanes_n)
+      chain_bundle<T>(a, i, static_cast<int>(std::min<size_t>(lanes_n, end - i)), inv_h2, x, w, scratch);
+  for (; i < end; ++i) chain_bundle<double>(a, i, 1, inv_h2, x, w, scratch);
 }
 
 /// The function values alone (no gradients, no writes) of a whole solver array, into out[0 ..
@@ -673,40 +669,41 @@ EMBRA_ALWAYS_INLINE T value_block(const int32_t* ids, const double* x) {
 }
 
 template <class T, Op kOp>
-EMBRA_ALWAYS_INLINE void values(const SolverArray& a, const double* x, double* out) {
+EMBRA_ALWAYS_INLINE void values(const SolverArray& a, size_t i, size_t end, const double* x, double* out) {
   constexpr size_t lanes_n = static_cast<size_t>(lanes::Lanes<T>::count);
   constexpr size_t arity = kOp == Op::dihedral ? 4 : 2;
-  const size_t n = a.size();
-  size_t i = 0;
-  for (; i + lanes_n <= n; i += lanes_n) {
+  for (; i + lanes_n <= end; i += lanes_n) {
     const T v = value_block<T, kOp>(&a.ids[arity * i], x);
     std::memcpy(out + i, &v, sizeof v);
   }
-  for (; i < n; ++i) out[i] = value_block<double, kOp>(&a.ids[arity * i], x);
+  for (; i < end; ++i) out[i] = value_block<double, kOp>(&a.ids[arity * i], x);
 }
 
 /// The passes for one lane type, compiled for one instruction set (ATTR).
-#define EMBRA_DEFINE_PASS(NAME, T, ATTR, OP)                                         \
-  ATTR void NAME##_##OP(SolverArray& a, double inv_h2, double* x, const double* w) { \
-    pass<T, Op::OP>(a, inv_h2, x, w);                                                \
+#define EMBRA_DEFINE_PASS(NAME, T, ATTR, OP)                                                               \
+  ATTR void NAME##_##OP(SolverArray& a, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x, \
+                        const double* w) {                                                                 \
+    pass<T, Op::OP>(a, begin, end, in_lanes, inv_h2, x, w);                                                \
   }
-#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                             \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, distance)                                                           \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, tether)                                                             \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                           \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                          \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                       \
-  ATTR void NAME##_tether_runs(const SolverArray& t, double* x, const double* w) {                     \
-    tether_runs<T>(t, x, w);                                                                           \
-  }                                                                                                    \
-  ATTR void NAME##_chain(SolverArray& a, double inv_h2, double* x, const double* w, double* scratch) { \
-    chain_pass<T>(a, inv_h2, x, w, scratch);                                                           \
-  }                                                                                                    \
-  ATTR void NAME##_distance_values(const SolverArray& a, const double* x, double* out) {               \
-    values<T, Op::distance>(a, x, out);                                                                \
-  }                                                                                                    \
-  ATTR void NAME##_dihedral_values(const SolverArray& a, const double* x, double* out) {               \
-    values<T, Op::dihedral>(a, x, out);                                                                \
+#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                                         \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, distance)                                                                       \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, tether)                                                                         \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                                       \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                                      \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                                   \
+  ATTR void NAME##_tether_runs(const SolverArray& t, size_t begin, size_t end, bool others, double* x,             \
+                               const double* w) {                                                                  \
+    tether_runs<T>(t, begin, end, others, x, w);                                                                   \
+  }                                                                                                                \
+  ATTR void NAME##_chain(SolverArray& a, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x,        \
+                         const double* w, double* scratch) {                                                       \
+    chain_pass<T>(a, begin, end, in_lanes, inv_h2, x, w, scratch);                                                 \
+  }                                                                                                                \
+  ATTR void NAME##_distance_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) { \
+    values<T, Op::distance>(a, begin, end, x, out);                                                                \
+  }                                                                                                                \
+  ATTR void NAME##_dihedral_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) { \
+    values<T, Op::dihedral>(a, begin, end, x, out);                                                                \
   }
 
 EMBRA_DEFINE_PASSES(scalar, double, )
@@ -743,6 +740,56 @@ const Kernels& kernels() {
 #endif
   }();
   return chosen;
+}
+
+namespace {
+
+// Items per thread below which a range is not split: a part must outweigh the hand-over (a few
+// microseconds). A constraint costs tens of nanoseconds, a chain a few links' worth each.
+constexpr size_t kGrain = 512;
+constexpr size_t kChainGrain = 16;
+constexpr size_t kAlign = 4;  // parts start on a block of the widest lanes
+
+}  // namespace
+
+void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, double* x, const double* w) {
+  const size_t colours = a.colours();
+  for (size_t c = 0; c < colours; ++c) {
+    const size_t begin = static_cast<size_t>(a.colour_start[c]), end = static_cast<size_t>(a.colour_start[c + 1]);
+    if (a.shared_tail && c + 1 == colours)
+      kernel(a, begin, end, false, inv_h2, x, w);
+    else
+      pool.run(begin, end, kAlign, kGrain, [&](size_t b, size_t e, int) { kernel(a, b, e, true, inv_h2, x, w); });
+  }
+}
+
+void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, const double* w,
+                std::vector<double>& scratch) {
+  const Kernels& k = kernels();
+  const size_t colours = a.chain_colour_start.empty() ? 0 : a.chain_colour_start.size() - 1;
+  const size_t stride = scratch.size() / static_cast<size_t>(pool.size());
+  for (size_t c = 0; c < colours; ++c) {
+    const size_t begin = static_cast<size_t>(a.chain_colour_start[c]);
+    const size_t end = static_cast<size_t>(a.chain_colour_start[c + 1]);
+    if (a.chain_shared_tail && c + 1 == colours)
+      k.chain(a, begin, end, false, inv_h2, x, w, scratch.data());
+    else
+      pool.run(begin, end, kAlign, kChainGrain, [&](size_t b, size_t e, int part) {
+        k.chain(a, b, e, true, inv_h2, x, w, scratch.data() + stride * static_cast<size_t>(part));
+      });
+  }
+}
+
+void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w) {
+  const Kernels& k = kernels();
+  // Runs share no particle: the pairs and the others may go in any split, in either order.
+  pool.run(0, t.pair_runs.size(), kAlign, kGrain,
+           [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, false, x, w); });
+  pool.run(0, t.other_runs.size(), 1, kGrain, [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, true, x, w); });
+}
+
+void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {
+  pool.run(0, a.size(), kAlign, kGrain, [&](size_t b, size_t e, int) { kernel(a, b, e, x, out); });
 }
 
 const char* solver_kernels() {

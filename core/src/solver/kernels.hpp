@@ -4,6 +4,7 @@
 // compiled for every lane width this machine may run (lanes.hpp): all give the same bits.
 #pragma once
 
+#include "common/pool.hpp"
 #include "embra/core/world.hpp"
 
 #include <vector>
@@ -20,24 +21,42 @@ inline const double* coords(const std::vector<Vec3>& x) {
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are packed xyz triples");
 
-/// One instruction set's kernels. Each projection kernel takes one Gauss-Seidel pass of XPBD over a
-/// solver array (alpha~ = compliance * inv_h2), writing positions x (xyz) of particles with inverse
-/// mass w != 0.
+/// One instruction set's kernels, each over a range of one solver array. A projection kernel takes
+/// one Gauss-Seidel pass of XPBD (alpha~ = compliance * inv_h2) over the constraints [begin, end) of
+/// one colour, writing positions x (xyz) of particles with inverse mass w != 0: in blocks of lanes
+/// with `in_lanes`, else one at a time in order (a shared tail, whose constraints may overlap).
 struct Kernels {
-  void (*distance)(SolverArray&, double, double*, const double*);
-  void (*tether)(SolverArray&, double, double*, const double*);
-  void (*dihedral)(SolverArray&, double, double*, const double*);
-  void (*planarity)(SolverArray&, double, double*, const double*);
-  void (*plane_offset)(SolverArray&, double, double*, const double*);
-  void (*chain)(SolverArray&, double, double*, const double*, double*);
-  void (*distance_values)(const SolverArray&, const double*, double*);
-  void (*dihedral_values)(const SolverArray&, const double*, double*);
-  void (*tether_runs)(const SolverArray&, double*, const double*);
+  using Pass = void (*)(SolverArray&, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x,
+                        const double* w);
+  using Values = void (*)(const SolverArray&, size_t begin, size_t end, const double* x, double* out);
+  Pass distance, tether, dihedral, planarity, plane_offset;
+  /// The chains [begin, end) of one colour (Settings::chain_solve); scratch: World::kChainScratch
+  /// doubles per link of the longest chain, plus as many again.
+  void (*chain)(SolverArray&, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x, const double* w,
+                double* scratch);
+  /// The function values of constraints [begin, end) into out[begin .. end).
+  Values distance_values, dihedral_values;
+  /// The automatic tethers' runs pair_runs[begin .. end), or other_runs[begin .. end) with `others`.
+  void (*tether_runs)(const SolverArray&, size_t begin, size_t end, bool others, double* x, const double* w);
   const char* name;
 };
 
 /// The kernels for this machine. Every set computes the same bits (lanes.hpp); EMBRA_KERNELS=scalar,
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels();
+
+// Whole passes, colour by colour, each colour's items split over the pool's threads. Items of one
+// colour share no movable particle and every kernel gives an item the same bits in a block or alone,
+// so the result does not depend on the thread count.
+
+/// One pass of `kernel` over every constraint of `a`.
+void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, double* x, const double* w);
+/// The chain pass over every chain of `a`; `scratch` holds one equal share per thread of the pool.
+void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, const double* w,
+                std::vector<double>& scratch);
+/// Every automatic tether run of `t` (runs share no particle).
+void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
+/// The function values of every constraint of `a` into out[0 .. a.size()).
+void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out);
 
 }  // namespace embra

@@ -85,14 +85,14 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
 /// XPBD residual |C + alpha~ lambda| (for a tether only while it pulls or is overstretched).
 /// Distances and dihedral angles are evaluated by the kernels' value passes into `values`.
 template <Kind K>
-void residuals(const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max, double& sum_sq,
-               std::vector<double>& values) {
+void residuals(ThreadPool& pool, const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max,
+               double& sum_sq, std::vector<double>& values) {
   constexpr int N = arity(K);
   constexpr bool kLanes = K == Kind::distance || K == Kind::tether || K == Kind::dihedral;
   if constexpr (kLanes) {
     values.resize(a.size());
     const Kernels& k = kernels();
-    (K == Kind::dihedral ? k.dihedral_values : k.distance_values)(a, coords(x), values.data());
+    values_pass(pool, K == Kind::dihedral ? k.dihedral_values : k.distance_values, a, coords(x), values.data());
   }
   for (size_t i = 0; i < a.size(); ++i) {
     double value;
@@ -229,26 +229,26 @@ void World::project_group(Group& g, double h, bool first) {
   // a fold ended 14 % long (the 128 x 128 acceptance cloth, frame 81 at 20 substeps); projected
   // before it, 2.9 %.
   project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
-  k.dihedral(g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
+  project_pass(*pool_, k.dihedral, g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
   // Tethers before stretching too: a tether pulls each particle on its own toward its anchor, and
   // during a whip that squeezes the edges between neighbours it pulls unequally; the stretch pass
   // after it takes that back (the 64 x 64 cloth after 200 frames: 2.05 % -> 1.16 %, 32 x 32: 2.77 %
   // -> 1.03 %).
-  k.tether(g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
+  project_pass(*pool_, k.tether, g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
   if (settings_.realign_passes > 0)
-    k.tether(g.tethers, inv_h2, x, w);  // one at a time: realignment needs their multipliers
+    project_pass(*pool_, k.tether, g.tethers, inv_h2, x, w);  // one at a time: realignment needs multipliers
   else
-    k.tether_runs(g.tethers, x, w);
+    tether_runs_pass(*pool_, g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
   if (distance.chain_start.empty() || !first || settings_.realign_passes > 0)
-    k.distance(distance, inv_h2, x, w);
+    project_pass(*pool_, k.distance, distance, inv_h2, x, w);
   else
-    k.chain(distance, inv_h2, x, w, chain_scratch_.data());
+    chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   project_generic<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
-  k.planarity(g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
-  k.plane_offset(g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
+  project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
+  project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
   if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
     self_collision::project(self_contacts_, x_, w_);
@@ -309,7 +309,7 @@ void World::measure() {
     for (const KindInfo& info : kKinds)
       visit_kind(info.kind, [&](auto k) {
         if constexpr (k != Kind::weld)
-          residuals<k>(g.solve[static_cast<int>(info.kind)], inv_h2, x_, max, sq, measure_values_);
+          residuals<k>(*pool_, g.solve[static_cast<int>(info.kind)], inv_h2, x_, max, sq, measure_values_);
       });
     for (const SolverArray& a : g.solve) n += static_cast<int64_t>(a.size());
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];

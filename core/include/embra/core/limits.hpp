@@ -29,6 +29,8 @@ inline constexpr int64_t kMaxParticles = int64_t{1} << 21;
 inline constexpr int64_t kMaxConstraints = int64_t{1} << 24;
 /// Work per step: substeps x iterations (each iteration a pass over every group).
 inline constexpr int64_t kMaxPassesPerStep = 100000;
+/// Solver threads per world (Settings::threads; 0 = every core).
+inline constexpr int32_t kMaxThreads = 256;
 /// A scene file embra_world_load_file reads (2 GiB): larger files are refused before they are read.
 inline constexpr int64_t kMaxSceneBytes = int64_t{1} << 31;
 /// An OBJ file a scene names: larger files are refused before they are read.

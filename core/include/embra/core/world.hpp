@@ -152,6 +152,10 @@ struct Settings {
   // 1: cloth and shells (bodies with triangles) collide with themselves and each other, point against
   // triangle and edge against edge, kept their thickness apart (self_collision.hpp); 0 (default): off.
   int32_t self_collision = 0;
+  // Threads the solver uses, the caller's included: 1 (default) none besides it; 0 every core of the
+  // machine; at most limits::kMaxThreads. Each colour's constraints and chains are split over them;
+  // the result is the same bits at any count.
+  int32_t threads = 1;
 };
 
 struct GroupReport {
@@ -384,10 +388,15 @@ struct PanelLayout {
 /// "scalar". All give the same bits; the environment variable EMBRA_KERNELS forces one.
 const char* solver_kernels();
 
+class ThreadPool;
+
 /// The world. Not thread-safe: one thread at a time per world; different worlds are independent.
 class World {
  public:
   explicit World(const Settings& settings = Settings());
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
 
   // --- settings --------------------------------------------------------------------------------
   const Settings& settings() const { return settings_; }
@@ -562,7 +571,8 @@ class World {
   /// 4 lanes, and per particle 4 for each lane (the chain step, solver/kernels.cpp).
   static constexpr size_t kChainScratch = 52;
   std::vector<double> measure_values_;                // measure(): one array's constraint values
-  std::vector<double> chain_scratch_;                 // kChainScratch per link of the longest chain, + 1
+  std::vector<double> chain_scratch_;                 // per thread: kChainScratch per link of the longest chain, + 1
+  std::unique_ptr<ThreadPool> pool_;                  // Settings::threads
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
   StepReport report_;

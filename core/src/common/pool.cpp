@@ -1,0 +1,80 @@
+// ThreadPool (pool.hpp): workers that spin briefly for the next job, then sleep on an atomic.
+#include "common/pool.hpp"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace embra {
+
+namespace {
+
+/// Spins this long (pause instructions, tens of microseconds) before sleeping: the colours of one
+/// pass follow each other within microseconds, and a sleeping worker takes far longer to wake.
+constexpr int kSpins = 4096;
+
+inline void relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+/// Waits until `a` holds a value other than `old`; returns it.
+template <class T>
+T wait_change(const std::atomic<T>& a, T old) {
+  for (int i = 0; i < kSpins; ++i) {
+    const T now = a.load(std::memory_order_acquire);
+    if (now != old) return now;
+    relax();
+  }
+  for (;;) {
+    a.wait(old, std::memory_order_acquire);
+    const T now = a.load(std::memory_order_acquire);
+    if (now != old) return now;
+  }
+}
+
+}  // namespace
+
+ThreadPool::ThreadPool(int threads) {
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  workers_.reserve(static_cast<size_t>(threads - 1));
+  for (int i = 0; i + 1 < threads; ++i) workers_.emplace_back([this, i] { work(i); });
+}
+
+ThreadPool::~ThreadPool() {
+  publish(0);
+  for (std::thread& t : workers_) t.join();
+}
+
+void ThreadPool::publish(int parts) {
+  const uint64_t number = (job_.load(std::memory_order_relaxed) >> 16) + 1;
+  job_.store(number << 16 | static_cast<uint64_t>(parts), std::memory_order_release);
+  job_.notify_all();
+}
+
+void ThreadPool::dispatch(void (*call)(void*, int), void* context, int parts) {
+  call_ = call;
+  context_ = context;
+  pending_.store(parts - 1, std::memory_order_relaxed);
+  publish(parts);
+  call(context, 0);
+  for (int left = pending_.load(std::memory_order_acquire); left != 0;) left = wait_change(pending_, left);
+}
+
+void ThreadPool::work(int index) {
+  uint64_t seen = 0;
+  for (;;) {
+    seen = wait_change(job_, seen);
+    const int parts = static_cast<int>(seen & 0xffff);
+    if (parts == 0) return;
+    if (index + 1 < parts) {
+      call_(context_, index + 1);
+      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
+    }
+  }
+}
+
+}  // namespace embra

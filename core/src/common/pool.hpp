@@ -1,0 +1,85 @@
+// The solver's threads: a fixed pool that splits one range of independent items (the constraints of
+// one colour, the chains of one colour, the particles of a pass) into one contiguous part per
+// thread, runs the parts at once and returns when all are done.
+//
+// What a part computes never depends on how the range was split: every item reads and writes only
+// its own particles (a colour's constraints share no movable particle), and the kernels give the
+// same bits for an item whether it is computed in a block of lanes or alone (lanes.hpp). So the
+// result is the same at any thread count, bit for bit.
+//
+// The caller's thread runs part 0; workers wait for work spinning briefly, then sleeping on an
+// atomic (std::atomic::wait), so an idle pool costs nothing and a busy one hands work over in
+// microseconds. One pool serves one world, one call at a time (the C ABI's one-call-at-a-time rule).
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace embra {
+
+class ThreadPool {
+ public:
+  /// A pool of `threads` threads in all, the caller's included (1: no workers; every range runs on
+  /// the caller). 0 takes std::thread::hardware_concurrency().
+  explicit ThreadPool(int threads = 1);  // at most 65535
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  /// Threads in all, the caller's included.
+  int size() const { return static_cast<int>(workers_.size()) + 1; }
+
+  /// Calls fn(part_begin, part_end, part) over [begin, end) cut into at most size() contiguous parts,
+  /// each (but the last) a multiple of `align` items long and at least `grain` items; fewer parts
+  /// when the range is short (a range under 2 * grain runs on the caller alone). `part` is in
+  /// [0, size()): the index of per-thread scratch. Returns when every part is done.
+  template <class F>
+  void run(size_t begin, size_t end, size_t align, size_t grain, F&& fn) {
+    const size_t n = end > begin ? end - begin : 0;
+    size_t parts = workers_.empty() || grain == 0 ? 1 : std::min<size_t>(static_cast<size_t>(size()), n / grain);
+    if (parts <= 1) {
+      if (n > 0) fn(begin, end, 0);
+      return;
+    }
+    // Equal parts, rounded up to `align`; the last takes what is left.
+    size_t step = (n + parts - 1) / parts;
+    step = (step + align - 1) / align * align;
+    parts = (n + step - 1) / step;
+    Job<F> job{&fn, begin, end, step};
+    dispatch(&Job<F>::call, &job, static_cast<int>(parts));
+  }
+
+ private:
+  template <class F>
+  struct Job {
+    F* fn;
+    size_t begin, end, step;
+    static void call(void* self, int part) {
+      const Job& j = *static_cast<Job*>(self);
+      const size_t b = j.begin + static_cast<size_t>(part) * j.step;
+      const size_t e = std::min(j.end, b + j.step);
+      if (b < e) (*j.fn)(b, e, part);
+    }
+  };
+
+  /// Runs call(context, p) for p in [0, parts): parts 1 .. parts - 1 on workers, 0 here.
+  void dispatch(void (*call)(void*, int), void* context, int parts);
+  void publish(int parts);  // a new job number with `parts` parts (0: stop)
+  void work(int index);
+
+  std::vector<std::thread> workers_;
+  // The current job. call_ and context_ are written before job_ publishes them and read only by the
+  // workers that have a part, which the caller waits for before it writes them again.
+  void (*call_)(void*, int) = nullptr;
+  void* context_ = nullptr;
+  // (job number << 16) | parts: one word, so that a worker sees a job's number and part count
+  // together. 0 parts: stop.
+  std::atomic<uint64_t> job_{0};
+  std::atomic<int> pending_{0};  // worker parts of the current job not yet done
+};
+
+}  // namespace embra

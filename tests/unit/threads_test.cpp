@@ -1,0 +1,120 @@
+// The solver's threads (Settings::threads, common/pool.hpp): the same scene gives the same bits at
+// any thread count, and the pool covers every item of a range exactly once, in aligned parts.
+// Labelled "threads": the ThreadSanitizer stage of the test command runs these too.
+#include "common/pool.hpp"
+#include "embra/core/limits.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace embra {
+namespace {
+
+/// Every item of [begin, end) is visited exactly once; parts are contiguous, start on `align` from
+/// `begin` and number at most the pool's threads.
+TEST(Threads, PoolCoversEveryItemOnceInAlignedParts) {
+  for (int threads : {1, 2, 3, 8}) {
+    ThreadPool pool(threads);
+    ASSERT_EQ(pool.size(), threads);
+    for (size_t n : {0u, 1u, 7u, 100u, 1023u, 5000u, 65537u}) {
+      std::vector<std::atomic<int>> seen(n + 3);
+      std::atomic<int> parts{0};
+      std::vector<std::atomic<int>> part_used(static_cast<size_t>(threads));
+      pool.run(3, n + 3, 4, 64, [&](size_t b, size_t e, int part) {
+        EXPECT_EQ((b - 3) % 4, 0u);
+        EXPECT_LT(b, e);
+        ASSERT_GE(part, 0);
+        ASSERT_LT(part, threads);
+        part_used[static_cast<size_t>(part)].fetch_add(1);
+        parts.fetch_add(1);
+        for (size_t i = b; i < e; ++i) seen[i].fetch_add(1);
+      });
+      for (size_t i = 0; i < 3; ++i) EXPECT_EQ(seen[i].load(), 0);
+      for (size_t i = 3; i < n + 3; ++i) ASSERT_EQ(seen[i].load(), 1) << "item " << i << " of " << n;
+      EXPECT_LE(parts.load(), threads);
+      for (auto& u : part_used) EXPECT_LE(u.load(), 1);  // one part per thread's scratch
+      if (n < 128) {
+        EXPECT_LE(parts.load(), 1);  // under two grains: the caller alone
+      }
+    }
+  }
+}
+
+/// A 128 x 128 cloth pinned at two corners at the default settings (chain solve, automatic tethers
+/// in lanes, bending) falling onto a sphere: big enough that every colour of every kind is split
+/// over the threads.
+std::unique_ptr<World> cloth(int threads) {
+  Settings s;
+  s.threads = threads;
+  auto w = std::make_unique<World>(s);
+  const test::Grid g = test::make_grid(128, 128, 1.0 / 127.0, Vec3(-0.5, -0.5, 1.0));
+  BodyDesc d;
+  d.positions = g.positions;
+  d.triangles = g.triangles;
+  d.material.thickness = 0.002;
+  d.generate = generate_stretch | generate_bend;
+  w->create_body(d);
+  test::hard_pin(*w, g.index(0, 127), Vec3(-0.5, 0.5, 1.0));
+  test::hard_pin(*w, g.index(127, 127), Vec3(0.5, 0.5, 1.0));
+  ColliderDesc sphere;
+  sphere.shape = ColliderShape::sphere;
+  sphere.position = Vec3(0.1, -0.2, 0.8);
+  sphere.radius = 0.15;
+  w->create_collider(sphere);
+  return w;
+}
+
+/// Positions, velocities and the residual, as raw doubles.
+std::vector<double> state(const World& w) {
+  std::vector<double> out = test::flatten(w.positions());
+  const std::vector<double> v = test::flatten(w.velocities());
+  out.insert(out.end(), v.begin(), v.end());
+  out.push_back(w.report().residual_max);
+  out.push_back(w.report().residual_rms);
+  return out;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(Threads, ClothIsBitIdenticalAtAnyThreadCount) {
+  constexpr int kFrames = 10;
+  auto w1 = cloth(1);
+  for (int f = 0; f < kFrames; ++f) w1->step();
+  const std::vector<double> one = state(*w1);
+  for (int threads : {2, 3, 8}) {
+    auto w = cloth(threads);
+    for (int f = 0; f < kFrames; ++f) w->step();
+    EXPECT_TRUE(same_bits(state(*w), one)) << threads << " threads";
+  }
+  // The thread count changed between frames changes nothing either.
+  auto w = cloth(1);
+  for (int f = 0; f < kFrames; ++f) {
+    Settings s = w->settings();
+    s.threads = 1 + f % 4;
+    w->set_settings(s);
+    w->step();
+  }
+  EXPECT_TRUE(same_bits(state(*w), one)) << "thread count changed every frame";
+}
+
+TEST(Threads, CountIsValidated) {
+  Settings s;
+  s.threads = 0;  // every core
+  World w(s);
+  EXPECT_EQ(w.settings().threads, 0);
+  s.threads = limits::kMaxThreads + 1;
+  EXPECT_THROW(w.set_settings(s), Error);
+  s.threads = -1;
+  EXPECT_THROW(w.set_settings(s), Error);
+  EXPECT_EQ(w.settings().threads, 0);
+}
+
+}  // namespace
+}  // namespace embra
