@@ -556,7 +556,9 @@ def gen_dotnet(h: Header) -> str:
             else:
                 out.append(f"        public {ty} {pascal(f.name)};")
         out.append("    }")
-    out += ["", "    public static partial class Native", "    {"]
+    out += ["", "    public static partial class Native", "    {",
+            "        /// <summary>The EMBRA_ABI_VERSION these bindings were generated for (the SONAME's number).</summary>",
+            f"        public const int AbiVersion = {dict(h.defines)['EMBRA_ABI_VERSION']};"]
     for fn in h.functions:
         params = ", ".join(cs_param(h, fn, i) for i in range(len(fn.params)))
         out.append(f"        [DllImport(Library, CallingConvention = C)] public static extern "
@@ -626,6 +628,16 @@ def shown(path: str) -> str:
     return path if rel.startswith("..") else rel
 
 
+def abi_version() -> Tuple[str, str]:
+    """EMBRA_ABI_VERSION, the SONAME's number, as CMakeLists.txt sets it (embra.h gets it from there too,
+    through the generated embra_version.h): a define of the mirrors like the header's own."""
+    with open(os.path.join(ROOT, "CMakeLists.txt"), encoding="utf-8") as f:
+        m = re.search(r"^set\(EMBRA_ABI_VERSION (\d+)\)$", f.read(), flags=re.M)
+    if not m:
+        raise ParseError("CMakeLists.txt: no set(EMBRA_ABI_VERSION N)")
+    return ("EMBRA_ABI_VERSION", m.group(1))
+
+
 def main(argv: List[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--check", action="store_true", help="write nothing; exit 1 naming every stale file")
@@ -633,6 +645,7 @@ def main(argv: List[str]) -> int:
     args = ap.parse_args(argv)
     try:
         h = parse_header(args.header)
+        h.defines.insert(0, abi_version())
         files = outputs(h)
     except ParseError as e:
         print(f"gen_bindings: {e}", file=sys.stderr)

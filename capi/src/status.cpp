@@ -104,6 +104,7 @@ static_assert(EMBRA_MAX_PARTICLES == embra::limits::kMaxParticles);
 static_assert(EMBRA_MAX_CONSTRAINTS == embra::limits::kMaxConstraints);
 static_assert(EMBRA_MAX_PASSES_PER_STEP == embra::limits::kMaxPassesPerStep);
 static_assert(EMBRA_MAX_OBJ_BYTES == embra::limits::kMaxObjBytes);
+static_assert(EMBRA_MAX_THREADS == embra::limits::kMaxThreads);
 
 extern "C" {
 

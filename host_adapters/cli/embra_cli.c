@@ -12,6 +12,8 @@
  * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
  * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
  * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses.
+ * --threads T steps on T threads (0: one per core; default: the scene's solver.threads): the same
+ * bits at any T, and final.json keeps the scene's own setting.
  *
  * A scene's OBJ paths resolve against the scene file's folder and must stay inside it (no absolute
  * path, no ".." or symbolic link leading out: a scene file may come from anyone);
@@ -59,6 +61,8 @@ static int help(void) {
       "validate  loads SCENE.json (schemas/scene.schema.json) and builds its world; exit 0 if valid.\n"
       "run       steps the scene N frames (default: its own \"frames\"; 0: load and save only) and writes\n"
       "          DIR/final.json, DIR/metrics.jsonl, DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
+      "          --threads T steps on T threads (0: one per core; default: the scene's solver.threads);\n"
+      "          the results are the same bits at any T, and final.json keeps the scene's own setting.\n"
       "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files.\n"
       "\n"
       "OBJ files a scene names: paths are relative to the scene file's folder and must stay inside it\n"
@@ -605,11 +609,21 @@ static void progress(long done, long total, double ms) {
   fflush(stderr);
 }
 
+/* Sets the world's solver thread count (the rest of its solver settings as they are now); the
+ * count it had goes to *before when before is not NULL. */
+static int set_threads(embra_world* world, int32_t threads, int32_t* before) {
+  embra_solver_def s;
+  if (embra_world_get_solver(world, &s) != EMBRA_OK) return -1;
+  if (before) *before = s.threads;
+  s.threads = threads;
+  return embra_world_set_solver(world, &s) == EMBRA_OK ? 0 : -1;
+}
+
 static int cmd_run(int argc, char** argv) {
   if (argc < 1) return usage();
   const char* scene = argv[0];
   const char* out = "out";
-  long frames = -1, every = 0, threads = 1;
+  long frames = -1, every = 0, threads = -1;
   int allow_outside = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--allow-outside-paths") == 0) {
@@ -622,17 +636,24 @@ static int cmd_run(int argc, char** argv) {
     } else if (strcmp(argv[i], "--every") == 0) {
       if (parse_int(argv[++i], 1, 100000000, &every)) return usage();
     } else if (strcmp(argv[i], "--threads") == 0) {
-      if (parse_int(argv[++i], 1, 1024, &threads)) return usage();
+      if (parse_int(argv[++i], 0, EMBRA_MAX_THREADS, &threads)) return usage();
     } else if (strcmp(argv[i], "--out") == 0) {
       out = argv[++i];
     } else {
       return usage();
     }
   }
-  (void)threads; /* the solver is single-threaded for now; results never depend on this */
   embra_world* world = NULL;
   const int loaded = load_scene_file(scene, allow_outside, &world);
   if (loaded != 0) return loaded;
+  /* --threads T steps on T threads (0: every core); final.json keeps the scene's own setting, so it
+   * is the same file at any T (the solver's result does not depend on the thread count). */
+  int32_t scene_threads = 1;
+  if (threads >= 0 && set_threads(world, (int32_t)threads, &scene_threads) != 0) {
+    fprintf(stderr, "embra: --threads %ld: %s\n", threads, embra_last_error_message());
+    embra_world_destroy(world);
+    return EXIT_INVALID;
+  }
   if (frames < 0) {
     int64_t f = 0;
     embra_world_get_scene_frames(world, &f);
@@ -733,7 +754,8 @@ static int cmd_run(int argc, char** argv) {
   fclose(metrics);
   /* The state reached so far is kept whatever happened: a failed step restored the last good one. */
   snprintf(path, sizeof path, "%s/final.json", out);
-  if (embra_world_save_file(world, path) != EMBRA_OK) {
+  if ((threads >= 0 && set_threads(world, scene_threads, NULL) != 0) ||
+      embra_world_save_file(world, path) != EMBRA_OK) {
     fprintf(stderr, "embra: %s\n", embra_last_error_message());
     if (rc == 0) rc = EXIT_INVALID;
   }

@@ -12,7 +12,6 @@ namespace Embra
     public static partial class Native
     {
         public const string Library = "embra";  // libembra.so: the assembly's folder, LD_LIBRARY_PATH, the system
-        public const int AbiVersion = 0;        // the EMBRA_ABI_VERSION these bindings were written against
         const CallingConvention C = CallingConvention.Cdecl;
     }
 }

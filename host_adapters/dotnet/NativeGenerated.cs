@@ -31,6 +31,7 @@ namespace Embra
         public const int MaxConstraints = 16777216;
         public const int MaxPassesPerStep = 100000;
         public const int MaxObjBytes = 268435456;
+        public const int MaxThreads = 256;
     }
 
     /// <summary>EMBRA_GENERATE_*.</summary>
@@ -88,7 +89,7 @@ namespace Embra
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct SolverDef
     {
-        public const int CurrentVersion = 1;
+        public const int CurrentVersion = 2;
         public int Version;
         public int Substeps;
         public double Dt;
@@ -101,6 +102,8 @@ namespace Embra
         public int RealignPasses;
         public int SelfCollision;
         public int ChainSolve;
+        public int Threads;
+        public int Reserved0;
     }
 
     /// <summary>embra_world_counts.</summary>
@@ -419,6 +422,8 @@ namespace Embra
 
     public static partial class Native
     {
+        /// <summary>The EMBRA_ABI_VERSION these bindings were generated for (the SONAME's number).</summary>
+        public const int AbiVersion = 1;
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_last_error_message();
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_status_name(int status);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_version();

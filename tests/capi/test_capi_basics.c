@@ -85,7 +85,7 @@ static void test_struct_layout(void) {
   CHECK_INT(sizeof(embra_collider_id), 8);
   CHECK_INT(offsetof(embra_group_id, generation), 4);
 
-  CHECK_INT(sizeof(embra_solver_def), 8 * 4 + 6 * 8);
+  CHECK_INT(sizeof(embra_solver_def), 10 * 4 + 6 * 8);
   CHECK_INT(offsetof(embra_solver_def, substeps), 4);
   CHECK_INT(offsetof(embra_solver_def, dt), 8);
   CHECK_INT(offsetof(embra_solver_def, iterations), 16);
@@ -96,6 +96,8 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_solver_def, tethers), 64);
   CHECK_INT(offsetof(embra_solver_def, self_collision), 72);
   CHECK_INT(offsetof(embra_solver_def, chain_solve), 76);
+  CHECK_INT(offsetof(embra_solver_def, threads), 80);
+  CHECK_INT(offsetof(embra_solver_def, reserved0), 84);
 
   CHECK_INT(sizeof(embra_world_counts), 6 * 4 + 8);
   CHECK_INT(offsetof(embra_world_counts, constraints), 24);

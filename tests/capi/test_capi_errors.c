@@ -546,8 +546,18 @@ static void test_solver_and_gravity(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_def", embra_world_get_solver(W, NULL));
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_world_set_solver(W, none));
   d = embra_default_solver_def();
-  d.version = 2;
+  d.version = 1; /* the layout before threads */
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_world_set_solver(W, &d));
+  d.version = 3;
+  REFUSED(EMBRA_ERROR_VERSION, "version", embra_world_set_solver(W, &d));
+  d = embra_default_solver_def();
+  d.reserved0 = 1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "reserved0", embra_world_set_solver(W, &d));
+  d = embra_default_solver_def();
+  d.threads = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "threads", embra_world_set_solver(W, &d));
+  d.threads = EMBRA_MAX_THREADS + 1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "threads", embra_world_set_solver(W, &d));
   d.version = 0;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_world_set_solver(W, &d));
   for (i = 0; i < 3; ++i) {

@@ -403,7 +403,8 @@ constexpr std::tuple kSolverRows{Row{"dt", &Settings::dt},
                                  Row{"realign_passes", &Settings::realign_passes},
                                  Row{"chebyshev_rho_milli", &Settings::chebyshev_rho_milli},
                                  Row{"self_collision", &Settings::self_collision},
-                                 Row{"chain_solve", &Settings::chain_solve}};
+                                 Row{"chain_solve", &Settings::chain_solve},
+                                 Row{"threads", &Settings::threads}};
 
 constexpr std::tuple kMaterialRows{Row{"mass", &Material::mass},
                                    Row{"density", &Material::density},

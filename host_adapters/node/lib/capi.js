@@ -17,10 +17,8 @@
 
 const generated = require('./capi_generated');
 
-const { koffi, PROTOTYPES } = generated;
-
-/** The EMBRA_ABI_VERSION these bindings were written against (the SONAME's number). */
-const ABI_VERSION = 0;
+// ABI_VERSION: the EMBRA_ABI_VERSION these bindings were generated for (the SONAME's number).
+const { koffi, PROTOTYPES, ABI_VERSION } = generated;
 const LIBRARY_ENV = 'EMBRA_LIBRARY';
 
 // --- loading --------------------------------------------------------------------------------------

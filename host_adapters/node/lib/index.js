@@ -9,7 +9,7 @@
 //   console.log(world.positions());
 //   world.close();
 //
-// libembra is loaded from $EMBRA_LIBRARY, else as libembra.so.0 through the dynamic loader's search.
+// libembra is loaded from $EMBRA_LIBRARY, else as libembra.so.1 through the dynamic loader's search.
 
 const capi = require('./capi');
 const errors = require('./errors');

@@ -12,9 +12,7 @@ import os
 import sys
 
 from ._capi_generated import *  # noqa: F401,F403 - the whole mirror is this module's interface
-from ._capi_generated import PROTOTYPES, _Id  # noqa: F401 - _Id: the id structs' base, used by world.py
-
-ABI_VERSION = 0  # the EMBRA_ABI_VERSION these bindings were written against (the SONAME's number)
+from ._capi_generated import ABI_VERSION, PROTOTYPES, _Id  # noqa: F401 - _Id: the id structs' base, used by world.py
 
 LIBRARY_ENV = "EMBRA_LIBRARY"
 

@@ -7,6 +7,7 @@ import ctypes
 from ctypes import POINTER, c_char, c_char_p, c_double, c_int32, c_int64, c_uint32, c_void_p  # noqa: F401
 
 # --- #define constants: ranges and limits, struct versions ---
+ABI_VERSION = 1
 MAX_ABS_VALUE = 1e300
 MIN_POSITIVE = 1e-300
 MAX_DT = 1e6
@@ -15,7 +16,8 @@ MAX_PARTICLES = 2097152
 MAX_CONSTRAINTS = 16777216
 MAX_PASSES_PER_STEP = 100000
 MAX_OBJ_BYTES = 268435456
-SOLVER_DEF_VERSION = 1
+MAX_THREADS = 256
+SOLVER_DEF_VERSION = 2
 GROUP_DEF_VERSION = 1
 BODY_DEF_VERSION = 1
 CONSTRAINT_DEF_VERSION = 1
@@ -138,6 +140,8 @@ class SolverDef(ctypes.Structure):
         ("realign_passes", c_int32),
         ("self_collision", c_int32),
         ("chain_solve", c_int32),
+        ("threads", c_int32),
+        ("reserved0", c_int32),
     ]
 
 

@@ -25,7 +25,8 @@ test('versions and status names', () => {
 
 test('defaults are the documented ones', () => {
   const s = embra.defaultSolverDef();
-  assert.deepEqual([s.version, s.substeps, s.iterations, s.tethers, s.realign_passes, s.chain_solve], [1, 16, 1, 2, 0, 1]);
+  assert.deepEqual([s.version, s.substeps, s.iterations, s.tethers, s.realign_passes, s.chain_solve, s.threads],
+    [2, 16, 1, 2, 0, 1, 1]);
   assert.equal(s.dt, 1.0 / 60.0);
   assert.deepEqual(s.gravity, [0, 0, -9.81]);
   assert.equal(s.settle_speed, 1e-3);

@@ -52,7 +52,8 @@ def test_versions():
 
 def test_defaults_are_the_documented_ones():
     s = embra.default_solver_def()
-    assert (s.version, s.substeps, s.iterations, s.tethers, s.realign_passes, s.chain_solve) == (1, 16, 1, 2, 0, 1)
+    assert (s.version, s.substeps, s.iterations, s.tethers, s.realign_passes, s.chain_solve, s.threads) == \
+        (2, 16, 1, 2, 0, 1, 1)
     assert s.dt == 1.0 / 60.0 and tuple(s.gravity) == (0.0, 0.0, -9.81) and s.settle_speed == 1e-3
     m = embra.default_material()
     assert (m.mass, m.density, m.stretch_compliance, m.bend_compliance) == (0.0, 1.0, 0.0, 1.0)
