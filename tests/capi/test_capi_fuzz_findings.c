@@ -7,7 +7,10 @@
  *   hold, so the copy stepped differently);
  * - a collider the host moved with embra_collider_set_transform sweeps from its old pose over the
  *   next step, in the world and in its saved and reloaded copy alike (the saved scene held only the
- *   new pose, so the copy's collider stood still; /state/colliders now holds the frame's start). */
+ *   new pose, so the copy's collider stood still; /state/colliders now holds the frame's start);
+ * - a hard pin's target moved 1e300 away (accepted: within EMBRA_MAX_ABS_VALUE) is reached in one
+ *   frame at a speed beyond 1e300, which no scene can hold: the step stepped, and the saved world
+ *   did not load back. Such a step now fails with EMBRA_ERROR_NUMERICAL and is undone. */
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -144,8 +147,45 @@ static void test_moved_collider_sweeps_the_same_after_save_and_load(void) {
   embra_world_destroy(w);
 }
 
+static void test_state_beyond_the_range_fails_the_step(void) {
+  embra_world* w = NULL;
+  embra_world* copy = NULL;
+  embra_pin_def pin = embra_default_pin_def();
+  embra_pin_id pin_id;
+  embra_warning warning;
+  const double far[3] = {-EMBRA_MAX_ABS_VALUE, -EMBRA_MAX_ABS_VALUE, 1e299};
+  double before[12], after[12];
+  char *text, *saved;
+  int i;
+  CHECK_OK(embra_world_create(&w, NULL));
+  if (w == NULL) return;
+  rod(w);
+  pin.particle = 0;
+  pin.target[2] = 1.0;
+  CHECK_OK(embra_pin_create(w, &pin, &pin_id));
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_pin_set_target(w, pin_id, far)); /* a target within the range is accepted */
+  CHECK_OK(embra_world_get_positions(w, before, 12, 0, 4));
+  text = capi_test_save(w);
+  CHECK_STATUS(embra_world_step(w), EMBRA_ERROR_NUMERICAL); /* reached at ~1e302 m/s */
+  CHECK_OK(embra_world_get_warning(w, &warning));
+  CHECK_INT(warning.particle, 0);
+  CHECK_OK(embra_world_get_positions(w, after, 12, 0, 4));
+  for (i = 0; i < 12; ++i) CHECK(before[i] == after[i]);
+  saved = capi_test_save(w); /* the world is as before the step, and loads back */
+  CHECK(text != NULL && saved != NULL && strcmp(text, saved) == 0);
+  if (saved != NULL) {
+    CHECK_OK(embra_world_load_json(&copy, saved, (int64_t)strlen(saved), NULL));
+    embra_world_destroy(copy);
+  }
+  free(text);
+  free(saved);
+  embra_world_destroy(w);
+}
+
 int main(void) {
   RUN(test_moved_hard_pin_steps_the_same_after_save_and_load);
   RUN(test_moved_collider_sweeps_the_same_after_save_and_load);
+  RUN(test_state_beyond_the_range_fails_the_step);
   return capi_test_finish();
 }

@@ -40,8 +40,9 @@
  *   message of the last failure on the calling thread is embra_last_error_message(), never NULL.
  *   A refused call changes nothing: every argument is checked before anything is modified.
  *   No exception, abort or C++ object ever crosses this boundary. Numerical trouble in a step
- *   (a non-finite position) restores the world to its state before the step, returns
- *   EMBRA_ERROR_NUMERICAL and records an embra_warning.
+ *   (a position or velocity non-finite or beyond EMBRA_MAX_ABS_VALUE, which no scene could hold)
+ *   restores the world to its state before the step, returns EMBRA_ERROR_NUMERICAL and records an
+ *   embra_warning.
  *
  * RANGES AND LIMITS
  *   Every number a world accepts is finite and within +-EMBRA_MAX_ABS_VALUE (1e300); values that
@@ -101,7 +102,8 @@ enum {
   EMBRA_ERROR_SCHEMA = -4,           /* a JSON document does not match its schema */
   EMBRA_ERROR_VERSION = -5,          /* header and library (or a def's version) disagree */
   EMBRA_ERROR_LOCKED = -6,           /* the world is in use by a call in progress */
-  EMBRA_ERROR_NUMERICAL = -7,        /* the step produced a non-finite state; world restored */
+  EMBRA_ERROR_NUMERICAL = -7,        /* the step produced a non-finite state, or one beyond
+                                        EMBRA_MAX_ABS_VALUE; world restored */
   EMBRA_ERROR_INTERNAL = -8,         /* a bug in embra, or out of memory; message says which */
   EMBRA_ERROR_CANCELLED = -9         /* embra_world_cancel stopped the step; world restored */
 };
@@ -532,7 +534,8 @@ EMBRA_API embra_status embra_collider_get_transform(const embra_world* world, em
 
 /* Advances one frame (solver dt). A frame that does not complete leaves the world exactly as
  * before the call, the scene actions applied for that frame included: EMBRA_ERROR_NUMERICAL when
- * the state went non-finite (embra_world_get_warning says where), EMBRA_ERROR_CANCELLED when
+ * the state went non-finite or beyond EMBRA_MAX_ABS_VALUE (embra_world_get_warning says where; a
+ * hard pin's target 1e300 away reached in one frame is such a state), EMBRA_ERROR_CANCELLED when
  * embra_world_cancel stopped it. */
 EMBRA_API embra_status embra_world_step(embra_world* world);
 /* Asks the step in progress on another thread to stop: it checks between iterations, restores the
@@ -569,7 +572,7 @@ EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_gr
 
 typedef struct embra_warning {
   int64_t frame;    /* frame of the last numerical failure, -1 if none */
-  int32_t particle; /* first non-finite particle, -1 if none */
+  int32_t particle; /* first particle non-finite or beyond EMBRA_MAX_ABS_VALUE, -1 if none */
   int32_t reserved0;
 } embra_warning;
 

@@ -4,6 +4,7 @@
 
 #include "collision/collider_shapes.hpp"
 #include "collision/self_collision.hpp"
+#include "common/pool.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,10 @@
 namespace embra {
 
 namespace {
+/// Particles per thread below which the contact search is not split (a box or mesh costs a distance
+/// query a particle near it; the rest a bounds test).
+constexpr size_t kContactGrain = 1024;
+
 /// Signed gap of a particle to a collider's surface, and the outward normal there.
 double collider_gap(const Collider& c, const Vec3& x, const Vec3& from, Vec3& normal) {
   if (c.desc.shape == ColliderShape::plane) {
@@ -61,15 +66,26 @@ void World::find_contacts() {
   if (!colliders_.empty()) detected_ = x_;
 }
 
-void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) const {
+void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) {
+  // Each part looks at a contiguous run of the particles; appended part after part, the contacts
+  // stand in particle order as if found on one thread.
+  contact_parts_.resize(static_cast<size_t>(pool_->size()));
+  for (std::vector<Contact>& part : contact_parts_) part.clear();
+  pool_->run(0, only ? only->size() : x_.size(), 1, kContactGrain, [&](size_t begin, size_t end, int part) {
+    find_collider_contacts(index, only, begin, end, contact_parts_[static_cast<size_t>(part)]);
+  });
+  for (const std::vector<Contact>& part : contact_parts_) out.insert(out.end(), part.begin(), part.end());
+}
+
+void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, size_t begin, size_t end,
+                                   std::vector<Contact>& out) const {
   const Collider& col = colliders_[index];
   if (col.geometry) {
-    find_shape_contacts(index, only, out);
+    find_shape_contacts(index, only, begin, end, out);
     return;
   }
   const Vec3 normal = col.rotation * Vec3::UnitZ();
-  const size_t count = only ? only->size() : x_.size();
-  for (size_t k = 0; k < count; ++k) {
+  for (size_t k = begin; k < end; ++k) {
     const size_t i = only ? static_cast<size_t>((*only)[k]) : k;
     if (w_[i] == 0.0) continue;
     // The clearance, plus the path, plus the clearance again as a margin (see find_shape_contacts).
@@ -188,7 +204,8 @@ void World::project_face_contacts() {
   }
 }
 
-void World::find_shape_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) const {
+void World::find_shape_contacts(int32_t index, const std::vector<int32_t>* only, size_t begin, size_t end,
+                                std::vector<Contact>& out) const {
   const Collider& col = colliders_[index];
   const ColliderGeometry& geo = *col.geometry;
   // Convex solids have a convex distance along any straight path, so a Newton step towards the
@@ -198,8 +215,7 @@ void World::find_shape_contacts(int32_t index, const std::vector<int32_t>* only,
   Vec3 lo, hi;
   shape_bounds(col.desc, geo, lo, hi);
   const Eigen::Quaterniond inv_prev = col.rotation_prev.conjugate(), inv = col.rotation.conjugate();
-  const size_t count = only ? only->size() : x_.size();
-  for (size_t k = 0; k < count; ++k) {
+  for (size_t k = begin; k < end; ++k) {
     const size_t i = only ? static_cast<size_t>((*only)[k]) : k;
     if (w_[i] == 0.0) continue;
     // The particle's path in the collider's frame, from where it was against the collider's pose at

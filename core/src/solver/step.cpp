@@ -14,13 +14,14 @@
 //     apply_friction           collider, self and face contacts (contacts.cpp)
 //     settle_contacts_on_surface  swept contacts pushed out along the closest point (contacts.cpp)
 //     update_velocities        v <- (x - x_prev) / h, damped
-//     check_state_finite       a non-finite position or velocity fails the frame
+//     check_state_in_range     a position or velocity non-finite or beyond 1e300 fails the frame
 //   end_frame                  multipliers back to the constraint arrays, colliders' frame pose, clock
 //   measure                    residuals per group, kinetic energy, settled flag
 //
 // A frame that does not complete is undone (restore) and its exception passes on.
 #include "collision/collider_shapes.hpp"
 #include "collision/self_collision.hpp"
+#include "embra/core/limits.hpp"
 #include "embra/core/world.hpp"
 #include "model/kind_traits.hpp"
 #include "solver/contacts.hpp"
@@ -33,6 +34,18 @@
 namespace embra {
 
 namespace {
+
+/// Particles per thread below which a per-particle pass is not split (a particle costs nanoseconds).
+constexpr size_t kParticleGrain = 2048;
+
+/// Calls f(i) for every particle i of [0, n), the range split over the pool's threads: for passes
+/// where each particle reads and writes only its own state (the same bits at any split).
+template <class F>
+void each_particle(ThreadPool& pool, size_t n, F&& f) {
+  pool.run(0, n, 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+    for (size_t i = begin; i < end; ++i) f(i);
+  });
+}
 
 /// Welds x0 = x1 (three multipliers each).
 void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
@@ -129,13 +142,12 @@ void add_corrections(const SolverArray& a, const std::vector<Vec3>& x, const std
 void World::predict(double h, double alpha) {
   apply_fields(h, report_.time + alpha * settings_.dt - h);  // fields/fields.cpp
   const Vec3 dv = h * settings_.gravity;
-  const size_t n = x_.size();
-  for (size_t i = 0; i < n; ++i) {
+  each_particle(*pool_, x_.size(), [&](size_t i) {
     x_prev_[i] = x_[i];
-    if (w_[i] == 0.0) continue;
+    if (w_[i] == 0.0) return;
     v_[i] += dv;
     x_[i] += h * v_[i];
-  }
+  });
   for (const Pin& p : pins_)
     if (p.alive && p.compliance == 0.0)
       x_[p.particle] = (1.0 - alpha) * p.target_prev + alpha * p.target;  // exact at 1
@@ -203,8 +215,9 @@ void World::realign(const std::vector<Vec3>& predicted) {
       corr[fc.partner[k]] += step;
     }
   }
-  for (size_t i = 0; i < x_.size(); ++i)
+  each_particle(*pool_, x_.size(), [&](size_t i) {
     if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
+  });
 }
 
 void World::project_group(Group& g, double h, bool first) {
@@ -265,33 +278,52 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
   constexpr int kStart = 2;
   if (iteration >= kStart && iteration + 1 < settings_.iterations) {
     omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
-    for (size_t i = 0; i < x_.size(); ++i)
+    each_particle(*pool_, x_.size(), [&](size_t i) {
       if (w_[i] != 0.0) x_[i] = omega * (x_[i] - chebyshev_prev_[i]) + chebyshev_prev_[i];
+    });
   }
   chebyshev_prev_.swap(chebyshev_now_);
 }
 
 void World::update_velocities(double h) {
   const double inv_h = 1.0 / h;
-  double rate_before = 0.0, decay = 1.0;  // exp(-rate h), computed again only when the rate changes
-  for (size_t i = 0; i < x_.size(); ++i) {
-    v_[i] = (x_[i] - x_prev_[i]) * inv_h;
-    const double rate = settings_.damping + damping_[i];
-    if (rate > 0.0) {
-      if (rate != rate_before) rate_before = rate, decay = std::exp(-rate * h);
-      v_[i] *= decay;
+  pool_->run(0, x_.size(), 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+    double rate_before = 0.0, decay = 1.0;  // exp(-rate h), computed again only when the rate changes
+    for (size_t i = begin; i < end; ++i) {
+      v_[i] = (x_[i] - x_prev_[i]) * inv_h;
+      const double rate = settings_.damping + damping_[i];
+      if (rate > 0.0) {
+        if (rate != rate_before) rate_before = rate, decay = std::exp(-rate * h);
+        v_[i] *= decay;
+      }
     }
-  }
+  });
 }
 
-void World::check_state_finite() {
-  for (size_t i = 0; i < x_.size(); ++i) {
-    if (x_[i].allFinite() && v_[i].allFinite()) continue;
+void World::check_state_in_range() {
+  // The first particle (lowest index) whose position or velocity is non-finite or beyond
+  // limits::kMaxAbsValue (what a scene can hold: a state past it could not be saved and loaded back),
+  // from each part's first.
+  const size_t n = x_.size();
+  std::vector<size_t> first(static_cast<size_t>(pool_->size()), n);
+  const auto in_range = [](const Vec3& a) {  // Eigen's maxCoeff may pass over a NaN: allFinite first
+    return a.allFinite() && a.cwiseAbs().maxCoeff() <= limits::kMaxAbsValue;
+  };
+  pool_->run(0, n, 1, kParticleGrain, [&](size_t begin, size_t end, int part) {
+    for (size_t i = begin; i < end; ++i)
+      if (!in_range(x_[i]) || !in_range(v_[i])) {
+        first[static_cast<size_t>(part)] = i;
+        return;
+      }
+  });
+  const size_t i = *std::min_element(first.begin(), first.end());
+  if (i < n) {
     const int32_t bad = static_cast<int32_t>(i);
     warning_.frame = report_.frame;
     warning_.particle = bad;
-    warning_.message = "non-finite position or velocity at particle " + std::to_string(bad) + " in frame " +
-                       std::to_string(report_.frame) + "; the world was restored to the start of the frame";
+    warning_.message = "non-finite position or velocity (or beyond 1e300) at particle " + std::to_string(bad) +
+                       " in frame " + std::to_string(report_.frame) +
+                       "; the world was restored to the start of the frame";
     throw Error(ErrorCode::numerical, warning_.message);
   }
 }
@@ -439,7 +471,7 @@ void World::step(const StepControl& control) {
       apply_friction();
       settle_contacts_on_surface();
       update_velocities(h);
-      check_state_finite();
+      check_state_in_range();
     }
   } catch (...) {
     restore(start);

@@ -503,8 +503,14 @@ class World {
   /// Inverse of the joint mass of a panel corner and its partner across the slab (0: one is fixed).
   double slab_weight(int32_t a, int32_t b) const;
   // Contacts of one collider with every movable particle, or with those listed in `only`.
-  void find_collider_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
-  void find_shape_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out) const;
+  /// Contacts of `collider` with every particle (or those of `only`), appended to `out` in particle
+  /// order; the particles are split over the threads, each part's contacts appended in turn.
+  void find_collider_contacts(int32_t collider, const std::vector<int32_t>* only, std::vector<Contact>& out);
+  /// The same for the particles [begin, end) of the list (all particles, or `only`).
+  void find_collider_contacts(int32_t collider, const std::vector<int32_t>* only, size_t begin, size_t end,
+                              std::vector<Contact>& out) const;
+  void find_shape_contacts(int32_t collider, const std::vector<int32_t>* only, size_t begin, size_t end,
+                           std::vector<Contact>& out) const;
   void catch_late_contacts();
   void settle_contacts_on_surface();
   void project_contact(Contact& ct);
@@ -518,7 +524,9 @@ class World {
   void solve(double h, const StepControl& control);
   void apply_friction();
   void update_velocities(double h);
-  void check_state_finite();  // throws Error(numerical), with a Warning, at the first non-finite particle
+  // Throws Error(numerical), with a Warning, at the first particle whose position or velocity is
+  // non-finite or beyond limits::kMaxAbsValue.
+  void check_state_in_range();
   void end_frame();
   void measure();
   /// What a frame that does not complete restores (step): the state, and the pin targets,
@@ -573,6 +581,7 @@ class World {
   std::vector<double> measure_values_;                // measure(): one array's constraint values
   std::vector<double> chain_scratch_;                 // per thread: kChainScratch per link of the longest chain, + 1
   std::unique_ptr<ThreadPool> pool_;                  // Settings::threads
+  std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
   StepReport report_;
