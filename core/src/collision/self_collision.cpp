@@ -1,6 +1,7 @@
 // Self-collision: broad phase, narrow phase in space-time, projection and friction (see the header).
 #include "collision/self_collision.hpp"
 
+#include "common/pool.hpp"
 #include "common/triangle.hpp"
 
 #include <algorithm>
@@ -474,12 +475,37 @@ struct Scratch {
   std::vector<int32_t> cand;
   std::vector<double> reach;                            // per particle: the diagonal of its region
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
+  // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
+  std::vector<std::vector<int32_t>> part_cand, part_pairs;
+  std::vector<std::vector<SelfContact>> part_contacts;
 };
 
 Scratch& scratch() {
   thread_local Scratch s;
   return s;
 }
+
+/// Calls body(k, list, cand) for every k of [0, n), split over the pool's threads, each part
+/// appending to a list of its own (cand: that part's scratch for grid queries); the lists are then
+/// appended to `out` in part order, which is the order one loop over [0, n) gives.
+template <class T, class F>
+void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>>& parts,
+            std::vector<std::vector<int32_t>>& cands, std::vector<T>& out, F&& body) {
+  const size_t threads = static_cast<size_t>(pool.size());
+  parts.resize(threads);
+  cands.resize(threads);
+  for (std::vector<T>& list : parts) list.clear();
+  pool.run(0, n, 1, grain, [&](size_t begin, size_t end, int part) {
+    std::vector<T>& list = parts[static_cast<size_t>(part)];
+    std::vector<int32_t>& cand = cands[static_cast<size_t>(part)];
+    for (size_t k = begin; k < end; ++k) body(k, list, cand);
+  });
+  for (const std::vector<T>& list : parts) out.insert(out.end(), list.begin(), list.end());
+}
+
+// Items per thread below which a detection loop is not split.
+constexpr size_t kPairGrain = 256;     // primitives queried against a grid
+constexpr size_t kContactGrain = 512;  // candidate pairs measured
 
 /// A unit normal: `primary` if it has a length, else `fallback`, turned toward `side` (the vector
 /// from the second primitive to the first at the start of the substep).
@@ -598,46 +624,50 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     s.edge_grid.build(s.edge_boxes, cell);
     cache.point_triangle.clear();
     cache.edge_edge.clear();
-    for (int32_t p : s.points) {
-      s.tri_grid.query(region({p}), s.cand);
-      for (int32_t t : s.cand) {
-        const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
-        if (v[0] == p || v[1] == p || v[2] == p) continue;
-        if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) continue;
-        const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
-        double bary[3];
-        if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
-            thk + 2.0 * (s.reach[p] + reach({v[0], v[1], v[2]})))
-          continue;
-        const BodyInfo& b = in.bodies[s.tri_body[t]];
-        // Neighbours on the surface that rest within reach never count.
-        if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
-            point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
-          continue;
-        cache.point_triangle.insert(cache.point_triangle.end(), {p, t});
-      }
-    }
-    for (size_t ea = 0; ea < ne; ++ea) {
-      const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1];
-      s.edge_grid.query(s.edge_boxes[ea], s.cand);
-      for (int32_t eb : s.cand) {
-        if (static_cast<size_t>(eb) <= ea) continue;
-        const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
-        if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
-        if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) continue;
-        const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
-        double ps, pt;
-        if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >=
-            thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
-          continue;
-        if (s.edge_body[ea] == s.edge_body[eb]) {
-          const BodyInfo& b = in.bodies[s.edge_body[ea]];
-          if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
-            continue;
-        }
-        cache.edge_edge.insert(cache.edge_edge.end(), {static_cast<int32_t>(ea), eb});
-      }
-    }
+    gather(*in.pool, s.points.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
+           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+             const int32_t p = s.points[k];
+             s.tri_grid.query(region({p}), cand);
+             for (int32_t t : cand) {
+               const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+               if (v[0] == p || v[1] == p || v[2] == p) continue;
+               if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) continue;
+               const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+               double bary[3];
+               if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
+                   thk + 2.0 * (s.reach[p] + reach({v[0], v[1], v[2]})))
+                 continue;
+               const BodyInfo& b = in.bodies[s.tri_body[t]];
+               // Neighbours on the surface that rest within reach never count.
+               if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
+                   point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) <
+                       thk)
+                 continue;
+               pairs.insert(pairs.end(), {p, t});
+             }
+           });
+    gather(*in.pool, ne, kPairGrain, s.part_pairs, s.part_cand, cache.edge_edge,
+           [&](size_t ea, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+             const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1];
+             s.edge_grid.query(s.edge_boxes[ea], cand);
+             for (int32_t eb : cand) {
+               if (static_cast<size_t>(eb) <= ea) continue;
+               const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
+               if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
+               if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) continue;
+               const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+               double ps, pt;
+               if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >=
+                   thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
+                 continue;
+               if (s.edge_body[ea] == s.edge_body[eb]) {
+                 const BodyInfo& b = in.bodies[s.edge_body[ea]];
+                 if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
+                   continue;
+               }
+               pairs.insert(pairs.end(), {static_cast<int32_t>(ea), eb});
+             }
+           });
   }
 
   // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
@@ -658,75 +688,81 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   for (size_t e = 0; e < ne; ++e) s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]});
 
   // Point against triangle.
-  for (size_t k = 0; k < cache.point_triangle.size(); k += 2) {
-    const int32_t p = cache.point_triangle[k], t = cache.point_triangle[k + 1];
-    if (!s.swept_point[p].overlaps(s.swept_tri[t])) continue;
-    const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
-    const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
-    double bary[3];
-    const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
-    const double motion = (x1[p] - x0[p]).norm() + std::max({(x1[v[0]] - x0[v[0]]).norm(), (x1[v[1]] - x0[v[1]]).norm(),
-                                                             (x1[v[2]] - x0[v[2]]).norm()});
-    if (d0 >= thk + motion) continue;
-    double toi;
-    const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
-    Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
-    Vec3 primary = side;  // closest points at the start
-    if (point_triangle_toi(x0[p], x1[p], x0[v[0]], x1[v[0]], x0[v[1]], x1[v[1]], x0[v[2]], x1[v[2]], thk, toi)) {
-      point_triangle_distance(lerp(x0[p], x1[p], toi), lerp(x0[v[0]], x1[v[0]], toi), lerp(x0[v[1]], x1[v[1]], toi),
-                              lerp(x0[v[2]], x1[v[2]], toi), bary);
-      side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
-      primary = tri_n;  // touching within the substep: hold it on the triangle's side it came from
-    }
-    SelfContact c{};
-    c.ids[0] = p;
-    for (int j = 0; j < 3; ++j) c.ids[j + 1] = v[j];
-    c.weight[0] = 1.0;
-    for (int j = 0; j < 3; ++j) c.weight[j + 1] = -bary[j];
-    if (!orient_normal(primary, side, side, c.normal) && !orient_normal(tri_n, x1[p] - x0[p], x0[p] - x1[p], c.normal))
-      continue;
-    c.thickness = thk;
-    c.mu_s = mean_mu(in.mu_s, c.ids);
-    c.mu_k = mean_mu(in.mu_k, c.ids);
-    out.push_back(c);
-  }
+  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
+         [&](size_t pair, std::vector<SelfContact>& found, std::vector<int32_t>&) {
+           const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
+           if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;
+           const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+           const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+           double bary[3];
+           const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
+           const double motion =
+               (x1[p] - x0[p]).norm() +
+               std::max({(x1[v[0]] - x0[v[0]]).norm(), (x1[v[1]] - x0[v[1]]).norm(), (x1[v[2]] - x0[v[2]]).norm()});
+           if (d0 >= thk + motion) return;
+           double toi;
+           const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
+           Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+           Vec3 primary = side;  // closest points at the start
+           if (point_triangle_toi(x0[p], x1[p], x0[v[0]], x1[v[0]], x0[v[1]], x1[v[1]], x0[v[2]], x1[v[2]], thk, toi)) {
+             point_triangle_distance(lerp(x0[p], x1[p], toi), lerp(x0[v[0]], x1[v[0]], toi),
+                                     lerp(x0[v[1]], x1[v[1]], toi), lerp(x0[v[2]], x1[v[2]], toi), bary);
+             side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+             primary = tri_n;  // touching within the substep: hold it on the triangle's side it came from
+           }
+           SelfContact c{};
+           c.ids[0] = p;
+           for (int j = 0; j < 3; ++j) c.ids[j + 1] = v[j];
+           c.weight[0] = 1.0;
+           for (int j = 0; j < 3; ++j) c.weight[j + 1] = -bary[j];
+           if (!orient_normal(primary, side, side, c.normal) &&
+               !orient_normal(tri_n, x1[p] - x0[p], x0[p] - x1[p], c.normal))
+             return;
+           c.thickness = thk;
+           c.mu_s = mean_mu(in.mu_s, c.ids);
+           c.mu_k = mean_mu(in.mu_k, c.ids);
+           found.push_back(c);
+         });
 
   // Edge against edge.
-  for (size_t k = 0; k < cache.edge_edge.size(); k += 2) {
-    const size_t ea = static_cast<size_t>(cache.edge_edge[k]), eb = static_cast<size_t>(cache.edge_edge[k + 1]);
-    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) continue;
-    const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
-    const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
-    double sa, tb;
-    const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
-    const double motion = std::max((x1[a0] - x0[a0]).norm(), (x1[a1] - x0[a1]).norm()) +
-                          std::max((x1[b0] - x0[b0]).norm(), (x1[b1] - x0[b1]).norm());
-    if (d0 >= thk + motion) continue;
-    const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
-    Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
-    Vec3 primary = side;
-    double toi;
-    if (edge_edge_toi(x0[a0], x0[a1], x0[b0], x0[b1], x1[a0], x1[a1], x1[b0], x1[b1], thk, toi)) {
-      edge_edge_distance(lerp(x0[a0], x1[a0], toi), lerp(x0[a1], x1[a1], toi), lerp(x0[b0], x1[b0], toi),
-                         lerp(x0[b1], x1[b1], toi), sa, tb);
-      side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
-      primary = cross;
-    }
-    SelfContact c{};
-    c.ids[0] = a0;
-    c.ids[1] = a1;
-    c.ids[2] = b0;
-    c.ids[3] = b1;
-    c.weight[0] = 1.0 - sa;
-    c.weight[1] = sa;
-    c.weight[2] = -(1.0 - tb);
-    c.weight[3] = -tb;
-    if (!orient_normal(primary, side, side, c.normal) && !orient_normal(cross, Vec3::Zero(), side, c.normal)) continue;
-    c.thickness = thk;
-    c.mu_s = mean_mu(in.mu_s, c.ids);
-    c.mu_k = mean_mu(in.mu_k, c.ids);
-    out.push_back(c);
-  }
+  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
+         [&](size_t pair, std::vector<SelfContact>& found, std::vector<int32_t>&) {
+           const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
+           const size_t eb = static_cast<size_t>(cache.edge_edge[2 * pair + 1]);
+           if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;
+           const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
+           const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+           double sa, tb;
+           const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
+           const double motion = std::max((x1[a0] - x0[a0]).norm(), (x1[a1] - x0[a1]).norm()) +
+                                 std::max((x1[b0] - x0[b0]).norm(), (x1[b1] - x0[b1]).norm());
+           if (d0 >= thk + motion) return;
+           const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
+           Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+           Vec3 primary = side;
+           double toi;
+           if (edge_edge_toi(x0[a0], x0[a1], x0[b0], x0[b1], x1[a0], x1[a1], x1[b0], x1[b1], thk, toi)) {
+             edge_edge_distance(lerp(x0[a0], x1[a0], toi), lerp(x0[a1], x1[a1], toi), lerp(x0[b0], x1[b0], toi),
+                                lerp(x0[b1], x1[b1], toi), sa, tb);
+             side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+             primary = cross;
+           }
+           SelfContact c{};
+           c.ids[0] = a0;
+           c.ids[1] = a1;
+           c.ids[2] = b0;
+           c.ids[3] = b1;
+           c.weight[0] = 1.0 - sa;
+           c.weight[1] = sa;
+           c.weight[2] = -(1.0 - tb);
+           c.weight[3] = -tb;
+           if (!orient_normal(primary, side, side, c.normal) && !orient_normal(cross, Vec3::Zero(), side, c.normal))
+             return;
+           c.thickness = thk;
+           c.mu_s = mean_mu(in.mu_s, c.ids);
+           c.mu_k = mean_mu(in.mu_k, c.ids);
+           found.push_back(c);
+         });
 }
 
 // --- resolution ------------------------------------------------------------------------------------
@@ -800,7 +836,7 @@ void World::find_self_contacts() {
     self_contacts_.clear();
     return;
   }
-  self_collision::Input in{bodies_, x_prev_, x_, w_, radius_, mu_s_, mu_k_, &self_cache_};
+  self_collision::Input in{bodies_, x_prev_, x_, w_, radius_, mu_s_, mu_k_, &self_cache_, pool_.get()};
   self_collision::find_contacts(in, self_contacts_);
 }
 

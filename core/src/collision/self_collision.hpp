@@ -43,6 +43,7 @@ struct Input {
   std::span<const double> radius;  // half thickness per particle
   std::span<const double> mu_s, mu_k;
   SelfCollisionCache* cache;  // the candidate pairs, kept from substep to substep while they hold
+  ThreadPool* pool;           // the detection's loops are split over its threads (same result)
 };
 
 /// Finds the contacts of one substep (replaces `out`), in a deterministic order.
