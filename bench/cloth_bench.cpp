@@ -20,6 +20,7 @@
 //   ./build/bench/embra_bench --benchmark_filter='BM_ClothConfig'     the configurations compared
 //   ./build/bench/embra_bench --benchmark_filter='BM_Kernels'         cost per constraint and substep
 //   ./build/bench/embra_bench --benchmark_filter='BM_ClothDamped'     not the acceptance case: damped
+//   ./build/bench/embra_bench --benchmark_filter='BM_ClothToRest'     time until the hanging cloth is at rest
 #include "cloth_scenario.hpp"
 
 #include <benchmark/benchmark.h>
@@ -164,6 +165,58 @@ BENCHMARK(BM_ClothDamped)
     ->ArgNames({"substeps", "damping"})
     ->Args({8, 3})
     ->Args({16, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1);
+
+/// Time to an answer: the 128 x 128 cloth hanging from its two corners with velocity damping
+/// 6/s, stepped until it is at rest (max speed under 1 mm/s and max edge strain under 1 %, both
+/// held 30 frames in a row); the time is the steps' wall time until the first of those 30 frames
+/// (the strain is measured between steps, untimed). Args: {substeps, iterations, threads}. At
+/// most 3,000 frames: a case that never comes to rest reports frames_to_rest = -1.
+void BM_ClothToRest(benchmark::State& state) {
+  ClothCase c;
+  c.settings.substeps = static_cast<int32_t>(state.range(0));
+  c.settings.iterations = static_cast<int32_t>(state.range(1));
+  c.settings.threads = static_cast<int32_t>(state.range(2));
+  c.settings.damping = 6.0;
+  constexpr int kMaxFrames = 3000, kHeld = 30;
+  int rest_frame = -1;
+  double strain = 0.0;
+  for (auto _ : state) {
+    embra::World world(c.settings);
+    const auto scene = embra::bench::build_cloth(world, c);
+    double elapsed = 0.0, at_rest_since = 0.0;
+    int held = 0;
+    rest_frame = -1;
+    for (int f = 1; f <= kMaxFrames; ++f) {
+      const auto t0 = std::chrono::steady_clock::now();
+      world.step();
+      elapsed += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      strain = embra::bench::measure_strain(world, scene).max;
+      if (world.report().max_speed < 1e-3 && strain < 0.01) {
+        if (held++ == 0) at_rest_since = elapsed;
+        if (held == kHeld) {
+          rest_frame = f - kHeld + 1;
+          break;
+        }
+      } else {
+        held = 0;
+      }
+    }
+    state.SetIterationTime(rest_frame > 0 ? at_rest_since : elapsed);
+  }
+  state.counters["frames_to_rest"] = rest_frame;
+  state.counters["max_edge_strain"] = strain;
+  state.counters["threads"] = c.settings.threads;
+  state.SetLabel(describe(c) + " damping=6");
+}
+BENCHMARK(BM_ClothToRest)
+    ->ArgNames({"substeps", "iterations", "threads"})
+    ->Args({16, 1, 1})
+    ->Args({16, 1, 2})
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);

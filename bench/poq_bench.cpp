@@ -24,6 +24,7 @@ void drape(benchmark::State& state) {
   s.substeps = static_cast<int32_t>(state.range(1));
   s.iterations = static_cast<int32_t>(state.range(2));
   s.chebyshev_rho_milli = static_cast<int32_t>(state.range(3));
+  s.threads = static_cast<int32_t>(state.range(4));
   embra::World w(s);
   std::vector<double> pos;
   std::vector<int32_t> quads;
@@ -60,13 +61,14 @@ void drape(benchmark::State& state) {
 }
 
 BENCHMARK(drape)
-    ->ArgNames({"n", "substeps", "iterations", "chebyshev"})
-    ->Args({4, 60, 2, 0})
-    ->Args({16, 30, 10, 900})
-    ->Args({32, 30, 40, 900})
-    ->Args({32, 30, 24, 900})
-    ->Args({32, 30, 40, 0})
-    ->Args({32, 30, 2, 0})
+    ->ArgNames({"n", "substeps", "iterations", "chebyshev", "threads"})
+    ->Args({4, 60, 2, 0, 1})
+    ->Args({16, 30, 10, 900, 1})
+    ->Args({32, 30, 40, 900, 1})
+    ->Args({32, 30, 40, 900, 2})
+    ->Args({32, 30, 24, 900, 1})
+    ->Args({32, 30, 40, 0, 1})
+    ->Args({32, 30, 2, 0, 1})
     ->Iterations(20)
     ->Unit(benchmark::kMillisecond);
 

@@ -61,6 +61,7 @@ void BM_ClothSelfCollision(benchmark::State& state) {
   for (auto _ : state) {
     embra::Settings s;
     s.self_collision = static_cast<int32_t>(state.range(1));
+    s.threads = static_cast<int32_t>(state.range(2));
     embra::World w(s);
     build_folded_cloth(w, n);
     const auto t0 = std::chrono::steady_clock::now();
@@ -75,16 +76,22 @@ void BM_ClothSelfCollision(benchmark::State& state) {
   state.counters["ms_per_frame"] = 1e3 * seconds / (static_cast<double>(state.iterations()) * kFrames);
   state.counters["particles"] = static_cast<double>(n) * n;
   state.counters["max_contacts"] = static_cast<double>(contacts);
+  state.counters["threads"] = static_cast<double>(state.range(2));
   state.SetLabel(state.range(1) ? "self-collision on" : "self-collision off");
 }
 
+/// Args: {n, self-collision, threads}.
 BENCHMARK(BM_ClothSelfCollision)
-    ->Args({64, 1})
-    ->Args({128, 1})
-    ->Args({256, 1})
-    ->Args({64, 0})
-    ->Args({128, 0})
-    ->Args({256, 0})
+    ->ArgNames({"n", "self", "threads"})
+    ->Args({64, 1, 1})
+    ->Args({64, 1, 2})
+    ->Args({128, 1, 1})
+    ->Args({128, 1, 2})
+    ->Args({256, 1, 1})
+    ->Args({256, 1, 2})
+    ->Args({64, 0, 1})
+    ->Args({128, 0, 1})
+    ->Args({256, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);

@@ -1602,7 +1602,7 @@ void apply_actions(World& w, const SceneMeta& meta, int64_t frame) {
       case Action::Type::collider_pose: {
         const Collider& c = w.collider(a.target);
         const Eigen::Quaterniond q =
-            v.size() == 7 ? Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized() : c.desc.rotation;
+            v.size() == 7 ? unit_rotation(Eigen::Quaterniond(v[3], v[4], v[5], v[6])) : c.desc.rotation;
         w.set_collider_transform(a.target, Vec3(v[0], v[1], v[2]), q);
         break;
       }

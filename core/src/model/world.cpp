@@ -1189,7 +1189,7 @@ Id World::create_collider(const ColliderDesc& desc) {
   std::shared_ptr<const ColliderGeometry> geometry = build_collider_geometry(desc);  // validates the shape
   Collider c;
   c.desc = desc;
-  c.desc.rotation.normalize();
+  c.desc.rotation = unit_rotation(desc.rotation);
   c.geometry = std::move(geometry);
   c.frame_position = c.position = c.position_prev = desc.position;
   c.frame_rotation = c.rotation = c.rotation_prev = c.desc.rotation;
@@ -1211,7 +1211,7 @@ void World::set_collider_transform(Id id, const Vec3& position, const Eigen::Qua
   collider(id);
   check_transform(position, rotation);
   colliders_[id.index].desc.position = position;
-  colliders_[id.index].desc.rotation = rotation.normalized();
+  colliders_[id.index].desc.rotation = unit_rotation(rotation);
 }
 
 size_t World::collider_count() const {

@@ -13,8 +13,10 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -109,6 +111,13 @@ struct PinDesc {
 /// The numbering is part of the C ABI (embra_collider_shape).
 enum class ColliderShape : int32_t { plane = 0, sphere = 1, box = 2, capsule = 3, convex = 4, mesh = 5 };
 constexpr int kColliderShapeCount = 6;
+
+/// q scaled to unit length, or q itself when it is unit already to within rounding (16 ulp of its
+/// squared norm): so normalizing twice gives the bits of normalizing once, and a rotation saved to
+/// a scene loads back to the same bits.
+inline Eigen::Quaterniond unit_rotation(const Eigen::Quaterniond& q) {
+  return std::abs(q.squaredNorm() - 1.0) <= 16.0 * std::numeric_limits<double>::epsilon() ? q : q.normalized();
+}
 
 struct ColliderDesc {
   ColliderShape shape = ColliderShape::plane;
