@@ -83,6 +83,10 @@ embra_solver_def embra_default_solver_def(void) {
   return from_settings(embra::Settings());
 }
 
+embra_solver_def embra_form_finding_solver_def(void) {
+  return from_settings(embra::form_finding_settings());
+}
+
 embra_status embra_world_create(embra_world** out_world, const embra_solver_def* def) {
   if (out_world != nullptr) *out_world = nullptr;
   return guard("embra_world_create", [&] {

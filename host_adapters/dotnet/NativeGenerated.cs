@@ -431,6 +431,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_abi_version();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_check_abi(int headerAbiVersion);
         [DllImport(Library, CallingConvention = C)] public static extern SolverDef embra_default_solver_def();
+        [DllImport(Library, CallingConvention = C)] public static extern SolverDef embra_form_finding_solver_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_create(out IntPtr world, ref SolverDef def);
         [DllImport(Library, CallingConvention = C)] public static extern void embra_world_destroy(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_solver(IntPtr world, out SolverDef def);

@@ -5,6 +5,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include <string.h>
+
 #include "capi_test.h"
 
 static void test_versions(void) {
@@ -159,6 +161,18 @@ static void test_defaults(void) {
   CHECK_NEAR(s.damping, 0.0, 0.0);
   CHECK_NEAR(s.settle_speed, 1e-3, 0.0);
   CHECK_INT(s.tethers, 2);
+  CHECK_INT(s.threads, 1);
+  {
+    /* The form-finding preset: the defaults but for dt 1/15 s, 1 substep and 1 iteration. */
+    embra_solver_def f = embra_form_finding_solver_def(), d = s;
+    CHECK_NEAR(f.dt, 1.0 / 15.0, 0.0);
+    CHECK_INT(f.substeps, 1);
+    CHECK_INT(f.iterations, 1);
+    d.dt = f.dt;
+    d.substeps = f.substeps;
+    d.iterations = f.iterations;
+    CHECK(memcmp(&d, &f, sizeof d) == 0);
+  }
 
   CHECK_INT(g.version, EMBRA_GROUP_DEF_VERSION);
   CHECK_INT(g.order, 0);

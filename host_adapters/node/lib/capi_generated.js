@@ -382,6 +382,7 @@ const PROTOTYPES = {
   embra_abi_version: 'int32_t embra_abi_version(void)',
   embra_check_abi: 'embra_status embra_check_abi(int32_t header_abi_version)',
   embra_default_solver_def: 'embra_solver_def embra_default_solver_def(void)',
+  embra_form_finding_solver_def: 'embra_solver_def embra_form_finding_solver_def(void)',
   embra_world_create: 'embra_status embra_world_create(_Out_ embra_world **out_world, const embra_solver_def *def)',
   embra_world_destroy: 'void embra_world_destroy(embra_world *world)',
   embra_world_get_solver: 'embra_status embra_world_get_solver(const embra_world *world, _Out_ embra_solver_def *out_def)',

@@ -450,6 +450,7 @@ PROTOTYPES = {
     "embra_abi_version": (c_int32, []),
     "embra_check_abi": (c_int32, [c_int32]),
     "embra_default_solver_def": (SolverDef, []),
+    "embra_form_finding_solver_def": (SolverDef, []),
     "embra_world_create": (c_int32, [POINTER(c_void_p), POINTER(SolverDef)]),
     "embra_world_destroy": (None, [c_void_p]),
     "embra_world_get_solver": (c_int32, [c_void_p, POINTER(SolverDef)]),

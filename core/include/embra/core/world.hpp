@@ -397,6 +397,16 @@ struct PanelLayout {
 /// "scalar". All give the same bits; the environment variable EMBRA_KERNELS forces one.
 const char* solver_kernels();
 
+/// The form-finding preset (embra_form_finding_solver_def): the defaults with dt 1/15 s, 1 substep,
+/// 1 iteration; for the shape a structure comes to rest in rather than the motion on the way.
+inline Settings form_finding_settings() {
+  Settings s;
+  s.dt = 1.0 / 15.0;
+  s.substeps = 1;
+  s.iterations = 1;
+  return s;
+}
+
 class ThreadPool;
 
 /// The world. Not thread-safe: one thread at a time per world; different worlds are independent.
