@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace embra {
@@ -43,6 +44,28 @@ TEST(Threads, PoolCoversEveryItemOnceInAlignedParts) {
       }
     }
   }
+}
+
+/// A part that throws, on a worker or on the caller, never unwinds a worker: every part still
+/// runs, and the caller gets the exception once all are done. The pool works on afterwards.
+TEST(Threads, AThrowingPartReachesTheCaller) {
+  ThreadPool pool(3);
+  for (int thrower : {0, 1, 2}) {
+    std::atomic<int> ran{0};
+    try {
+      pool.run(0, 3000, 1, 100, [&](size_t, size_t, int part) {
+        ran.fetch_add(1);
+        if (part == thrower) throw Error(ErrorCode::internal, "part " + std::to_string(part));
+      });
+      ADD_FAILURE() << "no exception from part " << thrower;
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), "part " + std::to_string(thrower));
+    }
+    EXPECT_EQ(ran.load(), 3);
+  }
+  std::atomic<int> items{0};
+  pool.run(0, 3000, 1, 100, [&](size_t b, size_t e, int) { items.fetch_add(static_cast<int>(e - b)); });
+  EXPECT_EQ(items.load(), 3000);
 }
 
 /// A 128 x 128 cloth pinned at two corners at the default settings (chain solve, automatic tethers

@@ -40,6 +40,7 @@ T wait_change(const std::atomic<T>& a, T old) {
 
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  errors_.resize(static_cast<size_t>(threads));
   workers_.reserve(static_cast<size_t>(threads - 1));
   for (int i = 0; i + 1 < threads; ++i) workers_.emplace_back([this, i] { work(i); });
 }
@@ -55,13 +56,24 @@ void ThreadPool::publish(int parts) {
   job_.notify_all();
 }
 
+void ThreadPool::run_part(int part) noexcept {
+  try {
+    call_(context_, part);
+  } catch (...) {
+    errors_[static_cast<size_t>(part)] = std::current_exception();
+  }
+}
+
 void ThreadPool::dispatch(void (*call)(void*, int), void* context, int parts) {
   call_ = call;
   context_ = context;
+  for (std::exception_ptr& e : errors_) e = nullptr;
   pending_.store(parts - 1, std::memory_order_relaxed);
   publish(parts);
-  call(context, 0);
+  run_part(0);
   for (int left = pending_.load(std::memory_order_acquire); left != 0;) left = wait_change(pending_, left);
+  for (const std::exception_ptr& e : errors_)
+    if (e) std::rethrow_exception(e);
 }
 
 void ThreadPool::work(int index) {
@@ -71,7 +83,7 @@ void ThreadPool::work(int index) {
     const int parts = static_cast<int>(seen & 0xffff);
     if (parts == 0) return;
     if (index + 1 < parts) {
-      call_(context_, index + 1);
+      run_part(index + 1);
       if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
     }
   }

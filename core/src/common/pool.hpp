@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -36,7 +37,8 @@ class ThreadPool {
   /// Calls fn(part_begin, part_end, part) over [begin, end) cut into at most size() contiguous parts,
   /// each (but the last) a multiple of `align` items long and at least `grain` items; fewer parts
   /// when the range is short (a range under 2 * grain runs on the caller alone). `part` is in
-  /// [0, size()): the index of per-thread scratch. Returns when every part is done.
+  /// [0, size()): the index of per-thread scratch. Returns when every part is done; an exception a
+  /// part threw (on whichever thread) is thrown here then, the first part's first.
   template <class F>
   void run(size_t begin, size_t end, size_t align, size_t grain, F&& fn) {
     const size_t n = end > begin ? end - begin : 0;
@@ -66,6 +68,9 @@ class ThreadPool {
     }
   };
 
+  /// Runs part `part` of the current job, keeping what it throws for dispatch to throw.
+  void run_part(int part) noexcept;
+
   /// Runs call(context, p) for p in [0, parts): parts 1 .. parts - 1 on workers, 0 here.
   void dispatch(void (*call)(void*, int), void* context, int parts);
   void publish(int parts);  // a new job number with `parts` parts (0: stop)
@@ -79,7 +84,8 @@ class ThreadPool {
   // (job number << 16) | parts: one word, so that a worker sees a job's number and part count
   // together. 0 parts: stop.
   std::atomic<uint64_t> job_{0};
-  std::atomic<int> pending_{0};  // worker parts of the current job not yet done
+  std::atomic<int> pending_{0};             // worker parts of the current job not yet done
+  std::vector<std::exception_ptr> errors_;  // per part: what it threw (a worker must never unwind)
 };
 
 }  // namespace embra
