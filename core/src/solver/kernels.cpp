@@ -752,32 +752,38 @@ constexpr size_t kAlign = 4;  // parts start on a block of the widest lanes
 
 }  // namespace
 
-void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, double* x, const double* w) {
-  const size_t colours = a.colours();
+namespace {
+
+/// Calls run(begin, end, in_lanes, part) for each colour [starts[c], starts[c + 1]) in order: split
+/// over the pool's threads in blocks of lanes, except a shared tail (the last colour, when
+/// `shared_tail`: its items may overlap), which runs whole on the caller, one item at a time.
+template <class F>
+void each_colour(ThreadPool& pool, const std::vector<int32_t>& starts, bool shared_tail, size_t grain, F&& run) {
+  const size_t colours = starts.empty() ? 0 : starts.size() - 1;
   for (size_t c = 0; c < colours; ++c) {
-    const size_t begin = static_cast<size_t>(a.colour_start[c]), end = static_cast<size_t>(a.colour_start[c + 1]);
-    if (a.shared_tail && c + 1 == colours)
-      kernel(a, begin, end, false, inv_h2, x, w);
+    const size_t begin = static_cast<size_t>(starts[c]), end = static_cast<size_t>(starts[c + 1]);
+    if (shared_tail && c + 1 == colours)
+      run(begin, end, false, 0);
     else
-      pool.run(begin, end, kAlign, kGrain, [&](size_t b, size_t e, int) { kernel(a, b, e, true, inv_h2, x, w); });
+      pool.run(begin, end, kAlign, grain, [&](size_t b, size_t e, int part) { run(b, e, true, part); });
   }
+}
+
+}  // namespace
+
+void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, double* x, const double* w) {
+  each_colour(pool, a.colour_start, a.shared_tail, kGrain,
+              [&](size_t b, size_t e, bool in_lanes, int) { kernel(a, b, e, in_lanes, inv_h2, x, w); });
 }
 
 void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, const double* w,
                 std::vector<double>& scratch) {
   const Kernels& k = kernels();
-  const size_t colours = a.chain_colour_start.empty() ? 0 : a.chain_colour_start.size() - 1;
   const size_t stride = scratch.size() / static_cast<size_t>(pool.size());
-  for (size_t c = 0; c < colours; ++c) {
-    const size_t begin = static_cast<size_t>(a.chain_colour_start[c]);
-    const size_t end = static_cast<size_t>(a.chain_colour_start[c + 1]);
-    if (a.chain_shared_tail && c + 1 == colours)
-      k.chain(a, begin, end, false, inv_h2, x, w, scratch.data());
-    else
-      pool.run(begin, end, kAlign, kChainGrain, [&](size_t b, size_t e, int part) {
-        k.chain(a, b, e, true, inv_h2, x, w, scratch.data() + stride * static_cast<size_t>(part));
-      });
-  }
+  each_colour(pool, a.chain_colour_start, a.chain_shared_tail, kChainGrain,
+              [&](size_t b, size_t e, bool in_lanes, int part) {
+                k.chain(a, b, e, in_lanes, inv_h2, x, w, scratch.data() + stride * static_cast<size_t>(part));
+              });
 }
 
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w) {

@@ -28,6 +28,7 @@
 #include "solver/kernels.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -301,31 +302,26 @@ void World::update_velocities(double h) {
 }
 
 void World::check_state_in_range() {
-  // The first particle (lowest index) whose position or velocity is non-finite or beyond
-  // limits::kMaxAbsValue (what a scene can hold: a state past it could not be saved and loaded back),
-  // from each part's first.
-  const size_t n = x_.size();
-  std::vector<size_t> first(static_cast<size_t>(pool_->size()), n);
-  const auto in_range = [](const Vec3& a) {  // Eigen's maxCoeff may pass over a NaN: allFinite first
-    return a.allFinite() && a.cwiseAbs().maxCoeff() <= limits::kMaxAbsValue;
+  // A position or velocity non-finite or beyond limits::kMaxAbsValue (a state no scene could hold:
+  // it would not load back) fails the frame. NaN fails every comparison, so it is never in range.
+  const auto in_range = [&](size_t i) {
+    return (x_[i].array().abs() <= limits::kMaxAbsValue).all() && (v_[i].array().abs() <= limits::kMaxAbsValue).all();
   };
-  pool_->run(0, n, 1, kParticleGrain, [&](size_t begin, size_t end, int part) {
-    for (size_t i = begin; i < end; ++i)
-      if (!in_range(x_[i]) || !in_range(v_[i])) {
-        first[static_cast<size_t>(part)] = i;
-        return;
-      }
+  std::atomic<bool> bad_found{false};
+  each_particle(*pool_, x_.size(), [&](size_t i) {
+    if (!in_range(i)) bad_found.store(true, std::memory_order_relaxed);
   });
-  const size_t i = *std::min_element(first.begin(), first.end());
-  if (i < n) {
-    const int32_t bad = static_cast<int32_t>(i);
-    warning_.frame = report_.frame;
-    warning_.particle = bad;
-    warning_.message = "non-finite position or velocity (or beyond 1e300) at particle " + std::to_string(bad) +
-                       " in frame " + std::to_string(report_.frame) +
-                       "; the world was restored to the start of the frame";
-    throw Error(ErrorCode::numerical, warning_.message);
-  }
+  if (!bad_found.load(std::memory_order_relaxed)) return;
+  // The frame fails: name the first such particle (lowest index), found on this thread.
+  size_t i = 0;
+  while (in_range(i)) ++i;
+  const int32_t bad = static_cast<int32_t>(i);
+  warning_.frame = report_.frame;
+  warning_.particle = bad;
+  warning_.message = "non-finite position or velocity (or beyond 1e300) at particle " + std::to_string(bad) +
+                     " in frame " + std::to_string(report_.frame) +
+                     "; the world was restored to the start of the frame";
+  throw Error(ErrorCode::numerical, warning_.message);
 }
 
 void World::measure() {
