@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace embra::self_collision {
 
@@ -22,6 +23,9 @@ constexpr double kMinGap = 1e-6;
 /// benchmark, bench/self_collision_bench.cpp).
 constexpr double kRegionMotion = 3.0;
 constexpr double kRegionThickness = 0.25;
+/// The broad phase's grids are built again when more than one primitive in kRegrid has moved since
+/// they were built.
+constexpr size_t kRegrid = 4;
 
 struct Box {
   Vec3 lo, hi;
@@ -66,11 +70,10 @@ class Grid {
     }
   }
 
-  /// The boxes overlapping `q`, each once, in a deterministic order (cell by cell, increasing index
-  /// within a cell). A pair is reported only in the cell holding the low corner of the two boxes'
-  /// intersection, so no sort is needed to drop the duplicates.
+  /// Appends the boxes overlapping `q` to `out`, each once, in a deterministic order (cell by cell,
+  /// increasing index within a cell). A pair is reported only in the cell holding the low corner of
+  /// the two boxes' intersection, so no sort is needed to drop the duplicates.
   void query(const Box& q, std::vector<int32_t>& out) const {
-    out.clear();
     const int64_t n = cells(q);
     if (n > kMaxCells) {  // a huge query: every box
       for (size_t i = 0; i < boxes_.size(); ++i)
@@ -301,6 +304,28 @@ int exact_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 
 }  // namespace
 
+}  // namespace embra::self_collision
+
+namespace embra {
+
+/// What the broad phase keeps from substep to substep besides the pairs (SelfCollisionCache):
+/// each primitive's region box, each particle's reach, the grids of the last full rebuild and the
+/// primitives moved since with grids of their own.
+struct SelfCollisionIndex {
+  std::vector<self_collision::Box> tri_boxes, edge_boxes, point_boxes;  // point_boxes in points order
+  std::vector<double> reach;                                            // per particle: its region's diagonal
+  double cell = 1.0;
+  self_collision::Grid tri_grid, edge_grid, point_grid;
+  std::vector<uint8_t> tri_moved, edge_moved, point_moved;
+  std::vector<int32_t> moved_tris, moved_edges, moved_points;
+  std::vector<self_collision::Box> moved_tri_boxes, moved_edge_boxes, moved_point_boxes;
+  self_collision::Grid moved_tri_grid, moved_edge_grid, moved_point_grid;
+};
+
+}  // namespace embra
+
+namespace embra::self_collision {
+
 int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const Vec3 u = b - a, v = c - a, w = d - a;
   const double det = u.x() * (v.y() * w.z() - v.z() * w.y()) + u.y() * (v.z() * w.x() - v.x() * w.z()) +
@@ -337,6 +362,7 @@ int64_t count_edge_triangle_crossings(std::span<const Vec3> x, std::span<const i
   int64_t count = 0;
   for (size_t e = 0; e + 1 < edges.size(); e += 2) {
     const int32_t p = edges[e], q = edges[e + 1];
+    cand.clear();
     grid.query(box_of({x[p], x[q]}, 0.0), cand);
     for (int32_t t : cand) {
       const int32_t* v = &triangles[3 * static_cast<size_t>(t)];
@@ -470,10 +496,10 @@ namespace {
 struct Scratch {
   std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
   std::vector<int32_t> tri_body, edge_body;
-  std::vector<Box> tri_boxes, edge_boxes;
-  Grid tri_grid, edge_grid;
+  // The particles that left their regions (points order) and the primitives holding them.
+  std::vector<int32_t> left, changed_tris, changed_edges;
+  std::vector<uint8_t> changed, tri_changed, edge_changed;
   std::vector<int32_t> cand;
-  std::vector<double> reach;                            // per particle: the diagonal of its region
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
   std::vector<std::vector<int32_t>> part_cand, part_pairs;
@@ -575,25 +601,45 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   //    being measured again in every substep.
   // So the pairs measured below are a superset of those the swept bounds would give, and the
   // contacts are the same as with a broad phase rebuilt every substep.
-  bool valid = cache.lo.size() == x1.size() && cache.triangles == nt && cache.edges == ne;
+  // A pair's regions are those of its particles, so only the pairs with a particle that left its
+  // region need finding again: that particle gets a new region and the primitives holding it are
+  // queried again; the other pairs are kept. The grids are those of the last full rebuild, with the
+  // primitives whose regions changed since then in small grids of their own; when more than one
+  // primitive in kFullRebuild has changed, the grids are built again and every pair found again.
+  if (!cache.index) cache.index = std::make_shared<SelfCollisionIndex>();
+  SelfCollisionIndex& ix = *cache.index;
+  const size_t np = s.points.size();
+  const bool cached =
+      cache.lo.size() == x1.size() && cache.triangles == nt && cache.edges == ne && ix.point_boxes.size() == np;
   auto inside = [&](const Vec3& p, int32_t i) {
     return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
   };
-  for (size_t k = 0; valid && k < s.points.size(); ++k) {
+  s.left.clear();
+  for (size_t k = 0; k < np; ++k) {
     const int32_t i = s.points[k];
-    valid = inside(x0[i], i) && inside(x1[i], i);
+    if (!cached || !inside(x0[i], i) || !inside(x1[i], i)) s.left.push_back(static_cast<int32_t>(k));
   }
-  if (!valid) {
-    cache.lo.assign(x1.size(), Vec3::Zero());
-    cache.hi.assign(x1.size(), Vec3::Zero());
-    s.reach.assign(x1.size(), 0.0);
-    cache.triangles = nt;
-    cache.edges = ne;
-    for (int32_t i : s.points) {
+  if (!s.left.empty()) {
+    if (!cached) {
+      cache.lo.assign(x1.size(), Vec3::Zero());
+      cache.hi.assign(x1.size(), Vec3::Zero());
+      cache.triangles = nt;
+      cache.edges = ne;
+      ix = SelfCollisionIndex{};
+      ix.reach.assign(x1.size(), 0.0);
+      ix.tri_boxes.resize(nt);
+      ix.edge_boxes.resize(ne);
+      ix.point_boxes.resize(np);
+    }
+    // New regions for the particles that left (every particle the first time).
+    s.changed.assign(x1.size(), 0);
+    for (int32_t k : s.left) {
+      const int32_t i = s.points[k];
       const double margin = kRegionMotion * (x1[i] - x0[i]).norm() + kRegionThickness * grow_of(i);
       cache.lo[i] = x0[i].cwiseMin(x1[i]).array() - margin;
       cache.hi[i] = x0[i].cwiseMax(x1[i]).array() + margin;
-      s.reach[i] = (cache.hi[i] - cache.lo[i]).norm();
+      ix.reach[i] = (cache.hi[i] - cache.lo[i]).norm();
+      s.changed[i] = 1;
     }
     auto region = [&](std::initializer_list<int32_t> ids) {
       Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
@@ -610,62 +656,149 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     };
     auto reach = [&](std::initializer_list<int32_t> ids) {
       double d = 0.0;
-      for (int32_t i : ids) d = std::max(d, s.reach[i]);
+      for (int32_t i : ids) d = std::max(d, ix.reach[i]);
       return d;
     };
-    s.tri_boxes.resize(nt);
-    for (size_t t = 0; t < nt; ++t) s.tri_boxes[t] = region({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]});
-    s.edge_boxes.resize(ne);
-    for (size_t e = 0; e < ne; ++e) s.edge_boxes[e] = region({s.edges[2 * e], s.edges[2 * e + 1]});
-    // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
-    // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
-    const double cell = mean_extent(s.tri_boxes);
-    s.tri_grid.build(s.tri_boxes, cell);
-    s.edge_grid.build(s.edge_boxes, cell);
-    cache.point_triangle.clear();
-    cache.edge_edge.clear();
-    gather(*in.pool, s.points.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
+    // The primitives holding them: new boxes, and marked as moved since the last full rebuild.
+    s.changed_tris.clear();
+    s.changed_edges.clear();
+    s.tri_changed.assign(nt, 0);
+    s.edge_changed.assign(ne, 0);
+    ix.tri_moved.resize(nt, 0);
+    ix.edge_moved.resize(ne, 0);
+    ix.point_moved.resize(np, 0);
+    for (size_t t = 0; t < nt; ++t) {
+      const int32_t* v = &s.tris[3 * t];
+      if (!s.changed[v[0]] && !s.changed[v[1]] && !s.changed[v[2]]) continue;
+      ix.tri_boxes[t] = region({v[0], v[1], v[2]});
+      s.tri_changed[t] = 1;
+      s.changed_tris.push_back(static_cast<int32_t>(t));
+      if (!ix.tri_moved[t]) ix.tri_moved[t] = 1, ix.moved_tris.push_back(static_cast<int32_t>(t));
+    }
+    for (size_t e = 0; e < ne; ++e) {
+      const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
+      if (!s.changed[a] && !s.changed[b]) continue;
+      ix.edge_boxes[e] = region({a, b});
+      s.edge_changed[e] = 1;
+      s.changed_edges.push_back(static_cast<int32_t>(e));
+      if (!ix.edge_moved[e]) ix.edge_moved[e] = 1, ix.moved_edges.push_back(static_cast<int32_t>(e));
+    }
+    for (int32_t k : s.left) {
+      ix.point_boxes[k] = region({s.points[k]});
+      if (!ix.point_moved[k]) ix.point_moved[k] = 1, ix.moved_points.push_back(k);
+    }
+    // The grids are built again when too many primitives have moved since they were built (the
+    // pairs are kept); else the moved primitives get small grids of their own.
+    const bool regrid = !cached || ix.moved_tris.size() * kRegrid > nt || ix.moved_edges.size() * kRegrid > ne ||
+                        ix.moved_points.size() * kRegrid > np;
+    if (regrid) {
+      // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
+      // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
+      ix.cell = mean_extent(ix.tri_boxes);
+      ix.tri_grid.build(ix.tri_boxes, ix.cell);
+      ix.edge_grid.build(ix.edge_boxes, ix.cell);
+      ix.point_grid.build(ix.point_boxes, ix.cell);
+      for (int32_t t : ix.moved_tris) ix.tri_moved[t] = 0;
+      for (int32_t e : ix.moved_edges) ix.edge_moved[e] = 0;
+      for (int32_t k : ix.moved_points) ix.point_moved[k] = 0;
+      ix.moved_tris.clear(), ix.moved_edges.clear(), ix.moved_points.clear();
+    } else {
+      auto moved_boxes = [](const std::vector<int32_t>& ids, const std::vector<Box>& boxes, std::vector<Box>& into) {
+        into.resize(ids.size());
+        for (size_t k = 0; k < ids.size(); ++k) into[k] = boxes[ids[k]];
+      };
+      moved_boxes(ix.moved_tris, ix.tri_boxes, ix.moved_tri_boxes);
+      moved_boxes(ix.moved_edges, ix.edge_boxes, ix.moved_edge_boxes);
+      moved_boxes(ix.moved_points, ix.point_boxes, ix.moved_point_boxes);
+      ix.moved_tri_grid.build(ix.moved_tri_boxes, ix.cell);
+      ix.moved_edge_grid.build(ix.moved_edge_boxes, ix.cell);
+      ix.moved_point_grid.build(ix.moved_point_boxes, ix.cell);
+    }
+    // The kept pairs: neither side holds a particle with a new region.
+    auto keep = [](std::vector<int32_t>& pairs, auto&& stays) {
+      size_t kept = 0;
+      for (size_t k = 0; k < pairs.size(); k += 2)
+        if (stays(pairs[k], pairs[k + 1])) {
+          pairs[kept++] = pairs[k];
+          pairs[kept++] = pairs[k + 1];
+        }
+      pairs.resize(kept);
+    };
+    keep(cache.point_triangle, [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
+    keep(cache.edge_edge, [&](int32_t a, int32_t b) { return !s.edge_changed[a] && !s.edge_changed[b]; });
+    // The primitives whose regions overlap q: the full rebuild's grid, less those that moved since,
+    // and the grid of those.
+    auto query = [&](const Grid& grid, const std::vector<uint8_t>& moved, const Grid& moved_grid,
+                     const std::vector<int32_t>& moved_ids, const Box& q, std::vector<int32_t>& cand) {
+      cand.clear();
+      grid.query(q, cand);
+      if (moved_ids.empty()) return;
+      size_t kept = 0;
+      for (int32_t c : cand)
+        if (!moved[c]) cand[kept++] = c;
+      cand.resize(kept);
+      moved_grid.query(q, cand);
+      for (size_t k = kept; k < cand.size(); ++k) cand[k] = moved_ids[cand[k]];
+    };
+    // A pair is kept when the two can come within their thickness while their particles stay in
+    // their regions (see above), and they are not neighbours on the surface at rest.
+    auto point_triangle_pair = [&](int32_t p, int32_t t, std::vector<int32_t>& pairs) {
+      const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+      if (v[0] == p || v[1] == p || v[2] == p) return;
+      if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) return;
+      const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+      double bary[3];
+      if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
+          thk + 2.0 * (ix.reach[p] + reach({v[0], v[1], v[2]})))
+        return;
+      const BodyInfo& b = in.bodies[s.tri_body[t]];
+      if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
+          point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
+        return;
+      pairs.insert(pairs.end(), {p, t});
+    };
+    auto edge_edge_pair = [&](int32_t ea, int32_t eb, std::vector<int32_t>& pairs) {
+      const int32_t a0 = s.edges[2 * static_cast<size_t>(ea)], a1 = s.edges[2 * static_cast<size_t>(ea) + 1];
+      const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
+      if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) return;
+      if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) return;
+      const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+      double ps, pt;
+      if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
+        return;
+      if (s.edge_body[ea] == s.edge_body[eb]) {
+        const BodyInfo& b = in.bodies[s.edge_body[ea]];
+        if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk) return;
+      }
+      pairs.insert(pairs.end(), {ea, eb});
+    };
+    // Point against triangle: each particle with a new region against every triangle, then each
+    // triangle with a new region against the particles that kept theirs.
+    gather(*in.pool, s.left.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
            [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
-             const int32_t p = s.points[k];
-             s.tri_grid.query(region({p}), cand);
-             for (int32_t t : cand) {
-               const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
-               if (v[0] == p || v[1] == p || v[2] == p) continue;
-               if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) continue;
-               const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
-               double bary[3];
-               if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
-                   thk + 2.0 * (s.reach[p] + reach({v[0], v[1], v[2]})))
-                 continue;
-               const BodyInfo& b = in.bodies[s.tri_body[t]];
-               // Neighbours on the surface that rest within reach never count.
-               if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
-                   point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) <
-                       thk)
-                 continue;
-               pairs.insert(pairs.end(), {p, t});
-             }
+             const int32_t q = s.left[k];
+             query(ix.tri_grid, ix.tri_moved, ix.moved_tri_grid, ix.moved_tris, ix.point_boxes[q], cand);
+             for (int32_t t : cand) point_triangle_pair(s.points[q], t, pairs);
            });
-    gather(*in.pool, ne, kPairGrain, s.part_pairs, s.part_cand, cache.edge_edge,
-           [&](size_t ea, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
-             const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1];
-             s.edge_grid.query(s.edge_boxes[ea], cand);
+    if (s.left.size() < np)
+      gather(*in.pool, s.changed_tris.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
+             [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+               const int32_t t = s.changed_tris[k];
+               query(ix.point_grid, ix.point_moved, ix.moved_point_grid, ix.moved_points, ix.tri_boxes[t], cand);
+               for (int32_t q : cand)
+                 if (!s.changed[s.points[q]]) point_triangle_pair(s.points[q], t, pairs);
+             });
+    // Edge against edge, each pair once, the lower edge first.
+    gather(*in.pool, s.changed_edges.size(), kPairGrain, s.part_pairs, s.part_cand, cache.edge_edge,
+           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+             const int32_t ea = s.changed_edges[k];
+             query(ix.edge_grid, ix.edge_moved, ix.moved_edge_grid, ix.moved_edges, ix.edge_boxes[ea], cand);
              for (int32_t eb : cand) {
-               if (static_cast<size_t>(eb) <= ea) continue;
-               const int32_t b0 = s.edges[2 * static_cast<size_t>(eb)], b1 = s.edges[2 * static_cast<size_t>(eb) + 1];
-               if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
-               if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) continue;
-               const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
-               double ps, pt;
-               if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >=
-                   thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
-                 continue;
-               if (s.edge_body[ea] == s.edge_body[eb]) {
-                 const BodyInfo& b = in.bodies[s.edge_body[ea]];
-                 if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
-                   continue;
-               }
-               pairs.insert(pairs.end(), {static_cast<int32_t>(ea), eb});
+               if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
+               if (ea < eb)
+                 edge_edge_pair(ea, eb, pairs);
+               else
+                 edge_edge_pair(eb, ea, pairs);
              }
            });
   }

@@ -288,11 +288,13 @@ struct SelfContact {
 
 /// Self-collision candidate pairs (core/src/self_collision.hpp), kept while every particle stays
 /// inside the region [lo, hi] it had when they were found.
+struct SelfCollisionIndex;  // collision/self_collision.cpp
 struct SelfCollisionCache {
-  std::vector<Vec3> lo, hi;             // per particle
-  std::vector<int32_t> point_triangle;  // (particle, triangle) pairs
-  std::vector<int32_t> edge_edge;       // (edge, edge) pairs
-  size_t triangles = 0, edges = 0;      // the primitive counts they were found for
+  std::vector<Vec3> lo, hi;                   // per particle
+  std::vector<int32_t> point_triangle;        // (particle, triangle) pairs
+  std::vector<int32_t> edge_edge;             // (edge, edge) pairs
+  size_t triangles = 0, edges = 0;            // the primitive counts they were found for
+  std::shared_ptr<SelfCollisionIndex> index;  // the regions' boxes and grids
 };
 
 struct Contact {
