@@ -54,6 +54,8 @@ CORE_ENUMS: Dict[str, Tuple[str, Optional[str]]] = {
     "COLLIDER": ("embra::ColliderShape", "embra::kColliderShapeCount"),
     "PANEL_PINS": ("embra::PanelPins", None),
     "PANEL_METRIC": ("embra::PanelMetric", "embra::kPanelMetricCount"),
+    "SOLVE_UNTIL": ("embra::SolveUntil", None),
+    "SOLVE": ("embra::SolveOutcome", None),
 }
 
 # C# names of enum groups where the PascalCase of the prefix is not the name.
@@ -600,7 +602,8 @@ def gen_pins(h: Header) -> str:
            "// Included by capi/src/status.cpp: the C ABI casts these C enums to the core's, so each core",
            "// value is pinned to its C value, and a core enum's count to the length of the C list.",
            "// clang-format off", "#pragma once", "",
-           '#include "embra/core/kinds.hpp"', '#include "embra/core/panels.hpp"', '#include "embra/core/world.hpp"', ""]
+           '#include "embra/core/kinds.hpp"', '#include "embra/core/panels.hpp"', '#include "embra/core/solve.hpp"',
+           '#include "embra/core/world.hpp"', ""]
     for prefix, (core, count) in CORE_ENUMS.items():
         if prefix not in names:
             raise ParseError(f"CORE_ENUMS names EMBRA_{prefix}_*, which embra.h lacks")

@@ -7,6 +7,7 @@
 
 #include "embra/core/kinds.hpp"
 #include "embra/core/panels.hpp"
+#include "embra/core/solve.hpp"
 #include "embra/core/world.hpp"
 
 static_assert(static_cast<int>(embra::Kind::distance) == 0, "embra::Kind::distance is EMBRA_CONSTRAINT_DISTANCE = 0");
@@ -38,3 +39,11 @@ static_assert(static_cast<int>(embra::PanelMetric::miter) == 2, "embra::PanelMet
 static_assert(static_cast<int>(embra::PanelMetric::corner_distance) == 3, "embra::PanelMetric::corner_distance is EMBRA_PANEL_METRIC_CORNER_DISTANCE = 3");
 static_assert(static_cast<int>(embra::PanelMetric::conical) == 4, "embra::PanelMetric::conical is EMBRA_PANEL_METRIC_CONICAL = 4");
 static_assert(embra::kPanelMetricCount == 5, "embra::PanelMetric and the 5 EMBRA_PANEL_METRIC_* values differ");
+
+static_assert(static_cast<int>(embra::SolveUntil::settled) == 0, "embra::SolveUntil::settled is EMBRA_SOLVE_UNTIL_SETTLED = 0");
+static_assert(static_cast<int>(embra::SolveUntil::tolerance) == 1, "embra::SolveUntil::tolerance is EMBRA_SOLVE_UNTIL_TOLERANCE = 1");
+
+static_assert(static_cast<int>(embra::SolveOutcome::settled_within_tolerance) == 0, "embra::SolveOutcome::settled_within_tolerance is EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE = 0");
+static_assert(static_cast<int>(embra::SolveOutcome::settled_out_of_tolerance) == 1, "embra::SolveOutcome::settled_out_of_tolerance is EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE = 1");
+static_assert(static_cast<int>(embra::SolveOutcome::oscillating) == 2, "embra::SolveOutcome::oscillating is EMBRA_SOLVE_OSCILLATING = 2");
+static_assert(static_cast<int>(embra::SolveOutcome::drifting) == 3, "embra::SolveOutcome::drifting is EMBRA_SOLVE_DRIFTING = 3");

@@ -3,7 +3,8 @@
  *   embra version
  *   embra help
  *   embra validate SCENE.json [--allow-outside-paths]
- *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--allow-outside-paths]
+ *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]
+ *             [--allow-outside-paths]
  *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
@@ -13,7 +14,9 @@
  * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
  * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses.
  * --threads T steps on T threads (0: one per core; default: the scene's solver.threads): the same
- * bits at any T, and final.json keeps the scene's own setting.
+ * bits at any T, and final.json keeps the scene's own setting. --until settled|tolerance steps with
+ * embra_world_solve (N frames at most, 1000 by default) and prints why it stopped; it writes the
+ * final files and one metrics record (the last frame).
  *
  * A scene's OBJ paths resolve against the scene file's folder and must stay inside it (no absolute
  * path, no ".." or symbolic link leading out: a scene file may come from anyone);
@@ -26,7 +29,8 @@
  * second (moving pin targets, as a designer would drag them), then held while the form settles.
  * It prints convergence as it goes and writes OBJ files of the shell.
  *
- * Exit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state). */
+ * Exit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state), 4 --until:
+ * the world did not come to rest within tolerance. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
@@ -40,13 +44,14 @@
 
 #include "embra/embra.h"
 
-enum { EXIT_USAGE = 1, EXIT_INVALID = 2, EXIT_SIM = 3 };
+enum { EXIT_USAGE = 1, EXIT_INVALID = 2, EXIT_SIM = 3, EXIT_UNSETTLED = 4 };
 
 static const char kUsage[] =
     "usage: embra version\n"
     "       embra help\n"
     "       embra validate SCENE.json [--allow-outside-paths]\n"
-    "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--allow-outside-paths]\n"
+    "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]\n"
+    "                 [--allow-outside-paths]\n"
     "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]\n";
 
 static int usage(void) {
@@ -63,6 +68,11 @@ static int help(void) {
       "          DIR/final.json, DIR/metrics.jsonl, DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
       "          --threads T steps on T threads (0: one per core; default: the scene's solver.threads);\n"
       "          the results are the same bits at any T, and final.json keeps the scene's own setting.\n"
+      "          --until settled|tolerance steps until the world is at rest (and, with tolerance, every\n"
+      "          panel mesh within its tolerance targets) or N frames have passed, with embra_world_solve,\n"
+      "          and says why it stopped: at rest within or out of tolerance (the worst metric and where),\n"
+      "          or still moving, oscillating (with its period) or drifting. N defaults to 1000 there; the\n"
+      "          per-frame lines and frame OBJs are not written, metrics.jsonl holds the last frame.\n"
       "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files.\n"
       "\n"
       "OBJ files a scene names: paths are relative to the scene file's folder and must stay inside it\n"
@@ -71,7 +81,10 @@ static int help(void) {
       stdout);
   printf("be a regular file (no folder, device or pipe) of at most %lld bytes (EMBRA_MAX_OBJ_BYTES).\n",
          (long long)EMBRA_MAX_OBJ_BYTES);
-  fputs("\nExit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state).\n", stdout);
+  fputs(
+      "\nExit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state),\n"
+      "4 --until: the world did not come to rest within tolerance.\n",
+      stdout);
   return 0;
 }
 
@@ -619,11 +632,45 @@ static int set_threads(embra_world* world, int32_t threads, int32_t* before) {
   return embra_world_set_solver(world, &s) == EMBRA_OK ? 0 : -1;
 }
 
+/* Why embra_world_solve stopped, for a person. */
+static void print_solve_outcome(const embra_solve_result* s, const embra_world* world) {
+  static const char* const metric_names[] = {"planarity", "thickness error", "miter twist", "corner off plane"};
+  const char* metric = s->worst_metric >= 0 && s->worst_metric < 4 ? metric_names[s->worst_metric] : "";
+  char where[200] = "";
+  if (s->worst_metric >= 0) {
+    embra_tolerances tol;
+    embra_world_get_tolerances(world, &tol);
+    snprintf(where, sizeof where, "%s %.3e (target %.3e) at %s %d%s of panel mesh body %u", metric, s->worst_value,
+             s->worst_target, s->worst_metric == EMBRA_PANEL_METRIC_MITER ? "joint" : "panel", s->worst_element,
+             s->worst_layer == 0   ? " (top)"
+             : s->worst_layer == 1 ? " (bottom)"
+                                   : "",
+             s->worst_body.index);
+  }
+  switch (s->outcome) {
+    case EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE:
+      printf("%-18s at rest and within tolerance after %d frames%s%s\n", "stopped", s->frames,
+             s->worst_metric >= 0 ? "; closest to its target: " : "", where);
+      break;
+    case EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE:
+      printf("%-18s at rest after %d frames but out of tolerance: %s\n", "stopped", s->frames, where);
+      break;
+    case EMBRA_SOLVE_OSCILLATING:
+      printf("%-18s still moving after %d frames: oscillating with a period of %.4g s\n", "stopped", s->frames,
+             s->period);
+      break;
+    default:
+      printf("%-18s still moving after %d frames: drifting (no period)\n", "stopped", s->frames);
+      break;
+  }
+}
+
 static int cmd_run(int argc, char** argv) {
   if (argc < 1) return usage();
   const char* scene = argv[0];
   const char* out = "out";
   long frames = -1, every = 0, threads = -1;
+  int until = -1; /* EMBRA_SOLVE_UNTIL_*, or -1: step N frames */
   int allow_outside = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--allow-outside-paths") == 0) {
@@ -639,6 +686,14 @@ static int cmd_run(int argc, char** argv) {
       if (parse_int(argv[++i], 0, EMBRA_MAX_THREADS, &threads)) return usage();
     } else if (strcmp(argv[i], "--out") == 0) {
       out = argv[++i];
+    } else if (strcmp(argv[i], "--until") == 0) {
+      ++i;
+      if (strcmp(argv[i], "settled") == 0)
+        until = EMBRA_SOLVE_UNTIL_SETTLED;
+      else if (strcmp(argv[i], "tolerance") == 0)
+        until = EMBRA_SOLVE_UNTIL_TOLERANCE;
+      else
+        return usage();
     } else {
       return usage();
     }
@@ -654,11 +709,21 @@ static int cmd_run(int argc, char** argv) {
     embra_world_destroy(world);
     return EXIT_INVALID;
   }
-  if (frames < 0) {
+  embra_solve_def solve_def = embra_default_solve_def();
+  embra_solve_result solved;
+  memset(&solved, 0, sizeof solved);
+  if (until >= 0) {
+    solve_def.until = until;
+    if (frames > 0) solve_def.max_frames = (int32_t)frames; /* --frames is at most 1e8 */
+    frames = frames == 0 ? 0 : solve_def.max_frames;
+  } else if (frames < 0) {
     int64_t f = 0;
     embra_world_get_scene_frames(world, &f);
     frames = (long)f;
   }
+  /* --until: one call to embra_world_solve stands for the loop's frames. */
+  const long calls = until >= 0 ? (frames > 0 ? 1 : 0) : frames;
+  long stepped = 0;
   if (make_dir(out) != 0) {
     fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
     embra_world_destroy(world);
@@ -685,7 +750,7 @@ static int cmd_run(int argc, char** argv) {
   memset(&pt, 0, sizeof pt);
   long within_since = -1;
   const int tty = isatty(2);
-  const long stride = frames >= 10 ? frames / 10 : 1;
+  const long stride = calls >= 10 ? calls / 10 : 1;
   if (frames > 0)
     printf("%7s %9s %13s %13s %13s %13s %8s\n", "frame", "ms", "residual_max", "residual_rms", "kinetic_J", "max_speed",
            "settled");
@@ -694,19 +759,25 @@ static int cmd_run(int argc, char** argv) {
   long settled_at = -1;
   embra_step_report r;
   memset(&r, 0, sizeof r);
-  for (long f = 1; f <= frames; ++f) {
+  for (long f = 1; f <= calls; ++f) {
     const double t0 = now_ms();
-    const embra_status s = embra_world_step(world);
+    const embra_status s = until >= 0 ? embra_world_solve(world, &solve_def, &solved) : embra_world_step(world);
     const double ms = now_ms() - t0;
     total_ms += ms;
+    stepped += until >= 0 ? solved.frames : 1;
     if (s != EMBRA_OK) {
-      fprintf(stderr, "%sembra: frame %ld: %s\n", tty ? "\n" : "", f, embra_last_error_message());
+      fprintf(stderr, "%sembra: frame %ld: %s\n", tty ? "\n" : "", stepped, embra_last_error_message());
       rc = s == EMBRA_ERROR_NUMERICAL ? EXIT_SIM : EXIT_INVALID;
       break;
     }
     embra_world_get_report(world, &r);
-    if (r.settled && settled_at < 0) settled_at = (long)r.frame;
-    if (!r.settled) settled_at = -1;
+    if (until >= 0) {
+      settled_at =
+          solved.outcome <= EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE ? (long)r.frame - solve_def.hold_frames + 1 : -1;
+    } else {
+      if (r.settled && settled_at < 0) settled_at = (long)r.frame;
+      if (!r.settled) settled_at = -1;
+    }
     fprintf(metrics,
             "{\"frame\":%lld,\"time\":%.17g,\"ms\":%.6f,\"residual_max\":%.17g,\"residual_rms\":%.17g,"
             "\"kinetic_energy\":%.17g,\"max_speed\":%.17g,\"contacts\":%lld,\"settled\":%s}\n",
@@ -724,13 +795,13 @@ static int cmd_run(int argc, char** argv) {
       if (pt.within && within_since < 0) within_since = (long)r.frame;
       if (!pt.within) within_since = -1;
     }
-    if (f % stride == 0 || f == frames) {
+    if (f % stride == 0 || f == calls) {
       if (tty) fputs("\r\033[K", stderr); /* clear the progress bar's line */
       printf("%7lld %9.3f %13.3e %13.3e %13.3e %13.3e %8s\n", (long long)r.frame, ms, r.residual_max, r.residual_rms,
              r.kinetic_energy, r.max_speed, r.settled ? "yes" : "no");
       fflush(stdout);
     }
-    if (every > 0 && f % every == 0) {
+    if (until < 0 && every > 0 && f % every == 0) {
       snprintf(path, sizeof path, "%s/frame_%05ld.obj", out, f);
       if (write_world_obj(path, world) != 0) {
         rc = EXIT_INVALID;
@@ -748,7 +819,7 @@ static int cmd_run(int argc, char** argv) {
       if (panel_count > 0) run_index_file(&index, errors_name);
       run_index_frame(&index, world, f, obj_name, panel_count > 0 ? errors_name : NULL);
     }
-    if (tty && (f % 10 == 0 || f == frames)) progress(f, frames, total_ms);
+    if (tty && until < 0 && (f % 10 == 0 || f == frames)) progress(f, frames, total_ms);
   }
   if (tty) fputc('\n', stderr);
   fclose(metrics);
@@ -783,13 +854,17 @@ static int cmd_run(int argc, char** argv) {
   printf("%-18s %d particles, %lld constraints, %d pins, %d colliders\n", "world", c.particles,
          (long long)c.constraints, c.pins, c.colliders);
   printf("%-18s %lld (%.3f s simulated)\n", "frames", (long long)r.frame, r.time);
-  printf("%-18s %.3f total, %.3f per frame\n", "ms", total_ms, r.frame > 0 ? total_ms / (double)frames : 0.0);
+  printf("%-18s %.3f total, %.3f per frame\n", "ms", total_ms, stepped > 0 ? total_ms / (double)stepped : 0.0);
   printf("%-18s %.3e max, %.3e rms\n", "residual", r.residual_max, r.residual_rms);
   printf("%-18s %.3e J (max speed %.3e m/s)\n", "kinetic energy", r.kinetic_energy, r.max_speed);
   if (settled_at >= 0)
     printf("%-18s since frame %ld\n", "settled", settled_at);
   else
     printf("%-18s no\n", "settled");
+  if (until >= 0 && rc == 0) {
+    print_solve_outcome(&solved, world);
+    if (solved.outcome != EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE) rc = EXIT_UNSETTLED;
+  }
   printf("%-18s %s/final.json, %s/metrics.jsonl\n", "wrote", out, out);
   if (panel_count > 0) {
     if (write_cuts(world, panel_bodies, panel_count, out) != 0 && rc == 0) rc = EXIT_INVALID;

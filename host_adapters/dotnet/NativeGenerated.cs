@@ -44,6 +44,12 @@ namespace Embra
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
 
+    /// <summary>EMBRA_SOLVE_UNTIL_*.</summary>
+    public enum SolveUntil { Settled = 0, Tolerance = 1 }
+
+    /// <summary>EMBRA_SOLVE_*.</summary>
+    public enum Solve { SettledWithinTolerance = 0, SettledOutOfTolerance = 1, Oscillating = 2, Drifting = 3 }
+
     /// <summary>EMBRA_PANEL_PINS_*.</summary>
     public enum PanelPins { None = 0, TopCorners = 1, TopAndBottomCorners = 2 }
 
@@ -256,6 +262,34 @@ namespace Embra
         public long Count;
         public double ResidualMax;
         public double ResidualRms;
+    }
+
+    /// <summary>embra_solve_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct SolveDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Until;
+        public int MaxFrames;
+        public int HoldFrames;
+        public double MaxSeconds;
+    }
+
+    /// <summary>embra_solve_result.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct SolveResult
+    {
+        public int Outcome;
+        public int Frames;
+        public double Period;
+        public int WorstMetric;
+        public int WorstLayer;
+        public BodyId WorstBody;
+        public int WorstElement;
+        public int Reserved0;
+        public double WorstValue;
+        public double WorstTarget;
     }
 
     /// <summary>embra_warning.</summary>
@@ -474,6 +508,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_cancel(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_report(IntPtr world, out StepReport report);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
+        [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_warning(IntPtr world, out Warning warning);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_positions(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_velocities(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);

@@ -175,6 +175,8 @@ namespace Embra
         public static int AbiVersion { get { return Native.embra_abi_version(); } }
         public static int ConstraintArity(ConstraintKind kind) { return Native.embra_constraint_arity((int)kind); }
         public static SolverDef DefaultSolverDef() { return Native.embra_default_solver_def(); }
+        public static SolverDef FormFindingSolverDef() { return Native.embra_form_finding_solver_def(); }
+        public static SolveDef DefaultSolveDef() { return Native.embra_default_solve_def(); }
         public static Material DefaultMaterial() { return Native.embra_default_material(); }
         public static BodyDef DefaultBodyDef() { return Native.embra_default_body_def(); }
         public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
@@ -726,6 +728,31 @@ namespace Embra
         public void Step(int frames = 1)
         {
             for (int i = 0; i < frames; ++i) Call(Native.embra_world_step);
+        }
+
+        /// <summary>
+        /// Steps until the world is at rest (SolveUntil.Settled) and, with SolveUntil.Tolerance, every
+        /// panel mesh within its tolerance targets, or def.MaxFrames frames or def.MaxSeconds of wall
+        /// time have passed (embra_world_solve; def null: Library.DefaultSolveDef()). The result says
+        /// why it stopped: Outcome (a Solve value), Frames, Period (s, of an oscillation) and the worst
+        /// fabrication metric (WorstMetric a PanelMetric, or -1 without a panel mesh; WorstBody,
+        /// WorstElement, WorstLayer 0 top / 1 bottom / -1, WorstValue, WorstTarget).
+        /// </summary>
+        public SolveResult Solve(SolveDef? def = null)
+        {
+            SolveDef d = def ?? Native.embra_default_solve_def();
+            var r = new SolveResult();
+            Call(w => Native.embra_world_solve(w, ref d, out r));
+            return r;
+        }
+
+        /// <summary>Solve with the defaults but for `until` and the frame budget.</summary>
+        public SolveResult Solve(SolveUntil until, int maxFrames = 1000)
+        {
+            SolveDef d = Native.embra_default_solve_def();
+            d.Until = (int)until;
+            d.MaxFrames = maxFrames;
+            return Solve(d);
         }
 
         public StepReport Report

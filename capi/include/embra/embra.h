@@ -576,6 +576,67 @@ typedef struct embra_group_report {
 EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_group_id group,
                                               embra_group_report* out_report);
 
+/* ---------------------------------------------------------------------------------------------
+ * Solve to tolerance: step until done, and say why it stopped
+ *
+ * embra_world_solve steps frames (scene actions applied, as embra_world_step) until the world is at
+ * rest for hold_frames frames in a row (max_speed <= settle_speed) and, with
+ * EMBRA_SOLVE_UNTIL_TOLERANCE, every panel mesh's planarity (both layers), corner distance,
+ * thickness and miter are at or below the world's tolerance targets; or until max_frames frames or
+ * max_seconds of wall time. At rest but out of tolerance, it steps on while the worst of those
+ * metrics (value over target) still falls by 1 % every hold_frames frames. Still moving at the end,
+ * the motion is told apart as oscillating (back and forth with a period: the paper's "oscillates
+ * between two saddle states", a pendulum) or drifting: three fixed random projections of the
+ * movable particles' positions are recorded every frame, and over the last three quarters of the
+ * frames the one that varies most, less its trend, must rise through zero at least three times at
+ * intervals within 10 % of their mean, the period.
+ * A step that fails ends the call with its status (the world as before that frame; the frames
+ * before it stay stepped; *out_result says how many).
+ * ------------------------------------------------------------------------------------------- */
+
+enum {
+  EMBRA_SOLVE_UNTIL_SETTLED = 0,  /* at rest */
+  EMBRA_SOLVE_UNTIL_TOLERANCE = 1 /* at rest and every panel mesh within its tolerance targets */
+};
+
+#define EMBRA_SOLVE_DEF_VERSION 1
+typedef struct embra_solve_def {
+  int32_t version;     /* EMBRA_SOLVE_DEF_VERSION */
+  int32_t until;       /* EMBRA_SOLVE_UNTIL_*; default EMBRA_SOLVE_UNTIL_TOLERANCE */
+  int32_t max_frames;  /* frame budget, >= 1; default 1000 */
+  int32_t hold_frames; /* frames in a row at rest that count as settled, >= 1; default 10 */
+  double max_seconds;  /* wall-clock budget in s, >= 0 (0: none); default 0. With one, where the
+                          stepping stops depends on the machine (each frame is the same bits) */
+} embra_solve_def;
+
+enum {
+  EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE = 0, /* at rest, every panel mesh within its targets (or none) */
+  EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE = 1, /* at rest, worst_* above its target: no solution nearby */
+  EMBRA_SOLVE_OSCILLATING = 2,              /* still moving back and forth, with `period` */
+  EMBRA_SOLVE_DRIFTING = 3                  /* still moving, no period */
+};
+
+typedef struct embra_solve_result {
+  int32_t outcome;          /* EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE ... EMBRA_SOLVE_DRIFTING */
+  int32_t frames;           /* frames stepped by the call */
+  double period;            /* s, EMBRA_SOLVE_OSCILLATING: the motion's period; else 0 */
+  int32_t worst_metric;     /* the metric furthest above its target at the end (value / target), as
+                               EMBRA_PANEL_METRIC_PLANARITY, _CORNER_DISTANCE, _THICKNESS or _MITER;
+                               -1 when the world has no panel mesh */
+  int32_t worst_layer;      /* 0 top, 1 bottom (planarity, corner distance); -1 otherwise */
+  embra_body_id worst_body; /* the panel mesh */
+  int32_t worst_element;    /* panel (planarity, corner distance, thickness) or joint (miter: edge of
+                               the top mesh, in order of first appearance around the panels) */
+  int32_t reserved0;
+  double worst_value;  /* in the metric's unit (1 - n1.n2, or m) */
+  double worst_target; /* the world's tolerance target for it */
+} embra_solve_result;
+
+EMBRA_API embra_solve_def embra_default_solve_def(void);
+/* def nullable (the defaults); *out_result (required) is written also when a step fails. */
+EMBRA_API embra_status embra_world_solve(embra_world* world, const embra_solve_def* def,
+                                         embra_solve_result* out_result);
+
 typedef struct embra_warning {
   int64_t frame;    /* frame of the last numerical failure, -1 if none */
   int32_t particle; /* first particle non-finite or beyond EMBRA_MAX_ABS_VALUE, -1 if none */

@@ -22,6 +22,7 @@ const CONSTRAINT_DEF_VERSION = 1;
 const CONSTRAINT_BATCH_DEF_VERSION = 1;
 const PIN_DEF_VERSION = 1;
 const COLLIDER_DEF_VERSION = 2;
+const SOLVE_DEF_VERSION = 1;
 const PANEL_MESH_DEF_VERSION = 1;
 const TOLERANCES_VERSION = 1;
 const PANEL_METRICS_VERSION = 1;
@@ -68,6 +69,16 @@ const COLLIDER_CAPSULE = 3;
 const COLLIDER_CONVEX = 4;
 const COLLIDER_MESH = 5;
 
+// --- EMBRA_SOLVE_UNTIL_* ---
+const SOLVE_UNTIL_SETTLED = 0;
+const SOLVE_UNTIL_TOLERANCE = 1;
+
+// --- EMBRA_SOLVE_* ---
+const SOLVE_SETTLED_WITHIN_TOLERANCE = 0;
+const SOLVE_SETTLED_OUT_OF_TOLERANCE = 1;
+const SOLVE_OSCILLATING = 2;
+const SOLVE_DRIFTING = 3;
+
 // --- EMBRA_PANEL_PINS_* ---
 const PANEL_PINS_NONE = 0;
 const PANEL_PINS_TOP_CORNERS = 1;
@@ -88,6 +99,8 @@ const CUTS_CSV = 1;
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
+const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
+const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_tolerance: 1, oscillating: 2, drifting: 3 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
 const CUTS_NAMES = Object.freeze({ json: 0, csv: 1 });
@@ -235,6 +248,25 @@ const GroupReport = koffi.struct('embra_group_report', {
   residual_max: 'double',
   residual_rms: 'double',
 });
+const SolveDef = koffi.struct('embra_solve_def', {
+  version: 'int32_t',
+  until: 'int32_t',
+  max_frames: 'int32_t',
+  hold_frames: 'int32_t',
+  max_seconds: 'double',
+});
+const SolveResult = koffi.struct('embra_solve_result', {
+  outcome: 'int32_t',
+  frames: 'int32_t',
+  period: 'double',
+  worst_metric: 'int32_t',
+  worst_layer: 'int32_t',
+  worst_body: BodyIdType,
+  worst_element: 'int32_t',
+  reserved0: 'int32_t',
+  worst_value: 'double',
+  worst_target: 'double',
+});
 const Warning = koffi.struct('embra_warning', {
   frame: 'int64_t',
   particle: 'int32_t',
@@ -359,6 +391,8 @@ const STRUCTS = {
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
   embra_group_report: GroupReport,
+  embra_solve_def: SolveDef,
+  embra_solve_result: SolveResult,
   embra_warning: Warning,
   embra_panel_mesh_def: PanelMeshDef,
   embra_tolerance: Tolerance,
@@ -425,6 +459,8 @@ const PROTOTYPES = {
   embra_world_cancel: 'embra_status embra_world_cancel(embra_world *world)',
   embra_world_get_report: 'embra_status embra_world_get_report(const embra_world *world, _Out_ embra_step_report *out_report)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
+  embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
+  embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
   embra_world_get_warning: 'embra_status embra_world_get_warning(const embra_world *world, _Out_ embra_warning *out_warning)',
   embra_world_get_positions: 'embra_status embra_world_get_positions(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
   embra_world_get_velocities: 'embra_status embra_world_get_velocities(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
@@ -465,18 +501,20 @@ module.exports = {
   ABI_VERSION, MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS,
   MAX_PASSES_PER_STEP, MAX_OBJ_BYTES, MAX_THREADS, SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION,
   CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, COLLIDER_DEF_VERSION,
-  PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION, WIND_DEF_VERSION,
-  PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT,
-  ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL,
-  ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME,
-  CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD,
-  CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, COLLIDER_PLANE,
-  COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, PANEL_PINS_NONE,
-  PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS,
-  PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES,
-  CONSTRAINT_NAMES, COLLIDER_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType,
-  PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef,
-  ConstraintBatchDef, PinDef, ColliderDef, StepReport, GroupReport, Warning, PanelMeshDef, Tolerance,
-  Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef,
-  VortexDef,
+  SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION,
+  WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK,
+  ERROR_INVALID_ARGUMENT, ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED,
+  ERROR_NUMERICAL, ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND,
+  GENERATE_VOLUME, CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME,
+  CONSTRAINT_WELD, CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH,
+  COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH,
+  SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE,
+  SOLVE_OSCILLATING, SOLVE_DRIFTING, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
+  PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
+  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
+  COLLIDER_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
+  GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
+  ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef, StepReport, GroupReport, SolveDef, SolveResult,
+  Warning, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType,
+  WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

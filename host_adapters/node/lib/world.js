@@ -29,6 +29,9 @@ const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
 const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
+const SOLVE_UNTIL = capi.SOLVE_UNTIL_NAMES;
+const SOLVE_OUTCOMES = Object.freeze(Object.fromEntries(Object.entries(capi.SOLVE_NAMES).map(([k, v]) => [v, k])));
+const METRIC_NAMES = Object.freeze(Object.fromEntries(Object.entries(capi.PANEL_METRIC_NAMES).map(([k, v]) => [v, k])));
 const CUTS_FORMATS = capi.CUTS_NAMES;
 
 // --- ids ------------------------------------------------------------------------------------------
@@ -858,6 +861,40 @@ class World {
   }
 
   /** The report of the last step: {frame, time, kinetic_energy, max_speed, residual_max, ...}. */
+  /**
+   * Steps until the world is at rest (until 'settled') and, with until 'tolerance' (the default), every
+   * panel mesh within its tolerance targets, or maxFrames frames (1000) or maxSeconds of wall time (0:
+   * none) have passed; holdFrames (10) frames in a row at rest count as settled (embra_world_solve).
+   * Returns why it stopped: {outcome: 'settled_within_tolerance' | 'settled_out_of_tolerance' |
+   * 'oscillating' | 'drifting', settled, frames, period (s, of an oscillation, else 0), worst: null
+   * without a panel mesh, else the metric furthest above its target, {metric (a PANEL_METRICS name),
+   * body (BodyId), element (panel, or joint for 'miter'), layer ('top', 'bottom' or null), value,
+   * target}}.
+   */
+  solve(opts = {}) {
+    const given = options(opts, 'solve options');
+    const def = lib.embra_default_solve_def();
+    if (given.has('until')) {
+      def.until = enumValue(given.get('until'), SOLVE_UNTIL, 'until');
+      given.delete('until');
+    }
+    fill(def, capi.SolveDef, given, 'SolveDef');
+    const r = {};
+    this.#call('embra_world_solve', def, r);
+    const out = {
+      outcome: SOLVE_OUTCOMES[r.outcome], settled: r.outcome <= capi.SOLVE_SETTLED_OUT_OF_TOLERANCE,
+      frames: r.frames, period: r.period, worst: null,
+    };
+    if (r.worst_metric >= 0) {
+      out.worst = {
+        metric: METRIC_NAMES[r.worst_metric], body: new BodyId(r.worst_body.index, r.worst_body.generation),
+        element: r.worst_element, layer: r.worst_layer === 0 ? 'top' : r.worst_layer === 1 ? 'bottom' : null,
+        value: r.worst_value, target: r.worst_target,
+      };
+    }
+    return out;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);
@@ -940,6 +977,6 @@ if (typeof Symbol.dispose === 'symbol') {
 }
 
 module.exports = {
-  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_METRICS,
+  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_METRICS, SOLVE_UNTIL,
   CUTS_FORMATS, EmbraError, wrapIds,
 };

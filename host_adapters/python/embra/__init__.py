@@ -15,13 +15,13 @@ from . import _capi
 from ._capi import (ABI_VERSION, MAX_ABS_VALUE, MAX_CONSTRAINTS, MAX_DT, MAX_OBJ_BYTES, MAX_PARTICLES,
                     MAX_PASSES_PER_STEP, MAX_UNIT_SCALE, MIN_POSITIVE, BodyId, ColliderDef, ColliderId,
                     ConstraintBatchDef, ConstraintDef, FieldId, GroupDef, GroupId, GroupReport, LoadOptions, Material,
-                    MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId, PressureDef, SolverDef, StepReport,
+                    MetricSummary, PanelMeshDef, PanelMetrics, PinDef, PinId, PressureDef, SolveDef, SolveResult, SolverDef, StepReport,
                     SurfaceTensionDef, Tolerance, Tolerances, VortexDef, WindDef, WorldCounts, library_path)
 from ._capi import Warning as StepWarning
 from ._buffers import have_numpy
 from .errors import (BufferTooSmallError, CancelledError, EmbraError, InternalError, InvalidArgumentError, LockedError,
                      NumericalError, SchemaError, StaleIdError, VersionError, check)
-from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_METRICS, PANEL_PINS, SHAPES, Body, World, as_dict
+from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_METRICS, PANEL_PINS, SHAPES, SOLVE_UNTIL, Body, Solved, World, as_dict
 
 _lib = _capi.lib
 
@@ -59,6 +59,15 @@ def constraint_arity(kind):
 
 def default_solver_def():
     return _lib.embra_default_solver_def()
+
+
+def form_finding_solver_def():
+    """embra_form_finding_solver_def(): settings for reaching a settled form fast (World(solver=...))."""
+    return _lib.embra_form_finding_solver_def()
+
+
+def default_solve_def():
+    return _lib.embra_default_solve_def()
 
 
 def default_material():
@@ -101,14 +110,15 @@ check_abi()  # these bindings and the loaded library must agree before anything 
 __version__ = version_string()
 __all__ = [
     "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
-    "last_error_message", "constraint_arity", "default_solver_def", "default_material", "default_panel_mesh_def",
+    "last_error_message", "constraint_arity", "default_solver_def", "form_finding_solver_def", "default_solve_def",
+    "Solved", "SOLVE_UNTIL", "default_material", "default_panel_mesh_def",
     "default_tolerances", "default_wind_def", "default_pressure_def", "default_surface_tension_def",
     "default_vortex_def", "default_load_options", "have_numpy", "library_path", "ABI_VERSION",
     "EmbraError", "InvalidArgumentError", "StaleIdError", "BufferTooSmallError", "SchemaError", "VersionError",
     "LockedError", "NumericalError", "CancelledError", "InternalError",
     "MAX_ABS_VALUE", "MIN_POSITIVE", "MAX_DT", "MAX_UNIT_SCALE", "MAX_PARTICLES", "MAX_CONSTRAINTS",
     "MAX_PASSES_PER_STEP", "MAX_OBJ_BYTES",
-    "SolverDef", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef", "ColliderDef",
+    "SolverDef", "SolveDef", "SolveResult", "Material", "GroupDef", "ConstraintDef", "ConstraintBatchDef", "PinDef", "ColliderDef",
     "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "WindDef", "PressureDef",
     "SurfaceTensionDef", "VortexDef", "LoadOptions", "StepReport", "GroupReport", "StepWarning", "WorldCounts",
     "GroupId", "BodyId", "PinId", "ColliderId", "FieldId",

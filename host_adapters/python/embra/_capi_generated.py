@@ -24,6 +24,7 @@ CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
+SOLVE_DEF_VERSION = 1
 PANEL_MESH_DEF_VERSION = 1
 TOLERANCES_VERSION = 1
 PANEL_METRICS_VERSION = 1
@@ -70,6 +71,16 @@ COLLIDER_CAPSULE = 3
 COLLIDER_CONVEX = 4
 COLLIDER_MESH = 5
 
+# --- EMBRA_SOLVE_UNTIL_* ---
+SOLVE_UNTIL_SETTLED = 0
+SOLVE_UNTIL_TOLERANCE = 1
+
+# --- EMBRA_SOLVE_* ---
+SOLVE_SETTLED_WITHIN_TOLERANCE = 0
+SOLVE_SETTLED_OUT_OF_TOLERANCE = 1
+SOLVE_OSCILLATING = 2
+SOLVE_DRIFTING = 3
+
 # --- EMBRA_PANEL_PINS_* ---
 PANEL_PINS_NONE = 0
 PANEL_PINS_TOP_CORNERS = 1
@@ -90,6 +101,8 @@ CUTS_CSV = 1
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
+SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
+SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "oscillating": 2, "drifting": 3}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}
 CUTS_NAMES = {"json": 0, "csv": 1}
@@ -288,6 +301,33 @@ class GroupReport(ctypes.Structure):
         ("count", c_int64),
         ("residual_max", c_double),
         ("residual_rms", c_double),
+    ]
+
+
+class SolveDef(ctypes.Structure):
+    """embra_solve_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("until", c_int32),
+        ("max_frames", c_int32),
+        ("hold_frames", c_int32),
+        ("max_seconds", c_double),
+    ]
+
+
+class SolveResult(ctypes.Structure):
+    """embra_solve_result."""
+    _fields_ = [
+        ("outcome", c_int32),
+        ("frames", c_int32),
+        ("period", c_double),
+        ("worst_metric", c_int32),
+        ("worst_layer", c_int32),
+        ("worst_body", BodyId),
+        ("worst_element", c_int32),
+        ("reserved0", c_int32),
+        ("worst_value", c_double),
+        ("worst_target", c_double),
     ]
 
 
@@ -493,6 +533,8 @@ PROTOTYPES = {
     "embra_world_cancel": (c_int32, [c_void_p]),
     "embra_world_get_report": (c_int32, [c_void_p, POINTER(StepReport)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
+    "embra_default_solve_def": (SolveDef, []),
+    "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),
     "embra_world_get_warning": (c_int32, [c_void_p, POINTER(Warning)]),
     "embra_world_get_positions": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
     "embra_world_get_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),

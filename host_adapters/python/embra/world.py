@@ -17,8 +17,8 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    GroupId, GroupReport, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolverDef, StepReport, Tolerances,
-                    Warning, WorldCounts, lib)
+                    GroupId, GroupReport, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef, StepReport,
+                    Tolerances, Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
 # The names each enum's values go by here and in scenes: generated from embra.h with the enums.
@@ -28,6 +28,8 @@ GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
 PANEL_METRICS = dict(_capi.PANEL_METRIC_NAMES)
 CUTS_FORMATS = dict(_capi.CUTS_NAMES)
+SOLVE_UNTIL = dict(_capi.SOLVE_UNTIL_NAMES)
+SOLVE_OUTCOMES = {v: k for k, v in _capi.SOLVE_NAMES.items()}
 
 
 def as_dict(struct):
@@ -654,6 +656,24 @@ class World:
         for _ in range(buf.int32(frames, "frames")):
             self._call("embra_world_step")
 
+    def solve(self, until="tolerance", max_frames=None, hold_frames=None, max_seconds=None):
+        """Steps until the world is at rest (until="settled") and, with until="tolerance", every panel
+        mesh within its tolerance targets, or max_frames frames (default 1000) or max_seconds of wall
+        time have passed (embra_world_solve). Returns a Solved: why it stopped (outcome
+        "settled_within_tolerance", "settled_out_of_tolerance", "oscillating" or "drifting"), the
+        frames stepped, the period (s) of an oscillation and the worst fabrication metric and where."""
+        d = lib.embra_default_solve_def()
+        d.until = _enum(until, SOLVE_UNTIL, "until")
+        if max_frames is not None:
+            d.max_frames = buf.int32(max_frames, "max_frames")
+        if hold_frames is not None:
+            d.hold_frames = buf.int32(hold_frames, "hold_frames")
+        if max_seconds is not None:
+            d.max_seconds = float(max_seconds)
+        r = SolveResult()
+        self._call("embra_world_solve", byref(d), byref(r))
+        return Solved(r)
+
     def report(self):
         r = StepReport()
         self._call("embra_world_get_report", byref(r))
@@ -715,5 +735,36 @@ class World:
         return f.value
 
 
-__all__ = ["World", "Body", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_METRICS", "CUTS_FORMATS",
-           "EmbraError"]
+class Solved:
+    """What World.solve found. outcome: "settled_within_tolerance", "settled_out_of_tolerance",
+    "oscillating" or "drifting"; frames: stepped by the call; period: s, for an oscillation (else 0);
+    worst: None without a panel mesh, else a dict of the metric furthest above its target (value /
+    target): metric (a PANEL_METRICS name), body (BodyId), element (panel, or joint for "miter"), layer
+    ("top", "bottom" or None), value and target (1 - n1.n2 for planarity, else m)."""
+
+    def __init__(self, r):
+        self.outcome = SOLVE_OUTCOMES[r.outcome]
+        self.frames = r.frames
+        self.period = r.period
+        self.settled = r.outcome <= _capi.SOLVE_SETTLED_OUT_OF_TOLERANCE
+        self.worst = None
+        if r.worst_metric >= 0:
+            names = {v: k for k, v in PANEL_METRICS.items()}
+            self.worst = {"metric": names[r.worst_metric], "body": BodyId(r.worst_body.index, r.worst_body.generation),
+                          "element": r.worst_element, "layer": {0: "top", 1: "bottom"}.get(r.worst_layer),
+                          "value": r.worst_value, "target": r.worst_target}
+
+    def __repr__(self):
+        text = f"Solved({self.outcome}, frames={self.frames}"
+        if self.outcome == "oscillating":
+            text += f", period={self.period:.6g} s"
+        if self.worst is not None:
+            w = self.worst
+            layer = f" {w['layer']}" if w["layer"] else ""
+            text += (f", worst={w['metric']} {w['value']:.3e} (target {w['target']:.3e}) at "
+                     f"{'joint' if w['metric'] == 'miter' else 'panel'} {w['element']}{layer}")
+        return text + ")"
+
+
+__all__ = ["World", "Body", "Solved", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_METRICS",
+           "CUTS_FORMATS", "SOLVE_UNTIL", "EmbraError"]

@@ -242,6 +242,72 @@ namespace Embra.Tests
         }
     }
 
+    public class SolveTests
+    {
+        // A 1 m pendulum let go 0.1 rad from the vertical, no damping: still moving, oscillating with
+        // the small-angle period 2 pi sqrt(L / g) (1 + 0.1^2 / 16), to 1 %.
+        [Test]
+        public void APendulumOscillatesWithItsPeriod()
+        {
+            using (var w = new World())
+            {
+                double theta = 0.1;
+                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, Math.Sin(theta), 0.0, -Math.Cos(theta) }, masses: new[] { 0.0, 1.0 });
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 });
+                var r = w.Solve(SolveUntil.Tolerance, 900);
+                double expected = 2 * Math.PI * Math.Sqrt(1 / 9.81) * (1 + theta * theta / 16);
+                Assert.AreEqual((int)Solve.Oscillating, r.Outcome);
+                Assert.AreEqual(900, r.Frames);
+                Assert.AreEqual(expected, r.Period, 0.01 * expected);
+                Assert.AreEqual(-1, r.WorstMetric);
+            }
+        }
+
+        // One panel, its top corners pinned, one of them 5 cm off the plane of the others: at rest, out
+        // of tolerance, and the worst metric is that panel's top layer.
+        [Test]
+        public void APanelPinnedOffItsPlaneSettlesOutOfTolerance()
+        {
+            var solver = Library.FormFindingSolverDef();
+            solver.Damping = 2.0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultPanelMeshDef();
+                def.GridColumns = 1;
+                def.GridRows = 1;
+                def.Pins = (int)PanelPins.TopCorners;
+                var body = w.CreatePanelMesh(def);
+                foreach (var pin in w.Pins())
+                {
+                    if (w.PinParticle(pin) != body.First + 2) continue;
+                    var t = w.PinTarget(pin);
+                    w.SetPinTarget(pin, new[] { t[0], t[1], t[2] + 0.05 });
+                }
+                var r = w.Solve();
+                Assert.AreEqual((int)Solve.SettledOutOfTolerance, r.Outcome);
+                Assert.Less(r.Frames, 1000);
+                Assert.IsTrue(r.WorstMetric == (int)PanelMetric.Planarity || r.WorstMetric == (int)PanelMetric.CornerDistance);
+                Assert.AreEqual(body.Id.Index, r.WorstBody.Index);
+                Assert.AreEqual(0, r.WorstElement);
+                Assert.AreEqual(0, r.WorstLayer);
+                Assert.Greater(r.WorstValue, 100 * r.WorstTarget);
+            }
+        }
+
+        [Test]
+        public void ABadBudgetIsRefusedAndNothingSteps()
+        {
+            using (var w = new World())
+            {
+                w.CreateBody(new[] { 0.0, 0.0, 0.0 });
+                var d = Library.DefaultSolveDef();
+                d.MaxFrames = 0;
+                Assert.Throws<EmbraArgumentException>(() => w.Solve(d));
+                Assert.AreEqual(0, w.Report.Frame);
+            }
+        }
+    }
+
     public class ErrorTests
     {
         static World Square()

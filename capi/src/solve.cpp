@@ -1,0 +1,72 @@
+// Solve to tolerance: embra_world_solve (embra/core/solve.hpp).
+#include "copy.hpp"
+#include "guard.hpp"
+
+#include "embra/core/solve.hpp"
+#include "embra/io/scene.hpp"
+
+using namespace embra::capi;
+
+namespace {
+
+constexpr std::tuple kSolveCopies{Copy{&embra_solve_def::max_frames, &embra::SolveSettings::max_frames},
+                                  Copy{&embra_solve_def::hold_frames, &embra::SolveSettings::hold_frames},
+                                  Copy{&embra_solve_def::max_seconds, &embra::SolveSettings::max_seconds}};
+
+}  // namespace
+
+extern "C" {
+
+embra_solve_def embra_default_solve_def(void) {
+  const embra::SolveSettings s;
+  embra_solve_def d{};
+  d.version = EMBRA_SOLVE_DEF_VERSION;
+  d.until = static_cast<int32_t>(s.until);
+  to_c(kSolveCopies, s, d);
+  return d;
+}
+
+embra_status embra_world_solve(embra_world* world, const embra_solve_def* def, embra_solve_result* out_result) {
+  embra::SolveResult r;
+  const embra_status status = guard("embra_world_solve", world, [&] {
+    need(out_result, "out_result");
+    *out_result = embra_solve_result{};
+    out_result->worst_metric = out_result->worst_layer = out_result->worst_element = -1;
+    const embra_solve_def d = def ? *def : embra_default_solve_def();
+    need_version(d.version, EMBRA_SOLVE_DEF_VERSION, "embra_solve_def");
+    if (d.until != EMBRA_SOLVE_UNTIL_SETTLED && d.until != EMBRA_SOLVE_UNTIL_TOLERANCE)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.until must be EMBRA_SOLVE_UNTIL_SETTLED (0) or _TOLERANCE (1)");
+    embra::SolveSettings s;
+    s.until = static_cast<embra::SolveUntil>(d.until);
+    to_core(kSolveCopies, d, s);
+    embra::StepControl control;
+    if (!world->meta.actions.empty())
+      control.before_frame = [world](embra::World& w) {
+        embra::io::apply_actions(w, world->meta, w.report().frame + 1);
+      };
+    control.cancel = &world->cancel;
+    const embra::Tolerances tolerances = embra::io::parse_tolerances(world->meta.tolerances);
+    const int64_t frame_before = world->world.report().frame;
+    try {
+      r = embra::solve(world->world, s, tolerances, control);
+    } catch (...) {
+      out_result->frames = static_cast<int32_t>(world->world.report().frame - frame_before);
+      throw;
+    }
+    embra_solve_result o{};
+    o.outcome = static_cast<int32_t>(r.outcome);
+    o.frames = r.frames;
+    o.period = r.period;
+    o.worst_metric = r.worst.metric;
+    o.worst_layer = r.worst.layer;
+    o.worst_body = from_id<embra_body_id>(r.worst.body);
+    o.worst_element = r.worst.element;
+    o.worst_value = r.worst.value;
+    o.worst_target = r.worst.target;
+    *out_result = o;
+  });
+  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+  return status;
+}
+
+}  // extern "C"

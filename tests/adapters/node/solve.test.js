@@ -1,0 +1,56 @@
+'use strict';
+// World.solve through Node: a pendulum with no damping oscillates with period 2 pi sqrt(L / g) (to
+// 1 %); a panel whose top corners are pinned off one plane comes to rest out of tolerance, naming
+// that panel; bad options are refused before any step.
+
+const assert = require('node:assert/strict');
+const test = require('node:test');
+
+const { embra } = require('./helpers');
+
+test('a pendulum with no damping oscillates with its period', () => {
+  const w = new embra.World();
+  const theta = 0.1;
+  const b = w.createBody([0, 0, 0, Math.sin(theta), 0, -Math.cos(theta)], { masses: [0, 1] });
+  w.addConstraint('distance', [b.first, b.first + 1]);
+  const solved = w.solve({ maxFrames: 900 });
+  const expected = 2 * Math.PI * Math.sqrt(1 / 9.81) * (1 + theta * theta / 16);
+  assert.equal(solved.outcome, 'oscillating');
+  assert.equal(solved.settled, false);
+  assert.equal(solved.frames, 900);
+  assert.ok(Math.abs(solved.period - expected) < 0.01 * expected, `period ${solved.period} vs ${expected}`);
+  assert.equal(solved.worst, null);
+  w.close();
+});
+
+test('a panel pinned off its plane comes to rest out of tolerance, named', () => {
+  const w = new embra.World({ ...embra.formFindingSolverDef(), damping: 2.0 });
+  const body = w.createPanelMesh({ gridColumns: 1, gridRows: 1, pins: 'top_corners' });
+  for (const pin of w.pins()) {
+    if (w.pinParticle(pin) === body.first + 2) {
+      const t = w.pinTarget(pin);
+      w.setPinTarget(pin, [t[0], t[1], t[2] + 0.05]);
+    }
+  }
+  const solved = w.solve();
+  assert.equal(solved.outcome, 'settled_out_of_tolerance');
+  assert.equal(solved.settled, true);
+  assert.ok(solved.frames < 1000);
+  assert.ok(['planarity', 'corner_distance'].includes(solved.worst.metric));
+  assert.ok(solved.worst.body.equals(body.id));
+  assert.equal(solved.worst.element, 0);
+  assert.equal(solved.worst.layer, 'top');
+  assert.ok(solved.worst.value > 100 * solved.worst.target);
+  w.close();
+});
+
+test('bad solve options are refused and nothing steps', () => {
+  const w = new embra.World();
+  w.createBody([0, 0, 0]);
+  assert.throws(() => w.solve({ until: 'forever' }), RangeError);
+  assert.throws(() => w.solve({ maxFrames: 0 }), embra.InvalidArgumentError);
+  assert.throws(() => w.solve({ maxSeconds: NaN }), embra.InvalidArgumentError);
+  assert.throws(() => w.solve({ maxFrame: 10 }), TypeError);
+  assert.equal(w.report().frame, 0);
+  w.close();
+});

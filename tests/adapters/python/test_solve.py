@@ -1,0 +1,51 @@
+"""World.solve through Python: a pendulum with no damping oscillates with period 2 pi sqrt(L / g)
+(to 1 %); a panel whose top corners are pinned off one plane comes to rest out of tolerance, naming
+that panel; bad arguments are refused before any step."""
+
+import math
+
+import pytest
+
+import embra
+
+
+def test_a_pendulum_oscillates_with_its_period():
+    w = embra.World()
+    theta = 0.1
+    b = w.create_body([[0, 0, 0], [math.sin(theta), 0, -math.cos(theta)]], masses=[0, 1])
+    w.add_constraint("distance", [b.first, b.first + 1])
+    solved = w.solve(max_frames=900)
+    expected = 2 * math.pi * math.sqrt(1 / 9.81) * (1 + theta ** 2 / 16)
+    assert solved.outcome == "oscillating"
+    assert solved.frames == 900 and not solved.settled
+    assert solved.period == pytest.approx(expected, rel=0.01)
+    assert solved.worst is None
+    assert "oscillating" in repr(solved) and "period=" in repr(solved)
+
+
+def test_a_panel_pinned_off_its_plane_settles_out_of_tolerance():
+    w = embra.World(embra.form_finding_solver_def(), damping=2.0)
+    body = w.create_panel_mesh(grid_columns=1, grid_rows=1, pins="top_corners")
+    for pin in w.pins():
+        if w.pin_particle(pin) == body.first + 2:
+            x, y, z = w.pin_target(pin)
+            w.set_pin_target(pin, [x, y, z + 0.05])
+    solved = w.solve()
+    assert solved.outcome == "settled_out_of_tolerance" and solved.settled
+    assert solved.frames < 1000
+    worst = solved.worst
+    assert worst["metric"] in ("planarity", "corner_distance")
+    assert worst["body"] == body.id and worst["element"] == 0 and worst["layer"] == "top"
+    assert worst["value"] > 100 * worst["target"]
+
+
+def test_refusals_change_nothing():
+    w = embra.World()
+    w.create_body([[0, 0, 0]])
+    with pytest.raises(ValueError):
+        w.solve(until="forever")
+    with pytest.raises(embra.InvalidArgumentError):
+        w.solve(max_frames=0)
+    with pytest.raises(embra.InvalidArgumentError):
+        w.solve(max_seconds=float("nan"))
+    assert w.report().frame == 0
