@@ -43,5 +43,33 @@ awk -v rows=$rows '
     if (top <= 0) { print "reversed gravity must lift the membrane, apex " top; exit 1 }
   }' "$tmp/tent/final.obj" && ok || bad "final.obj does not match the tent's geometry"
 
+# --until: why the stepping stopped. A 1 m pendulum let go 0.1 rad from the vertical with no
+# damping never comes to rest: exit 4, oscillating with the small-angle period
+# 2 pi sqrt(1 / 9.81) (1 + 0.1^2 / 16) = 2.0073 s, to 1 %. A damped 8-link chain between two pins
+# comes to rest: exit 0. An unknown --until value is a usage error.
+"$embra" run "$tmp/none.json" --until forever >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "--until forever must exit 1"
+cat >"$tmp/pendulum.json" <<'JSON'
+{"format": "embra-scene", "version": 1, "name": "pendulum",
+ "bodies": [{"name": "p", "mesh": {"vertices": [[0, 0, 0], [0.09983341664682815, 0, -0.9950041652780258]],
+             "masses": [0, 1]}, "generate": []}],
+ "constraints": [{"kind": "distance", "particles": [[0, 1]]}]}
+JSON
+"$embra" run "$tmp/pendulum.json" --until settled --frames 900 --out "$tmp/pendulum" >"$tmp/log" 2>&1
+[ $? -eq 4 ] && ok || bad "a swinging pendulum must exit 4 under --until: $(cat "$tmp/log")"
+period=$(sed -n 's/.*oscillating with a period of \([0-9.]*\) s.*/\1/p' "$tmp/log")
+awk -v p="$period" 'BEGIN { e = 2 * 3.141592653589793 * sqrt(1 / 9.81) * (1 + 0.01 / 16); exit !(p != "" && (p - e < 0.01 * e) && (e - p < 0.01 * e)) }' \
+  && ok || bad "pendulum period '$period' s, expected 2.0073 s to 1 %: $(cat "$tmp/log")"
+cat >"$tmp/chain.json" <<'JSON'
+{"format": "embra-scene", "version": 1, "name": "chain", "solver": {"damping": 4.0},
+ "bodies": [{"name": "c", "mesh": {"vertices": [[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0], [0.3, 0, 0], [0.4, 0, 0],
+             [0.5, 0, 0], [0.6, 0, 0], [0.7, 0, 0], [0.8, 0, 0]]}, "generate": []}],
+ "constraints": [{"kind": "distance", "particles": [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 6], [6, 7], [7, 8]],
+                  "rest": [0.12, 0.12, 0.12, 0.12, 0.12, 0.12, 0.12, 0.12]}],
+ "pins": [{"name": "a", "particle": {"body": "c", "vertex": 0}}, {"name": "b", "particle": {"body": "c", "vertex": 8}}]}
+JSON
+"$embra" run "$tmp/chain.json" --until tolerance --out "$tmp/chain" >"$tmp/log" 2>&1 && ok || bad "a damped chain must come to rest: $(cat "$tmp/log")"
+grep -q "at rest and within tolerance after" "$tmp/log" && ok || bad "the chain's reason is missing: $(cat "$tmp/log")"
+[ -s "$tmp/chain/final.json" ] && [ "$(wc -l <"$tmp/chain/metrics.jsonl")" -eq 1 ] && ok || bad "--until writes final.json and one metrics record"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
