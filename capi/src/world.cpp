@@ -214,6 +214,44 @@ embra_status embra_world_get_report(const embra_world* world, embra_step_report*
   });
 }
 
+const char* embra_residual_unit(int32_t kind) {
+  if (kind == EMBRA_RESIDUAL_PINS || kind == EMBRA_RESIDUAL_CONTACTS) return "m";
+  if (!embra::is_kind(kind)) return nullptr;
+  return embra::kKinds[kind].unit.data();  // the table's string literals: NUL-terminated, static
+}
+
+const char* embra_residual_name(int32_t kind) {
+  if (kind == EMBRA_RESIDUAL_PINS) return "pins";
+  if (kind == EMBRA_RESIDUAL_CONTACTS) return "contacts";
+  if (!embra::is_kind(kind)) return nullptr;
+  return embra::kKinds[kind].name.data();  // the table's string literals (#name): NUL-terminated, static
+}
+
+embra_status embra_world_get_residuals(const embra_world* world, embra_kind_residual* out, int32_t capacity,
+                                       int32_t* out_count) {
+  return guard("embra_world_get_residuals", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const auto& by_kind = world->world.report().by_kind;
+    const auto c_kind = [](int k) {
+      return k == embra::kResidualPins       ? EMBRA_RESIDUAL_PINS
+             : k == embra::kResidualContacts ? EMBRA_RESIDUAL_CONTACTS
+                                             : k;
+    };
+    int32_t n = 0;
+    for (const embra::KindResidual& r : by_kind) n += r.count > 0 ? 1 : 0;
+    if (!fits(out, capacity, n, "residuals")) {
+      *out_count = n;
+      return;
+    }
+    int32_t i = 0;
+    for (int k = 0; k < embra::kResidualKinds; ++k)
+      if (by_kind[k].count > 0)
+        out[i++] = embra_kind_residual{c_kind(k), 0, by_kind[k].count, by_kind[k].max, by_kind[k].rms};
+    *out_count = n;
+  });
+}
+
 embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
   return guard("embra_world_get_warning", world, [&] {
     need(out_warning, "out_warning");

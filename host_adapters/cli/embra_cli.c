@@ -632,6 +632,33 @@ static int set_threads(embra_world* world, int32_t threads, int32_t* before) {
   return embra_world_set_solver(world, &s) == EMBRA_OK ? 0 : -1;
 }
 
+/* Reopens the metrics record just written (drops its closing "}\n") and adds the last step's
+ * residuals by kind, each in its unit: "residuals": {"distance": {"unit": "m", "count": ..,
+ * "max": .., "rms": ..}, ...}. */
+static void write_residuals(FILE* metrics, const embra_world* world) {
+  embra_kind_residual res[64];
+  int32_t n = 0;
+  if (embra_world_get_residuals(world, res, 64, &n) != EMBRA_OK) return;
+  fseek(metrics, -2, SEEK_CUR);
+  fputs(",\"residuals\":{", metrics);
+  for (int32_t i = 0; i < n; ++i)
+    fprintf(metrics, "%s\"%s\":{\"unit\":\"%s\",\"count\":%lld,\"max\":%.17g,\"rms\":%.17g}", i ? "," : "",
+            embra_residual_name(res[i].kind), embra_residual_unit(res[i].kind), (long long)res[i].count, res[i].max,
+            res[i].rms);
+  fputs("}}\n", metrics);
+}
+
+/* The last step's residuals by kind, one line each, in each kind's unit, for a person. */
+static void print_residuals(const embra_world* world) {
+  embra_kind_residual res[64];
+  int32_t n = 0;
+  if (embra_world_get_residuals(world, res, 64, &n) != EMBRA_OK) return;
+  for (int32_t i = 0; i < n; ++i)
+    printf("%-18s %-13s %.3e %-3s max, %.3e rms over %lld\n", i == 0 ? "residual" : "",
+           embra_residual_name(res[i].kind), res[i].max, embra_residual_unit(res[i].kind), res[i].rms,
+           (long long)res[i].count);
+}
+
 /* Why embra_world_solve stopped, for a person. */
 static void print_solve_outcome(const embra_solve_result* s, const embra_world* world) {
   static const char* const metric_names[] = {"planarity", "thickness error", "miter twist", "corner off plane"};
@@ -795,6 +822,7 @@ static int cmd_run(int argc, char** argv) {
       if (pt.within && within_since < 0) within_since = (long)r.frame;
       if (!pt.within) within_since = -1;
     }
+    write_residuals(metrics, world);
     if (f % stride == 0 || f == calls) {
       if (tty) fputs("\r\033[K", stderr); /* clear the progress bar's line */
       printf("%7lld %9.3f %13.3e %13.3e %13.3e %13.3e %8s\n", (long long)r.frame, ms, r.residual_max, r.residual_rms,
@@ -855,7 +883,7 @@ static int cmd_run(int argc, char** argv) {
          (long long)c.constraints, c.pins, c.colliders);
   printf("%-18s %lld (%.3f s simulated)\n", "frames", (long long)r.frame, r.time);
   printf("%-18s %.3f total, %.3f per frame\n", "ms", total_ms, stepped > 0 ? total_ms / (double)stepped : 0.0);
-  printf("%-18s %.3e max, %.3e rms\n", "residual", r.residual_max, r.residual_rms);
+  print_residuals(world);
   printf("%-18s %.3e J (max speed %.3e m/s)\n", "kinetic energy", r.kinetic_energy, r.max_speed);
   if (settled_at >= 0)
     printf("%-18s since frame %ld\n", "settled", settled_at);

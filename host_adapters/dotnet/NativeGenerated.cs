@@ -44,6 +44,9 @@ namespace Embra
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
 
+    /// <summary>EMBRA_RESIDUAL_*.</summary>
+    public enum Residual { Pins = -1, Contacts = -2 }
+
     /// <summary>EMBRA_SOLVE_UNTIL_*.</summary>
     public enum SolveUntil { Settled = 0, Tolerance = 1 }
 
@@ -253,6 +256,17 @@ namespace Embra
         public long ContactCount;
         public int Settled;
         public int Reserved0;
+    }
+
+    /// <summary>embra_kind_residual.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct KindResidual
+    {
+        public int Kind;
+        public int Reserved0;
+        public long Count;
+        public double Max;
+        public double Rms;
     }
 
     /// <summary>embra_group_report.</summary>
@@ -507,6 +521,9 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_step(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_cancel(IntPtr world);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_report(IntPtr world, out StepReport report);
+        [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_residual_unit(int kind);
+        [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_residual_name(int kind);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_residuals(IntPtr world, [Out] KindResidual[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);

@@ -177,6 +177,12 @@ namespace Embra
         public static SolverDef DefaultSolverDef() { return Native.embra_default_solver_def(); }
         public static SolverDef FormFindingSolverDef() { return Native.embra_form_finding_solver_def(); }
         public static SolveDef DefaultSolveDef() { return Native.embra_default_solve_def(); }
+        /// <summary>A residual kind's unit ("m", "rad", "m^3"): a ConstraintKind's number, or
+        /// Residual.Pins / Residual.Contacts; null for neither.</summary>
+        public static string ResidualUnit(int kind) { return Text(Native.embra_residual_unit(kind)); }
+        /// <summary>Its name: the kind's scene name, "pins" or "contacts"; null for neither.</summary>
+        public static string ResidualName(int kind) { return Text(Native.embra_residual_name(kind)); }
+        static string Text(IntPtr text) { return text == IntPtr.Zero ? null : Errors.Utf8(text); }
         public static Material DefaultMaterial() { return Native.embra_default_material(); }
         public static BodyDef DefaultBodyDef() { return Native.embra_default_body_def(); }
         public static ColliderDef DefaultColliderDef() { return Native.embra_default_collider_def(); }
@@ -753,6 +759,17 @@ namespace Embra
             d.Until = (int)until;
             d.MaxFrames = maxFrames;
             return Solve(d);
+        }
+
+        /// <summary>The last step's residuals by kind, each in its own unit (Library.ResidualUnit):
+        /// every kind the world holds, in kind order, then pins, then contacts.</summary>
+        public KindResidual[] Residuals()
+        {
+            int count = 0;
+            Call(w => Native.embra_world_get_residuals(w, null, 0, out count));
+            var res = new KindResidual[count];
+            Call(w => Native.embra_world_get_residuals(w, res, res.Length, out count));
+            return res;
         }
 
         public StepReport Report

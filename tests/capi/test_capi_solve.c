@@ -1,8 +1,13 @@
-/* embra_world_solve: why the stepping stopped, checked against what one can work out by hand: a
+/* Residuals by kind, each in its own unit: a hanging cloth of hard stretch constraints and bending
+ * hinges, whose distance residual is computed here from the positions alone (| |xi - xj| - rest |,
+ * the rests being the grid's edge lengths), and the mixed residual_max is the largest of the kinds'.
+ *
+ * embra_world_solve: why the stepping stopped, checked against what one can work out by hand: a
  * pendulum with no damping swings for ever with period 2 pi sqrt(L / g); a damped chain comes to
  * rest (no panel mesh: within tolerance); a panel whose four top corners are pinned off one plane
  * can never be planar and comes to rest out of tolerance, naming that panel; bad arguments are
  * refused before any step. */
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -150,6 +155,90 @@ static void test_panel_out_of_tolerance(void) {
   embra_world_destroy(w);
 }
 
+static void test_residuals_by_kind(void) {
+  enum { N = 6 };
+  const double step = 0.2;
+  double xyz[3 * N * N];
+  int32_t tris[3 * 2 * (N - 1) * (N - 1)];
+  embra_world* w = NULL;
+  embra_body_def bd = embra_default_body_def();
+  embra_body_id cloth;
+  embra_kind_residual res[16];
+  embra_step_report report;
+  int32_t first = -1, t = 0, count = -1, i, j;
+  double by_hand = 0.0, x[3 * N * N], biggest = 0.0;
+  for (i = 0; i < N; ++i)
+    for (j = 0; j < N; ++j) {
+      xyz[3 * (i * N + j)] = step * j;
+      xyz[3 * (i * N + j) + 1] = step * i;
+      xyz[3 * (i * N + j) + 2] = 0.0;
+    }
+  for (i = 0; i + 1 < N; ++i)
+    for (j = 0; j + 1 < N; ++j) {
+      const int32_t v = i * N + j;
+      tris[t++] = v, tris[t++] = v + 1, tris[t++] = v + N + 1;
+      tris[t++] = v, tris[t++] = v + N + 1, tris[t++] = v + N;
+    }
+  CHECK_OK(embra_world_create(&w, NULL));
+  bd.vertex_count = N * N;
+  bd.positions = xyz;
+  bd.triangle_count = 2 * (N - 1) * (N - 1);
+  bd.triangles = tris;
+  CHECK_OK(embra_body_create(w, &bd, &cloth, &first));
+  for (i = 0; i < 2; ++i) {
+    embra_pin_def p = embra_default_pin_def();
+    embra_pin_id pin;
+    p.particle = first + i * (N - 1);
+    memcpy(p.target, &xyz[3 * i * (N - 1)], sizeof p.target);
+    CHECK_OK(embra_pin_create(w, &p, &pin));
+  }
+  CHECK_OK(embra_world_get_residuals(w, NULL, 0, &count));
+  CHECK_INT(count, 0); /* nothing measured before the first step */
+  for (i = 0; i < 30; ++i) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_residuals(w, NULL, 0, &count));
+  CHECK_INT(count, 3); /* distance, dihedral, pins (the automatic tethers only bound a stretch) */
+  CHECK_STATUS(embra_world_get_residuals(w, res, 2, &count), EMBRA_ERROR_BUFFER_TOO_SMALL);
+  CHECK_OK(embra_world_get_residuals(w, res, 16, &count));
+  CHECK_INT(count, 3);
+  CHECK_INT(res[0].kind, EMBRA_CONSTRAINT_DISTANCE);
+  CHECK_INT(res[1].kind, EMBRA_CONSTRAINT_DIHEDRAL);
+  CHECK_INT(res[2].kind, EMBRA_RESIDUAL_PINS);
+  CHECK_INT(res[0].count, 2 * N * (N - 1) + (N - 1) * (N - 1));       /* rows, columns, diagonals */
+  CHECK_INT(res[1].count, 2 * (N - 1) * (N - 2) + (N - 1) * (N - 1)); /* interior edges */
+  CHECK_INT(res[2].count, 2);
+  CHECK_STR(embra_residual_unit(EMBRA_CONSTRAINT_DISTANCE), "m");
+  CHECK_STR(embra_residual_unit(EMBRA_CONSTRAINT_DIHEDRAL), "rad");
+  CHECK_STR(embra_residual_unit(EMBRA_CONSTRAINT_TET_VOLUME), "m^3");
+  CHECK_STR(embra_residual_unit(EMBRA_RESIDUAL_CONTACTS), "m");
+  CHECK(embra_residual_unit(99) == NULL);
+  CHECK_STR(embra_residual_name(EMBRA_CONSTRAINT_PLANE_OFFSET), "plane_offset");
+  CHECK_STR(embra_residual_name(EMBRA_RESIDUAL_PINS), "pins");
+  CHECK_STR(embra_residual_name(EMBRA_RESIDUAL_CONTACTS), "contacts");
+  CHECK(embra_residual_name(-3) == NULL);
+  /* The distance residual from the positions: every edge hard, rest = its grid length. */
+  CHECK_OK(embra_world_get_positions(w, x, 3 * N * N, first, N * N));
+  for (t = 0; t < 2 * (N - 1) * (N - 1); ++t)
+    for (j = 0; j < 3; ++j) {
+      const int32_t a = tris[3 * t + j], b = tris[3 * t + (j + 1) % 3];
+      const double dx = x[3 * a] - x[3 * b], dy = x[3 * a + 1] - x[3 * b + 1], dz = x[3 * a + 2] - x[3 * b + 2];
+      const double rx = xyz[3 * a] - xyz[3 * b], ry = xyz[3 * a + 1] - xyz[3 * b + 1];
+      const double r = fabs(sqrt(dx * dx + dy * dy + dz * dz) - sqrt(rx * rx + ry * ry));
+      if (r > by_hand) by_hand = r;
+    }
+  CHECK(by_hand > 0.0);
+  CHECK_NEAR(res[0].max, by_hand, 1e-15);
+  CHECK(res[0].rms <= res[0].max && res[0].rms > 0.0);
+  CHECK(res[2].max < 1e-12); /* hard pins hold */
+  CHECK_OK(embra_world_get_report(w, &report));
+  for (i = 0; i < count; ++i)
+    if (res[i].max > biggest) biggest = res[i].max;
+  CHECK_NEAR(report.residual_max, biggest, 0.0);
+  CHECK_STATUS(embra_world_get_residuals(NULL, res, 16, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_residuals(w, res, 16, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_residuals(w, res, -1, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+  embra_world_destroy(w);
+}
+
 static void test_refusals(void) {
   embra_world* w = NULL;
   embra_solve_def d = embra_default_solve_def();
@@ -185,6 +274,7 @@ int main(void) {
   RUN(test_pendulum_oscillates);
   RUN(test_chain_settles);
   RUN(test_panel_out_of_tolerance);
+  RUN(test_residuals_by_kind);
   RUN(test_refusals);
   return capi_test_finish();
 }

@@ -567,6 +567,33 @@ typedef struct embra_step_report {
 /* The report of the last step (all zero before the first). */
 EMBRA_API embra_status embra_world_get_report(const embra_world* world, embra_step_report* out_report);
 
+/* Residuals by kind, each in its own unit (embra_residual_unit): the step report's residual_max
+ * takes the largest over every constraint whatever its unit (m, rad, m^3); these say which. */
+enum {
+  EMBRA_RESIDUAL_PINS = -1,    /* pins, soft and hard: distance from the target (m) */
+  EMBRA_RESIDUAL_CONTACTS = -2 /* collider and panel-face contacts: penetration (m) */
+};
+
+typedef struct embra_kind_residual {
+  int32_t kind; /* EMBRA_CONSTRAINT_*, EMBRA_RESIDUAL_PINS or EMBRA_RESIDUAL_CONTACTS */
+  int32_t reserved0;
+  int64_t count; /* constraints of the kind measured (a weld counts once: |x0 - x1|) */
+  double max;    /* max |C + compliance/h^2 * lambda| over them, in the kind's unit */
+  double rms;
+} embra_kind_residual;
+
+/* The unit of a kind's values and residuals ("m", "rad", "m^3"; "m" for EMBRA_RESIDUAL_PINS and
+ * _CONTACTS), or NULL for a number that is neither. A static string. */
+EMBRA_API const char* embra_residual_unit(int32_t kind);
+/* Its name: the constraint kind's scene name ("distance", "dihedral", ...), "pins" or "contacts";
+ * NULL for a number that is neither. A static string. */
+EMBRA_API const char* embra_residual_name(int32_t kind);
+/* The last step's residuals by kind, for every kind the world holds (count > 0): the constraint kinds
+ * in number order, then pins, then contacts. *out_count (required) receives how many; out NULL and
+ * capacity 0 only ask for it; a smaller capacity is EMBRA_ERROR_BUFFER_TOO_SMALL. */
+EMBRA_API embra_status embra_world_get_residuals(const embra_world* world, embra_kind_residual* out, int32_t capacity,
+                                                 int32_t* out_count);
+
 typedef struct embra_group_report {
   int64_t count;       /* constraints in the group (soft pins and contacts included) */
   double residual_max; /* as in embra_step_report, over this group */

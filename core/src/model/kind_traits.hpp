@@ -35,7 +35,7 @@ using KindTag = std::integral_constant<Kind, K>;
 template <class F>
 decltype(auto) visit_kind(Kind kind, F&& f) {
   switch (kind) {
-#define EMBRA_KIND_VISIT(name, number, arity, multipliers, what) \
+#define EMBRA_KIND_VISIT(name, number, arity, multipliers, unit, what) \
   case Kind::name:                                               \
     return f(KindTag<Kind::name>{});
     EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_VISIT)
@@ -190,7 +190,7 @@ constexpr bool shares_operands() {
   return false;
 }
 
-#define EMBRA_KIND_HAS_TRAITS(name, number, arity, multipliers, what) \
+#define EMBRA_KIND_HAS_TRAITS(name, number, arity, multipliers, unit, what) \
   static_assert(sizeof(KindTraits<Kind::name>) > 0, "every kind has its KindTraits");
 EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_HAS_TRAITS)
 #undef EMBRA_KIND_HAS_TRAITS

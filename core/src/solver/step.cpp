@@ -329,6 +329,16 @@ void World::measure() {
   const double inv_h2 = 1.0 / (h * h);
   double all_max = 0.0, all_sq = 0.0;
   int64_t all_n = 0;
+  // Per kind: max, sum of squares, count (StepReport::by_kind).
+  std::array<double, kResidualKinds> kind_max{}, kind_sq{};
+  std::array<int64_t, kResidualKinds> kind_n{};
+  const auto add = [&](int kind, double r, double& max, double& sq) {
+    max = std::max(max, r);
+    sq += r * r;
+    kind_max[kind] = std::max(kind_max[kind], r);
+    kind_sq[kind] += r * r;
+    ++kind_n[kind];
+  };
   for (int32_t slot : order_) {
     Group& g = groups_[slot];
     double max = 0.0, sq = 0.0;
@@ -336,22 +346,28 @@ void World::measure() {
     // Every kind with a function, in table order, then the welds (three multipliers each).
     for (const KindInfo& info : kKinds)
       visit_kind(info.kind, [&](auto k) {
-        if constexpr (k != Kind::weld)
-          residuals<k>(*pool_, g.solve[static_cast<int>(info.kind)], inv_h2, x_, max, sq, measure_values_);
+        if constexpr (k != Kind::weld) {
+          const SolverArray& a = g.solve[static_cast<int>(info.kind)];
+          double kmax = 0.0, ksq = 0.0;
+          residuals<k>(*pool_, a, inv_h2, x_, kmax, ksq, measure_values_);
+          const int kind = static_cast<int>(info.kind);
+          max = std::max(max, kmax);
+          sq += ksq;
+          kind_max[kind] = std::max(kind_max[kind], kmax);
+          kind_sq[kind] += ksq;
+          kind_n[kind] += static_cast<int64_t>(a.size());
+        }
       });
     for (const SolverArray& a : g.solve) n += static_cast<int64_t>(a.size());
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
-      const double r = (x_[weld.ids[2 * i]] - x_[weld.ids[2 * i + 1]] + weld.compliance[i] * inv_h2 * l).norm();
-      max = std::max(max, r);
-      sq += r * r;
+      add(static_cast<int>(Kind::weld),
+          (x_[weld.ids[2 * i]] - x_[weld.ids[2 * i + 1]] + weld.compliance[i] * inv_h2 * l).norm(), max, sq);
     }
     for (int32_t pi : g.soft_pins) {
       const Pin& p = pins_[pi];
-      const double r = (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm();
-      max = std::max(max, r);
-      sq += r * r;
+      add(kResidualPins, (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm(), max, sq);
       ++n;
     }
     for (const Contact& ct : g.contacts) {
@@ -359,9 +375,7 @@ void World::measure() {
       const Collider& c = colliders_[ct.collider];
       const double gap =
           contact_gap(c, ct, x_[ct.particle], x_prev_[ct.particle], radius_[ct.particle] + c.desc.thickness, normal);
-      const double r = std::max(-gap, 0.0);
-      max = std::max(max, r);
-      sq += r * r;
+      add(kResidualContacts, std::max(-gap, 0.0), max, sq);
       ++n;
     }
     if (&g == &groups_[settings_.contact_group.index])
@@ -369,9 +383,8 @@ void World::measure() {
         const Collider& col = colliders_[fc.collider];
         const Vec3 bary = closest_barycentric(col.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
         const Vec3 q = bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]];
-        const double r = std::max(col.desc.radius + col.desc.thickness - (q - col.position).norm(), 0.0);
-        max = std::max(max, r);
-        sq += r * r;
+        add(kResidualContacts, std::max(col.desc.radius + col.desc.thickness - (q - col.position).norm(), 0.0), max,
+            sq);
         ++n;
       }
     g.report.count = n;
@@ -383,7 +396,16 @@ void World::measure() {
   }
   // Hard pins hold exactly; their residual is the distance left to the target.
   for (const Pin& p : pins_)
-    if (p.alive && p.compliance == 0.0) all_max = std::max(all_max, (x_[p.particle] - p.target).norm());
+    if (p.alive && p.compliance == 0.0) {
+      const double r = (x_[p.particle] - p.target).norm();
+      all_max = std::max(all_max, r);
+      kind_max[kResidualPins] = std::max(kind_max[kResidualPins], r);
+      kind_sq[kResidualPins] += r * r;
+      ++kind_n[kResidualPins];
+    }
+  for (int k = 0; k < kResidualKinds; ++k)
+    report_.by_kind[k] = KindResidual{kind_n[k], kind_max[k],
+                                      kind_n[k] > 0 ? std::sqrt(kind_sq[k] / static_cast<double>(kind_n[k])) : 0.0};
   double ke = 0.0, vmax = 0.0;
   for (size_t i = 0; i < x_.size(); ++i) {
     const double v2 = v_[i].squaredNorm();

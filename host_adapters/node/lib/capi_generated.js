@@ -69,6 +69,10 @@ const COLLIDER_CAPSULE = 3;
 const COLLIDER_CONVEX = 4;
 const COLLIDER_MESH = 5;
 
+// --- EMBRA_RESIDUAL_* ---
+const RESIDUAL_PINS = -1;
+const RESIDUAL_CONTACTS = -2;
+
 // --- EMBRA_SOLVE_UNTIL_* ---
 const SOLVE_UNTIL_SETTLED = 0;
 const SOLVE_UNTIL_TOLERANCE = 1;
@@ -99,6 +103,7 @@ const CUTS_CSV = 1;
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
+const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
 const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_tolerance: 1, oscillating: 2, drifting: 3 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
@@ -242,6 +247,13 @@ const StepReport = koffi.struct('embra_step_report', {
   contact_count: 'int64_t',
   settled: 'int32_t',
   reserved0: 'int32_t',
+});
+const KindResidual = koffi.struct('embra_kind_residual', {
+  kind: 'int32_t',
+  reserved0: 'int32_t',
+  count: 'int64_t',
+  max: 'double',
+  rms: 'double',
 });
 const GroupReport = koffi.struct('embra_group_report', {
   count: 'int64_t',
@@ -390,6 +402,7 @@ const STRUCTS = {
   embra_pin_def: PinDef,
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
+  embra_kind_residual: KindResidual,
   embra_group_report: GroupReport,
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
@@ -458,6 +471,9 @@ const PROTOTYPES = {
   embra_world_step: 'embra_status embra_world_step(embra_world *world)',
   embra_world_cancel: 'embra_status embra_world_cancel(embra_world *world)',
   embra_world_get_report: 'embra_status embra_world_get_report(const embra_world *world, _Out_ embra_step_report *out_report)',
+  embra_residual_unit: 'const char *embra_residual_unit(int32_t kind)',
+  embra_residual_name: 'const char *embra_residual_name(int32_t kind)',
+  embra_world_get_residuals: 'embra_status embra_world_get_residuals(const embra_world *world, embra_kind_residual *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
   embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
   embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
@@ -508,13 +524,13 @@ module.exports = {
   GENERATE_VOLUME, CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME,
   CONSTRAINT_WELD, CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH,
   COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH,
-  SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE,
-  SOLVE_OSCILLATING, SOLVE_DRIFTING, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
-  PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
-  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
-  COLLIDER_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
-  GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
-  ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef, StepReport, GroupReport, SolveDef, SolveResult,
-  Warning, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType,
-  WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE,
+  SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING,
+  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
+  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
+  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
+  PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
+  SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef,
+  StepReport, KindResidual, GroupReport, SolveDef, SolveResult, Warning, PanelMeshDef, Tolerance, Tolerances,
+  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -895,6 +895,28 @@ class World {
     return out;
   }
 
+  /**
+   * The last step's residuals by kind, each in its own unit (embra_world_get_residuals): an object from
+   * the kind's name ('distance', 'dihedral', ..., 'pins', 'contacts') to {unit ('m', 'rad', 'm^3'),
+   * count, max, rms}, for every kind the world holds, in kind order.
+   */
+  residuals() {
+    const n = [0];
+    this.#call('embra_world_get_residuals', null, 0, n);
+    const { koffi } = capi;
+    const size = koffi.sizeof(capi.KindResidual);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_residuals', out, n[0], n);
+    const result = {};
+    for (let k = 0; k < n[0]; k++) {
+      const r = koffi.decode(out, k * size, capi.KindResidual);
+      result[lib.embra_residual_name(r.kind)] = {
+        unit: lib.embra_residual_unit(r.kind), count: Number(r.count), max: r.max, rms: r.rms,
+      };
+    }
+    return result;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);

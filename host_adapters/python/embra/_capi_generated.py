@@ -71,6 +71,10 @@ COLLIDER_CAPSULE = 3
 COLLIDER_CONVEX = 4
 COLLIDER_MESH = 5
 
+# --- EMBRA_RESIDUAL_* ---
+RESIDUAL_PINS = -1
+RESIDUAL_CONTACTS = -2
+
 # --- EMBRA_SOLVE_UNTIL_* ---
 SOLVE_UNTIL_SETTLED = 0
 SOLVE_UNTIL_TOLERANCE = 1
@@ -101,6 +105,7 @@ CUTS_CSV = 1
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
+RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
 SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "oscillating": 2, "drifting": 3}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
@@ -292,6 +297,17 @@ class StepReport(ctypes.Structure):
         ("contact_count", c_int64),
         ("settled", c_int32),
         ("reserved0", c_int32),
+    ]
+
+
+class KindResidual(ctypes.Structure):
+    """embra_kind_residual."""
+    _fields_ = [
+        ("kind", c_int32),
+        ("reserved0", c_int32),
+        ("count", c_int64),
+        ("max", c_double),
+        ("rms", c_double),
     ]
 
 
@@ -532,6 +548,9 @@ PROTOTYPES = {
     "embra_world_step": (c_int32, [c_void_p]),
     "embra_world_cancel": (c_int32, [c_void_p]),
     "embra_world_get_report": (c_int32, [c_void_p, POINTER(StepReport)]),
+    "embra_residual_unit": (c_char_p, [c_int32]),
+    "embra_residual_name": (c_char_p, [c_int32]),
+    "embra_world_get_residuals": (c_int32, [c_void_p, POINTER(KindResidual), c_int32, POINTER(c_int32)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
     "embra_default_solve_def": (SolveDef, []),
     "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),

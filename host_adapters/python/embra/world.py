@@ -17,7 +17,8 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    GroupId, GroupReport, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef, StepReport,
+                    GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef,
+                    StepReport,
                     Tolerances, Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
@@ -673,6 +674,18 @@ class World:
         r = SolveResult()
         self._call("embra_world_solve", byref(d), byref(r))
         return Solved(r)
+
+    def residuals(self):
+        """The last step's residuals by kind, each in its own unit (embra_world_get_residuals): a dict
+        from the kind's name ("distance", "dihedral", ..., "pins", "contacts") to {"unit" ("m", "rad",
+        "m^3"), "count", "max", "rms"}, for every kind the world holds, in kind order."""
+        n = c_int32()
+        self._call("embra_world_get_residuals", None, 0, byref(n))
+        out = (KindResidual * max(n.value, 1))()
+        self._call("embra_world_get_residuals", out, n.value, byref(n))
+        return {lib.embra_residual_name(r.kind).decode(): {"unit": lib.embra_residual_unit(r.kind).decode(),
+                                                           "count": r.count, "max": r.max, "rms": r.rms}
+                for r in out[:n.value]}
 
     def report(self):
         r = StepReport()

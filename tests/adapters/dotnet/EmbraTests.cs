@@ -294,6 +294,31 @@ namespace Embra.Tests
             }
         }
 
+        // A hard rod's residual is | |x1 - x0| - L | from the positions, in metres.
+        [Test]
+        public void ResidualsByKindInTheirUnits()
+        {
+            using (var w = new World())
+            {
+                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.6, 0.0, -0.8 }, masses: new[] { 0.0, 1.0 });
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 });
+                Assert.AreEqual(0, w.Residuals().Length);
+                w.Step(10);
+                var res = w.Residuals();
+                Assert.AreEqual(1, res.Length);
+                Assert.AreEqual((int)ConstraintKind.Distance, res[0].Kind);
+                Assert.AreEqual("m", Library.ResidualUnit(res[0].Kind));
+                Assert.AreEqual("distance", Library.ResidualName(res[0].Kind));
+                Assert.AreEqual("rad", Library.ResidualUnit((int)ConstraintKind.Dihedral));
+                Assert.AreEqual("pins", Library.ResidualName((int)Residual.Pins));
+                Assert.IsNull(Library.ResidualUnit(99));
+                var x = w.GetPositions();
+                double length = Math.Sqrt(Math.Pow(x[3] - x[0], 2) + Math.Pow(x[4] - x[1], 2) + Math.Pow(x[5] - x[2], 2));
+                Assert.AreEqual(1, res[0].Count);
+                Assert.AreEqual(Math.Abs(length - 1.0), res[0].Max, 1e-15);
+            }
+        }
+
         [Test]
         public void ABadBudgetIsRefusedAndNothingSteps()
         {

@@ -1,5 +1,6 @@
 'use strict';
-// World.solve through Node: a pendulum with no damping oscillates with period 2 pi sqrt(L / g) (to
+// World.residuals and World.solve through Node: residuals by kind in their own units (a rod's is
+// | |x1 - x0| - L | from the positions); a pendulum with no damping oscillates with period 2 pi sqrt(L / g) (to
 // 1 %); a panel whose top corners are pinned off one plane comes to rest out of tolerance, naming
 // that panel; bad options are refused before any step.
 
@@ -52,5 +53,22 @@ test('bad solve options are refused and nothing steps', () => {
   assert.throws(() => w.solve({ maxSeconds: NaN }), embra.InvalidArgumentError);
   assert.throws(() => w.solve({ maxFrame: 10 }), TypeError);
   assert.equal(w.report().frame, 0);
+  w.close();
+});
+
+test('residuals by kind, each in its unit: a rod residual from the positions', () => {
+  const w = new embra.World();
+  const b = w.createBody([0, 0, 0, 0.6, 0, -0.8], { masses: [0, 1] });
+  w.addConstraint('distance', [b.first, b.first + 1]);
+  assert.deepEqual(w.residuals(), {});
+  w.step(10);
+  const res = w.residuals();
+  assert.deepEqual(Object.keys(res), ['distance']);
+  const x = w.positions();
+  const length = Math.hypot(x[3] - x[0], x[4] - x[1], x[5] - x[2]);
+  assert.equal(res.distance.unit, 'm');
+  assert.equal(res.distance.count, 1);
+  assert.ok(Math.abs(res.distance.max - Math.abs(length - 1)) <= 1e-15);
+  assert.equal(res.distance.rms, res.distance.max);
   w.close();
 });

@@ -1,4 +1,5 @@
-"""World.solve through Python: a pendulum with no damping oscillates with period 2 pi sqrt(L / g)
+"""World.residuals and World.solve through Python: residuals by kind in their own units (a hard
+pendulum rod's residual is | |x1 - x0| - L | from the positions); a pendulum with no damping oscillates with period 2 pi sqrt(L / g)
 (to 1 %); a panel whose top corners are pinned off one plane comes to rest out of tolerance, naming
 that panel; bad arguments are refused before any step."""
 
@@ -49,3 +50,18 @@ def test_refusals_change_nothing():
     with pytest.raises(embra.InvalidArgumentError):
         w.solve(max_seconds=float("nan"))
     assert w.report().frame == 0
+
+
+def test_residuals_by_kind_in_their_units():
+    w = embra.World()
+    b = w.create_body([[0, 0, 0], [0.6, 0, -0.8]], masses=[0, 1])
+    w.add_constraint("distance", [b.first, b.first + 1])
+    assert w.residuals() == {}
+    w.step(10)
+    res = w.residuals()
+    assert list(res) == ["distance"]
+    flat = [float(c) for p in w.positions() for c in (p if hasattr(p, "__len__") else [p])]
+    length = math.dist(flat[0:3], flat[3:6])
+    assert res["distance"]["unit"] == "m" and res["distance"]["count"] == 1
+    assert res["distance"]["max"] == pytest.approx(abs(length - 1.0), abs=1e-15)
+    assert res["distance"]["rms"] == res["distance"]["max"]

@@ -15,21 +15,22 @@
 
 namespace embra {
 
-// X(name, number, arity, multipliers, description). The numbers are part of the C ABI.
-#define EMBRA_CONSTRAINT_KINDS(X)                                                                        \
-  X(distance, 0, 2, 1, "|x0 - x1| = rest (stretch)")                                                     \
-  X(edge_angle, 1, 3, 1, "angle at x0 between x1 - x0 and x2 - x0 (shear)")                              \
-  X(dihedral, 2, 4, 1, "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                                 \
-  X(tet_volume, 3, 4, 1, "signed volume of (x0,x1,x2,x3) = rest")                                        \
-  X(weld, 4, 2, 3, "x0 = x1")                                                                            \
-  X(tether, 5, 2, 1, "|x0 - x1| <= rest (long-range attachment, unilateral)")                            \
-  X(planarity, 6, 4, 1, "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")      \
-  X(plane_offset, 7, 4, 1, "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)") \
-  X(equal_length, 8, 4, 1, "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")
+// X(name, number, arity, multipliers, unit, description). The numbers are part of the C ABI; the
+// unit is that of the constraint's value and residual (model units: m for metres).
+#define EMBRA_CONSTRAINT_KINDS(X)                                                                             \
+  X(distance, 0, 2, 1, "m", "|x0 - x1| = rest (stretch)")                                                     \
+  X(edge_angle, 1, 3, 1, "rad", "angle at x0 between x1 - x0 and x2 - x0 (shear)")                            \
+  X(dihedral, 2, 4, 1, "rad", "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                               \
+  X(tet_volume, 3, 4, 1, "m^3", "signed volume of (x0,x1,x2,x3) = rest")                                      \
+  X(weld, 4, 2, 3, "m", "x0 = x1")                                                                            \
+  X(tether, 5, 2, 1, "m", "|x0 - x1| <= rest (long-range attachment, unilateral)")                            \
+  X(planarity, 6, 4, 1, "m", "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")      \
+  X(plane_offset, 7, 4, 1, "m", "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)") \
+  X(equal_length, 8, 4, 1, "m", "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")
 
 /// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
 enum class Kind : int32_t {
-#define EMBRA_KIND_ENUM(name, number, arity, multipliers, what) name = number,
+#define EMBRA_KIND_ENUM(name, number, arity, multipliers, unit, what) name = number,
   EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_ENUM)
 #undef EMBRA_KIND_ENUM
 };
@@ -40,11 +41,13 @@ struct KindInfo {
   std::string_view name;  // the name in the scene format
   int arity;              // particles per constraint
   int multipliers;        // Lagrange multipliers per constraint
+  std::string_view unit;  // of the constraint's value and residual ("m", "rad", "m^3")
   std::string_view what;  // what the constraint holds
 };
 
 inline constexpr std::array kKinds = {
-#define EMBRA_KIND_ROW(name, number, arity, multipliers, what) KindInfo{Kind::name, #name, arity, multipliers, what},
+#define EMBRA_KIND_ROW(name, number, arity, multipliers, unit, what) \
+  KindInfo{Kind::name, #name, arity, multipliers, unit, what},
     EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_ROW)
 #undef EMBRA_KIND_ROW
 };
@@ -76,8 +79,8 @@ constexpr int multipliers(Kind kind) {
 /// The kind's name in the scene format ("unknown" for a number that is no kind).
 constexpr const char* kind_name(Kind kind) {
   switch (kind) {
-#define EMBRA_KIND_NAME(name, number, arity, multipliers, what) \
-  case Kind::name:                                              \
+#define EMBRA_KIND_NAME(name, number, arity, multipliers, unit, what) \
+  case Kind::name:                                                    \
     return #name;
     EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_NAME)
 #undef EMBRA_KIND_NAME

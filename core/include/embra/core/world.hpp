@@ -173,13 +173,27 @@ struct GroupReport {
   double residual_rms = 0.0;
 };
 
+/// The residuals of one kind of constraint over the world, in the kind's own unit (KindInfo::unit;
+/// pins and contacts: m).
+struct KindResidual {
+  int64_t count = 0;
+  double max = 0.0;
+  double rms = 0.0;
+};
+/// StepReport::by_kind: the constraint kinds in table order, then the pins (soft and hard), then the
+/// contacts (penetration of particles into colliders and of panel faces into spheres).
+constexpr int kResidualPins = kKindCount;
+constexpr int kResidualContacts = kKindCount + 1;
+constexpr int kResidualKinds = kKindCount + 2;
+
 struct StepReport {
   int64_t frame = 0;            // frames stepped since creation
   double time = 0.0;            // simulated seconds
   double kinetic_energy = 0.0;  // J
   double max_speed = 0.0;       // m/s
-  double residual_max = 0.0;    // over all constraints, in each constraint's own unit
-  double residual_rms = 0.0;
+  double residual_max = 0.0;    // over all constraints, in each constraint's own unit (mixed: by_kind
+  double residual_rms = 0.0;    // says which unit)
+  std::array<KindResidual, kResidualKinds> by_kind{};
   int64_t constraint_count = 0;
   int64_t contact_count = 0;
   bool settled = false;
