@@ -36,7 +36,7 @@ template <class F>
 decltype(auto) visit_kind(Kind kind, F&& f) {
   switch (kind) {
 #define EMBRA_KIND_VISIT(name, number, arity, multipliers, unit, what) \
-  case Kind::name:                                               \
+  case Kind::name:                                                     \
     return f(KindTag<Kind::name>{});
     EMBRA_CONSTRAINT_KINDS(EMBRA_KIND_VISIT)
 #undef EMBRA_KIND_VISIT
