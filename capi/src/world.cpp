@@ -252,6 +252,66 @@ embra_status embra_world_get_residuals(const embra_world* world, embra_kind_resi
   });
 }
 
+embra_status embra_world_get_worst_constraints(const embra_world* world, embra_constraint_residual* out,
+                                               int32_t capacity, int32_t* out_count) {
+  return guard("embra_world_get_worst_constraints", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    if (capacity > 0) need(out, "out");
+    const std::vector<embra::ConstraintResidual> worst = world->world.worst_constraints(static_cast<size_t>(capacity));
+    for (size_t i = 0; i < worst.size(); ++i) {
+      const embra::ConstraintResidual& c = worst[i];
+      embra_constraint_residual o{};
+      o.kind = c.kind == embra::kResidualPins ? EMBRA_RESIDUAL_PINS : c.kind;
+      o.index = c.index;
+      o.group = from_id<embra_group_id>(c.group);
+      o.pin = from_id<embra_pin_id>(c.pin);
+      for (int k = 0; k < 4; ++k) o.particles[k] = c.particles[k];
+      o.residual = c.residual;
+      o.violation = c.violation;
+      o.force = c.force;
+      out[i] = o;
+    }
+    *out_count = static_cast<int32_t>(worst.size());
+  });
+}
+
+embra_status embra_world_get_group_conflicts(const embra_world* world, embra_group_conflict* out, int32_t capacity,
+                                             int32_t* out_count) {
+  return guard("embra_world_get_group_conflicts", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::GroupConflict> conflicts = world->world.group_conflicts();
+    const int32_t n = static_cast<int32_t>(conflicts.size());
+    if (!fits(out, capacity, n, "conflicts")) {
+      *out_count = n;
+      return;
+    }
+    for (int32_t i = 0; i < n; ++i)
+      out[i] = embra_group_conflict{from_id<embra_group_id>(conflicts[i].a), from_id<embra_group_id>(conflicts[i].b),
+                                    conflicts[i].force, conflicts[i].particles};
+    *out_count = n;
+  });
+}
+
+embra_status embra_group_get_residuals(const embra_world* world, embra_group_id group, int32_t kind, double* out,
+                                       int64_t capacity, int64_t* out_count) {
+  return guard("embra_group_get_residuals", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    if (!embra::is_kind(kind))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "kind " + num(kind) + " is not an embra_constraint_kind");
+    const std::vector<double> r = world->world.constraint_residuals(to_id(group), static_cast<embra::Kind>(kind));
+    const int64_t n = static_cast<int64_t>(r.size());
+    if (!fits(out, capacity, n, "doubles")) {
+      *out_count = n;
+      return;
+    }
+    std::copy(r.begin(), r.end(), out);
+    *out_count = n;
+  });
+}
+
 embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
   return guard("embra_world_get_warning", world, [&] {
     need(out_warning, "out_warning");

@@ -659,6 +659,36 @@ static void print_residuals(const embra_world* world) {
            (long long)res[i].count);
 }
 
+/* What fights, for a person: the worst constraints (by violation x force) and the groups pulling
+ * against each other, after a run that did not come to rest. */
+static void print_fighting(const embra_world* world) {
+  embra_constraint_residual worst[5];
+  int32_t n = 0;
+  if (embra_world_get_worst_constraints(world, worst, 5, &n) == EMBRA_OK)
+    for (int32_t i = 0; i < n; ++i) {
+      const embra_constraint_residual* c = &worst[i];
+      char what[96];
+      if (c->kind == EMBRA_RESIDUAL_PINS)
+        snprintf(what, sizeof what, "pin %u on particle %d", c->pin.index, c->particles[0]);
+      else
+        snprintf(what, sizeof what, "%s %d (particles %d %d%s)", embra_residual_name(c->kind), c->index,
+                 c->particles[0], c->particles[1], c->particles[2] >= 0 ? " ..." : "");
+      const char* unit = embra_residual_unit(c->kind);
+      /* The force's unit is the one conjugate to the value's: N for a length, N m for an angle. */
+      const char* force_unit = strcmp(unit, "rad") == 0 ? "N m" : strcmp(unit, "m^3") == 0 ? "N/m^2" : "N";
+      printf("%-18s %s of group %u: %.3e %s from rest, %.3e %s (residual %.3e)\n", i == 0 ? "fighting" : "", what,
+             c->group.index, c->violation, unit, c->force, force_unit, c->residual);
+    }
+  if (embra_world_get_group_conflicts(world, NULL, 0, &n) != EMBRA_OK || n == 0) return;
+  embra_group_conflict* all = malloc((size_t)n * sizeof *all);
+  if (all && embra_world_get_group_conflicts(world, all, n, &n) == EMBRA_OK)
+    for (int32_t i = 0; i < n && i < 3; ++i)
+      printf("%-18s groups %u and %u pull against each other: %.3e N over %lld particles\n",
+             i == 0 ? "groups fighting" : "", all[i].a.index, all[i].b.index, all[i].force,
+             (long long)all[i].particles);
+  free(all);
+}
+
 /* Why embra_world_solve stopped, for a person. */
 static void print_solve_outcome(const embra_solve_result* s, const embra_world* world) {
   static const char* const metric_names[] = {"planarity", "thickness error", "miter twist", "corner off plane"};
@@ -889,6 +919,7 @@ static int cmd_run(int argc, char** argv) {
     printf("%-18s since frame %ld\n", "settled", settled_at);
   else
     printf("%-18s no\n", "settled");
+  if (settled_at < 0 && r.frame > 0) print_fighting(world);
   if (until >= 0 && rc == 0) {
     print_solve_outcome(&solved, world);
     if (solved.outcome != EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE) rc = EXIT_UNSETTLED;

@@ -269,6 +269,30 @@ namespace Embra
         public double Rms;
     }
 
+    /// <summary>embra_constraint_residual.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct ConstraintResidual
+    {
+        public int Kind;
+        public int Index;
+        public GroupId Group;
+        public PinId Pin;
+        public fixed int Particles[4];
+        public double Residual;
+        public double Violation;
+        public double Force;
+    }
+
+    /// <summary>embra_group_conflict.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct GroupConflict
+    {
+        public GroupId A;
+        public GroupId B;
+        public double Force;
+        public long Particles;
+    }
+
     /// <summary>embra_group_report.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GroupReport
@@ -524,6 +548,9 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_residual_unit(int kind);
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_residual_name(int kind);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_residuals(IntPtr world, [Out] KindResidual[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_worst_constraints(IntPtr world, [Out] ConstraintResidual[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_group_conflicts(IntPtr world, [Out] GroupConflict[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_residuals(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);

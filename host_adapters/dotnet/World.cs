@@ -772,6 +772,42 @@ namespace Embra
             return res;
         }
 
+        /// <summary>The `count` constraints and soft pins of the last step that fight hardest, worst
+        /// first, ranked by Violation x Force (an energy for every kind; embra_world_get_worst_constraints).
+        /// Kind is a ConstraintKind's number or Residual.Pins; Index the constraint's place among its
+        /// group's constraints of that kind, as added (-1 for a pin); Force in N (N m for angles).</summary>
+        public ConstraintResidual[] WorstConstraints(int count = 10)
+        {
+            Need(count >= 0, "count: must be >= 0");
+            var res = new ConstraintResidual[count];
+            int n = 0;
+            Call(w => Native.embra_world_get_worst_constraints(w, res, res.Length, out n));
+            Array.Resize(ref res, n);
+            return res;
+        }
+
+        /// <summary>Pairs of groups whose forces on shared particles oppose in the last step, largest
+        /// first (embra_world_get_group_conflicts): A before B in the projection order, Force in N.</summary>
+        public GroupConflict[] GroupConflicts()
+        {
+            int n = 0;
+            Call(w => Native.embra_world_get_group_conflicts(w, null, 0, out n));
+            var res = new GroupConflict[n];
+            Call(w => Native.embra_world_get_group_conflicts(w, res, res.Length, out n));
+            return res;
+        }
+
+        /// <summary>The residual of every constraint of `kind` in `group` after the last step, in the
+        /// order they were added, in the kind's unit (embra_group_get_residuals).</summary>
+        public double[] GroupResiduals(GroupId group, ConstraintKind kind)
+        {
+            long n = 0;
+            Call(w => Native.embra_group_get_residuals(w, group, (int)kind, null, 0, out n));
+            var res = new double[n];
+            Call(w => Native.embra_group_get_residuals(w, group, (int)kind, res, res.Length, out n));
+            return res;
+        }
+
         public StepReport Report
         {
             get { var r = new StepReport(); Call(w => Native.embra_world_get_report(w, out r)); return r; }

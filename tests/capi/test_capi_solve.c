@@ -239,6 +239,95 @@ static void test_residuals_by_kind(void) {
   embra_world_destroy(w);
 }
 
+/* A cable of 10 hard links hanging from one end; that end held by two soft pins (1e-3 m/N) to
+ * targets 0.5 m to either side, each pin in its own group. The two groups pull the end straight apart
+ * with 0.5 m / 1e-3 m/N = 500 N each (the cable's weight, 9.81 N, tilts them a little), so that pair
+ * is the first conflict, about 500 N on one particle, and the two pins are the worst constraints
+ * (stretched 0.5 m at 500 N); the cable's hard links, which carry 10 N, come after. */
+static void test_fighting_groups(void) {
+  embra_world* w = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def bd = embra_default_body_def();
+  embra_body_id body;
+  embra_group_def gd = embra_default_group_def();
+  embra_group_id ga, gb;
+  embra_pin_def pd = embra_default_pin_def();
+  embra_pin_id pa, pb;
+  embra_group_conflict conflicts[8];
+  embra_constraint_residual worst[4];
+  double xyz[33], res[16];
+  int32_t first = -1, n = -1, i;
+  int64_t count = -1;
+  s.damping = 5.0;
+  CHECK_OK(embra_world_create(&w, &s));
+  for (i = 0; i < 11; ++i) {
+    xyz[3 * i] = 0.0;
+    xyz[3 * i + 1] = 0.0;
+    xyz[3 * i + 2] = -0.1 * i;
+  }
+  bd.vertex_count = 11;
+  bd.positions = xyz;
+  bd.material.mass = 1.0;
+  CHECK_OK(embra_body_create(w, &bd, &body, &first));
+  for (i = 0; i < 10; ++i) {
+    embra_constraint_def c = embra_default_constraint_def();
+    c.particles[0] = first + i;
+    c.particles[1] = first + i + 1;
+    CHECK_OK(embra_constraint_add(w, &c));
+  }
+  gd.order = 1;
+  CHECK_OK(embra_group_create(w, &gd, &ga));
+  gd.order = 2;
+  CHECK_OK(embra_group_create(w, &gd, &gb));
+  pd.particle = first;
+  pd.compliance = 1e-3;
+  pd.target[0] = -0.5;
+  pd.group = ga;
+  CHECK_OK(embra_pin_create(w, &pd, &pa));
+  pd.target[0] = 0.5;
+  pd.group = gb;
+  CHECK_OK(embra_pin_create(w, &pd, &pb));
+  for (i = 0; i < 300; ++i) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_group_conflicts(w, NULL, 0, &n));
+  CHECK(n >= 1);
+  CHECK_OK(embra_world_get_group_conflicts(w, conflicts, 8, &n));
+  CHECK(conflicts[0].a.index == ga.index && conflicts[0].b.index == gb.index);
+  CHECK_NEAR(conflicts[0].force, 500.0, 10.0);
+  CHECK_INT(conflicts[0].particles, 1);
+  for (i = 1; i < n; ++i) CHECK(conflicts[i].force < 0.1 * conflicts[0].force);
+  CHECK_OK(embra_world_get_worst_constraints(w, worst, 4, &n));
+  CHECK_INT(n, 4);
+  CHECK_INT(worst[0].kind, EMBRA_RESIDUAL_PINS);
+  CHECK_INT(worst[1].kind, EMBRA_RESIDUAL_PINS);
+  CHECK((worst[0].pin.index == pa.index && worst[1].pin.index == pb.index) ||
+        (worst[0].pin.index == pb.index && worst[1].pin.index == pa.index));
+  CHECK_INT(worst[0].particles[0], first);
+  CHECK_INT(worst[0].particles[1], -1);
+  CHECK_NEAR(worst[0].violation, 0.5, 0.02);
+  CHECK_NEAR(worst[0].force, 500.0, 10.0);
+  /* Nearly converged (one iteration a substep: 1.2 % left): the residual does not show the fight. */
+  CHECK(worst[0].residual < 0.02 * worst[0].violation);
+  CHECK_INT(worst[2].kind, EMBRA_CONSTRAINT_DISTANCE);
+  CHECK(worst[2].force < 10.0 && worst[2].index >= 0 && worst[2].index < 10);
+  /* Per constraint, in the order added: the hard links' residuals. */
+  {
+    embra_group_id def_group;
+    CHECK_OK(embra_world_default_group(w, &def_group));
+    CHECK_OK(embra_group_get_residuals(w, def_group, EMBRA_CONSTRAINT_DISTANCE, NULL, 0, &count));
+    CHECK_INT(count, 10);
+    CHECK_OK(embra_group_get_residuals(w, def_group, EMBRA_CONSTRAINT_DISTANCE, res, 16, &count));
+    /* Under 2e-3 of the 0.1 m link; the top one, next to the pins' 1,000 N, holds the most. */
+    for (i = 0; i < 10; ++i) CHECK(res[i] >= 0.0 && res[i] < 2e-4);
+    for (i = 1; i < 10; ++i) CHECK(res[i] < res[0]);
+    CHECK_STATUS(embra_group_get_residuals(w, def_group, 42, res, 16, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(embra_group_get_residuals(w, def_group, EMBRA_CONSTRAINT_DISTANCE, res, 5, &count),
+                 EMBRA_ERROR_BUFFER_TOO_SMALL);
+  }
+  CHECK_STATUS(embra_world_get_worst_constraints(w, NULL, 4, &n), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_group_conflicts(w, conflicts, 0, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  embra_world_destroy(w);
+}
+
 static void test_refusals(void) {
   embra_world* w = NULL;
   embra_solve_def d = embra_default_solve_def();
@@ -275,6 +364,7 @@ int main(void) {
   RUN(test_chain_settles);
   RUN(test_panel_out_of_tolerance);
   RUN(test_residuals_by_kind);
+  RUN(test_fighting_groups);
   RUN(test_refusals);
   return capi_test_finish();
 }

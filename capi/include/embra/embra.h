@@ -594,6 +594,47 @@ EMBRA_API const char* embra_residual_name(int32_t kind);
 EMBRA_API embra_status embra_world_get_residuals(const embra_world* world, embra_kind_residual* out, int32_t capacity,
                                                  int32_t* out_count);
 
+/* Which constraints are fighting (after a step). A constraint's force is its multiplier of the last
+ * substep over h^2, in the unit conjugate to its value: N for a length, N m for an angle, N/m^2 for a
+ * volume; its violation |C| (how far from its rest) times its force is then an energy (J) for every
+ * kind, the scale on which the worst are ranked (the residual breaking ties). A compliant constraint
+ * that has converged has a residual near 0 however far it is stretched: the violation shows it. */
+typedef struct embra_constraint_residual {
+  int32_t kind;         /* EMBRA_CONSTRAINT_*, or EMBRA_RESIDUAL_PINS for a soft pin */
+  int32_t index;        /* in its group's constraints of that kind, in the order they were added
+                           (embra_group_get_residuals); -1 for a pin */
+  embra_group_id group; /* its group */
+  embra_pin_id pin;     /* the soft pin; {0, 0} otherwise */
+  int32_t particles[4]; /* its particles; -1 past the kind's arity */
+  double residual;      /* |C + compliance/h^2 * lambda| in the kind's unit (embra_residual_unit) */
+  double violation;     /* |C|, in the same unit (a tether: how far overstretched) */
+  double force;         /* |lambda| / h^2 */
+} embra_constraint_residual;
+
+/* The `capacity` worst constraints and soft pins of the last step, worst first; *out_count
+ * (required) receives how many were written (fewer when the world holds fewer). */
+EMBRA_API embra_status embra_world_get_worst_constraints(const embra_world* world, embra_constraint_residual* out,
+                                                         int32_t capacity, int32_t* out_count);
+
+typedef struct embra_group_conflict {
+  embra_group_id a, b; /* a before b in the projection order */
+  double force;        /* N: over their shared movable particles, the smaller of the two groups' forces on
+                          each times how far they point against each other (-cos of the angle, where
+                          negative): two groups pulling a particle straight apart add the smaller pull */
+  int64_t particles;   /* particles where the two forces point more than 120 degrees apart */
+} embra_group_conflict;
+
+/* Every pair of groups pulling against each other in the last step, largest force first (two-call
+ * pattern: out NULL and capacity 0 ask for the count; a smaller capacity is BUFFER_TOO_SMALL). */
+EMBRA_API embra_status embra_world_get_group_conflicts(const embra_world* world, embra_group_conflict* out,
+                                                       int32_t capacity, int32_t* out_count);
+
+/* The residual of every constraint of `kind` in `group` after the last step, in the order they were
+ * added to the group, in the kind's unit: for colouring a mesh by what fights. Constraints added
+ * since the last step read 0. Two-call pattern (out NULL, capacity 0: *out_count only). */
+EMBRA_API embra_status embra_group_get_residuals(const embra_world* world, embra_group_id group, int32_t kind,
+                                                 double* out, int64_t capacity, int64_t* out_count);
+
 typedef struct embra_group_report {
   int64_t count;       /* constraints in the group (soft pins and contacts included) */
   double residual_max; /* as in embra_step_report, over this group */

@@ -26,6 +26,7 @@
 #include "model/kind_traits.hpp"
 #include "solver/contacts.hpp"
 #include "solver/kernels.hpp"
+#include "solver/residuals.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -91,36 +92,6 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
     const double dl = (-c - alpha * a.lambda[i]) / denom;
     a.lambda[i] += dl;
     for (int k = 0; k < N; ++k) x[p[k]] += (w[p[k]] * dl) * e.grad[k];
-  }
-}
-
-// --- residuals ---------------------------------------------------------------------------------
-
-/// XPBD residual |C + alpha~ lambda| (for a tether only while it pulls or is overstretched).
-/// Distances and dihedral angles are evaluated by the kernels' value passes into `values`.
-template <Kind K>
-void residuals(ThreadPool& pool, const SolverArray& a, double inv_h2, const std::vector<Vec3>& x, double& max,
-               double& sum_sq, std::vector<double>& values) {
-  constexpr int N = arity(K);
-  constexpr bool kLanes = K == Kind::distance || K == Kind::tether || K == Kind::dihedral;
-  if constexpr (kLanes) {
-    values.resize(a.size());
-    const Kernels& k = kernels();
-    values_pass(pool, K == Kind::dihedral ? k.dihedral_values : k.distance_values, a, coords(x), values.data());
-  }
-  for (size_t i = 0; i < a.size(); ++i) {
-    double value;
-    if constexpr (kLanes)
-      value = values[i];
-    else
-      value = KindTraits<K>::evaluate(&a.ids[i * N], x).value;
-    const double c = KindTraits<K>::deviation(value, a.rest[i]);
-    double r = c + a.compliance[i] * inv_h2 * a.lambda[i];
-    if constexpr (K == Kind::tether)
-      if (a.lambda[i] == 0.0) r = std::max(c, 0.0);
-    r = std::abs(r);
-    max = std::max(max, r);
-    sum_sq += r * r;
   }
 }
 

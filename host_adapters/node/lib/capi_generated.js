@@ -255,6 +255,22 @@ const KindResidual = koffi.struct('embra_kind_residual', {
   max: 'double',
   rms: 'double',
 });
+const ConstraintResidual = koffi.struct('embra_constraint_residual', {
+  kind: 'int32_t',
+  index: 'int32_t',
+  group: GroupIdType,
+  pin: PinIdType,
+  particles: koffi.array('int32_t', 4, 'Array'),
+  residual: 'double',
+  violation: 'double',
+  force: 'double',
+});
+const GroupConflict = koffi.struct('embra_group_conflict', {
+  a: GroupIdType,
+  b: GroupIdType,
+  force: 'double',
+  particles: 'int64_t',
+});
 const GroupReport = koffi.struct('embra_group_report', {
   count: 'int64_t',
   residual_max: 'double',
@@ -403,6 +419,8 @@ const STRUCTS = {
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
   embra_kind_residual: KindResidual,
+  embra_constraint_residual: ConstraintResidual,
+  embra_group_conflict: GroupConflict,
   embra_group_report: GroupReport,
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
@@ -474,6 +492,9 @@ const PROTOTYPES = {
   embra_residual_unit: 'const char *embra_residual_unit(int32_t kind)',
   embra_residual_name: 'const char *embra_residual_name(int32_t kind)',
   embra_world_get_residuals: 'embra_status embra_world_get_residuals(const embra_world *world, embra_kind_residual *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_world_get_worst_constraints: 'embra_status embra_world_get_worst_constraints(const embra_world *world, embra_constraint_residual *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_world_get_group_conflicts: 'embra_status embra_world_get_group_conflicts(const embra_world *world, embra_group_conflict *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_group_get_residuals: 'embra_status embra_group_get_residuals(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
   embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
   embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
@@ -531,6 +552,7 @@ module.exports = {
   CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
   PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
   SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef,
-  StepReport, KindResidual, GroupReport, SolveDef, SolveResult, Warning, PanelMeshDef, Tolerance, Tolerances,
-  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  StepReport, KindResidual, ConstraintResidual, GroupConflict, GroupReport, SolveDef, SolveResult, Warning,
+  PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef,
+  PressureDef, SurfaceTensionDef, VortexDef,
 };

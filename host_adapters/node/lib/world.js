@@ -917,6 +917,71 @@ class World {
     return result;
   }
 
+  /**
+   * The `count` (10) constraints and soft pins of the last step that fight hardest, worst first
+   * (embra_world_get_worst_constraints: ranked by violation x force, an energy for every kind): [{kind
+   * (a KINDS name, or 'pins'), group, index (in the group's constraints of that kind, as added; -1 for
+   * a pin), pin (PinId or null), particles, residual and violation (in unit), unit, force (N; N m for
+   * angles, N/m^2 for volumes)}].
+   */
+  worstConstraints(count = 10) {
+    buf.int32(count, 'count');
+    const { koffi } = capi;
+    const size = koffi.sizeof(capi.ConstraintResidual);
+    const out = Buffer.alloc(Math.max(count, 1) * size);
+    const n = [0];
+    this.#call('embra_world_get_worst_constraints', out, count, n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const c = koffi.decode(out, k * size, capi.ConstraintResidual);
+      const pin = c.kind === capi.RESIDUAL_PINS;
+      const arity = pin ? 1 : lib.embra_constraint_arity(c.kind);
+      result.push({
+        kind: lib.embra_residual_name(c.kind), group: new GroupId(c.group.index, c.group.generation), index: c.index,
+        pin: pin ? new PinId(c.pin.index, c.pin.generation) : null, particles: Array.from(c.particles).slice(0, arity),
+        residual: c.residual, violation: c.violation, unit: lib.embra_residual_unit(c.kind), force: c.force,
+      });
+    }
+    return result;
+  }
+
+  /**
+   * Pairs of groups whose forces on shared particles oppose in the last step, largest first
+   * (embra_world_get_group_conflicts): [{a, b (GroupIds, a first in the projection order), force (N),
+   * particles (where they point more than 120 degrees apart)}].
+   */
+  groupConflicts() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_group_conflicts', null, 0, n);
+    const size = koffi.sizeof(capi.GroupConflict);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_group_conflicts', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const c = koffi.decode(out, k * size, capi.GroupConflict);
+      result.push({
+        a: new GroupId(c.a.index, c.a.generation), b: new GroupId(c.b.index, c.b.generation), force: c.force,
+        particles: Number(c.particles),
+      });
+    }
+    return result;
+  }
+
+  /**
+   * The residual of every constraint of `kind` in `group` after the last step, in the order they were
+   * added, in the kind's unit (embra_group_get_residuals): a Float64Array.
+   */
+  groupResiduals(group, kind) {
+    if (!(group instanceof GroupId)) throw new TypeError(`group: expected a GroupId, got ${buf.describe(group)}`);
+    const k = enumValue(kind, KINDS, 'kind');
+    const n = [0];
+    this.#call('embra_group_get_residuals', group, k, null, 0, n);
+    const out = new Float64Array(Number(n[0]));
+    this.#call('embra_group_get_residuals', group, k, out, out.length, n);
+    return out;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);

@@ -311,6 +311,30 @@ class KindResidual(ctypes.Structure):
     ]
 
 
+class ConstraintResidual(ctypes.Structure):
+    """embra_constraint_residual."""
+    _fields_ = [
+        ("kind", c_int32),
+        ("index", c_int32),
+        ("group", GroupId),
+        ("pin", PinId),
+        ("particles", c_int32 * 4),
+        ("residual", c_double),
+        ("violation", c_double),
+        ("force", c_double),
+    ]
+
+
+class GroupConflict(ctypes.Structure):
+    """embra_group_conflict."""
+    _fields_ = [
+        ("a", GroupId),
+        ("b", GroupId),
+        ("force", c_double),
+        ("particles", c_int64),
+    ]
+
+
 class GroupReport(ctypes.Structure):
     """embra_group_report."""
     _fields_ = [
@@ -551,6 +575,9 @@ PROTOTYPES = {
     "embra_residual_unit": (c_char_p, [c_int32]),
     "embra_residual_name": (c_char_p, [c_int32]),
     "embra_world_get_residuals": (c_int32, [c_void_p, POINTER(KindResidual), c_int32, POINTER(c_int32)]),
+    "embra_world_get_worst_constraints": (c_int32, [c_void_p, POINTER(ConstraintResidual), c_int32, POINTER(c_int32)]),
+    "embra_world_get_group_conflicts": (c_int32, [c_void_p, POINTER(GroupConflict), c_int32, POINTER(c_int32)]),
+    "embra_group_get_residuals": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
     "embra_default_solve_def": (SolveDef, []),
     "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),

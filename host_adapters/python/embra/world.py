@@ -17,7 +17,7 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef,
+                    ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef,
                     StepReport,
                     Tolerances, Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
@@ -686,6 +686,47 @@ class World:
         return {lib.embra_residual_name(r.kind).decode(): {"unit": lib.embra_residual_unit(r.kind).decode(),
                                                            "count": r.count, "max": r.max, "rms": r.rms}
                 for r in out[:n.value]}
+
+    def worst_constraints(self, count=10):
+        """The `count` constraints and soft pins of the last step that fight hardest, worst first
+        (embra_world_get_worst_constraints: ranked by violation x force, an energy for every kind): a
+        list of dicts {kind (a KINDS name, or "pins"), group, index (in the group's constraints of that
+        kind, as added; -1 for a pin), pin (PinId or None), particles, residual and violation (in
+        unit), unit, force (N; N m for angles, N/m^2 for volumes)}."""
+        out = (ConstraintResidual * max(count, 1))()
+        n = c_int32()
+        self._call("embra_world_get_worst_constraints", out, buf.int32(count, "count"), byref(n))
+        result = []
+        for c in out[:n.value]:
+            arity = 1 if c.kind == _capi.RESIDUAL_PINS else lib.embra_constraint_arity(c.kind)
+            result.append({"kind": lib.embra_residual_name(c.kind).decode(),
+                           "group": GroupId(c.group.index, c.group.generation), "index": c.index,
+                           "pin": PinId(c.pin.index, c.pin.generation) if c.kind == _capi.RESIDUAL_PINS else None,
+                           "particles": list(c.particles[:arity]), "residual": c.residual,
+                           "violation": c.violation, "unit": lib.embra_residual_unit(c.kind).decode(),
+                           "force": c.force})
+        return result
+
+    def group_conflicts(self):
+        """Pairs of groups whose forces on shared particles oppose in the last step, largest first
+        (embra_world_get_group_conflicts): a list of dicts {a, b (GroupIds, a first in the projection
+        order), force (N), particles (where they point more than 120 degrees apart)}."""
+        n = c_int32()
+        self._call("embra_world_get_group_conflicts", None, 0, byref(n))
+        out = (GroupConflict * max(n.value, 1))()
+        self._call("embra_world_get_group_conflicts", out, n.value, byref(n))
+        return [{"a": GroupId(c.a.index, c.a.generation), "b": GroupId(c.b.index, c.b.generation), "force": c.force,
+                 "particles": c.particles} for c in out[:n.value]]
+
+    def group_residuals(self, group, kind):
+        """The residual of every constraint of `kind` in `group` after the last step, in the order they
+        were added, in the kind's unit (embra_group_get_residuals): a list of floats."""
+        g, k = _id(group, GroupId, "group"), _enum(kind, KINDS, "kind")
+        n = c_int64()
+        self._call("embra_group_get_residuals", g, k, None, 0, byref(n))
+        out = (c_double * max(n.value, 1))()
+        self._call("embra_group_get_residuals", g, k, out, n.value, byref(n))
+        return list(out[:n.value])
 
     def report(self):
         r = StepReport()

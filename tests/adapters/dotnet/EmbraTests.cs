@@ -319,6 +319,45 @@ namespace Embra.Tests
             }
         }
 
+        // A hanging cable's top held by two soft pins (1e-3 m/N) 0.5 m to either side, each in its own
+        // group: 500 N each way on one particle; that pair is named first.
+        [Test]
+        public void TwoGroupsPullingACableApartAreNamedFirst()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Damping = 5.0;
+            using (var w = new World(solver))
+            {
+                var xyz = new double[33];
+                for (int i = 0; i < 11; ++i) xyz[3 * i + 2] = -0.1 * i;
+                var def = Library.DefaultBodyDef();
+                def.Material.Mass = 1.0;
+                var b = w.CreateBody(xyz, def: def);
+                for (int i = 0; i < 10; ++i) w.AddConstraint(ConstraintKind.Distance, new[] { b.First + i, b.First + i + 1 });
+                var left = w.CreateGroup(order: 1);
+                var right = w.CreateGroup(order: 2);
+                var pa = w.CreatePin(b.First, new[] { -0.5, 0, 0 }, 1e-3, left);
+                var pb = w.CreatePin(b.First, new[] { 0.5, 0, 0 }, 1e-3, right);
+                w.Step(300);
+                var first = w.GroupConflicts()[0];
+                Assert.AreEqual(left.Index, first.A.Index);
+                Assert.AreEqual(right.Index, first.B.Index);
+                Assert.AreEqual(500.0, first.Force, 10.0);
+                Assert.AreEqual(1, first.Particles);
+                var worst = w.WorstConstraints(3);
+                Assert.AreEqual(3, worst.Length);
+                Assert.AreEqual((int)Residual.Pins, worst[0].Kind);
+                Assert.IsTrue((worst[0].Pin.Index == pa.Index && worst[1].Pin.Index == pb.Index) ||
+                              (worst[0].Pin.Index == pb.Index && worst[1].Pin.Index == pa.Index));
+                Assert.AreEqual(0.5, worst[0].Violation, 0.02);
+                Assert.AreEqual(500.0, worst[0].Force, 10.0);
+                Assert.AreEqual((int)ConstraintKind.Distance, worst[2].Kind);
+                var links = w.GroupResiduals(w.DefaultGroup, ConstraintKind.Distance);
+                Assert.AreEqual(10, links.Length);
+                Assert.Less(links.Max(), 2e-4);
+            }
+        }
+
         [Test]
         public void ABadBudgetIsRefusedAndNothingSteps()
         {

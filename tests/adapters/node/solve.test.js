@@ -72,3 +72,33 @@ test('residuals by kind, each in its unit: a rod residual from the positions', (
   assert.equal(res.distance.rms, res.distance.max);
   w.close();
 });
+
+test('two groups pulling a cable apart are named first', () => {
+  // A hanging cable's top held by two soft pins (1e-3 m/N) 0.5 m to either side, each in its own
+  // group: 500 N each way on one particle.
+  const w = new embra.World({ damping: 5.0 });
+  const xyz = [];
+  for (let i = 0; i < 11; i++) xyz.push(0, 0, -0.1 * i);
+  const b = w.createBody(xyz, { mass: 1.0 });
+  for (let i = 0; i < 10; i++) w.addConstraint('distance', [b.first + i, b.first + i + 1]);
+  const left = w.createGroup({ order: 1 });
+  const right = w.createGroup({ order: 2 });
+  const pa = w.createPin(b.first, [-0.5, 0, 0], { compliance: 1e-3, group: left });
+  const pb = w.createPin(b.first, [0.5, 0, 0], { compliance: 1e-3, group: right });
+  w.step(300);
+  const first = w.groupConflicts()[0];
+  assert.ok(first.a.equals(left) && first.b.equals(right));
+  assert.ok(Math.abs(first.force - 500) < 10, `force ${first.force}`);
+  assert.equal(first.particles, 1);
+  const worst = w.worstConstraints(3);
+  assert.ok((worst[0].pin.equals(pa) && worst[1].pin.equals(pb)) || (worst[0].pin.equals(pb) && worst[1].pin.equals(pa)));
+  assert.equal(worst[0].kind, 'pins');
+  assert.deepEqual(worst[0].particles, [b.first]);
+  assert.ok(Math.abs(worst[0].violation - 0.5) < 0.02 && Math.abs(worst[0].force - 500) < 10);
+  assert.equal(worst[2].kind, 'distance');
+  assert.equal(worst[2].particles.length, 2);
+  const links = w.groupResiduals(w.defaultGroup(), 'distance');
+  assert.equal(links.length, 10);
+  assert.ok(Math.max(...links) < 2e-4);
+  w.close();
+});

@@ -288,6 +288,7 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_step_report": _capi.StepReport, "embra_group_report": _capi.GroupReport,
                "embra_solve_def": _capi.SolveDef, "embra_solve_result": _capi.SolveResult,
                "embra_kind_residual": _capi.KindResidual,
+               "embra_constraint_residual": _capi.ConstraintResidual, "embra_group_conflict": _capi.GroupConflict,
                "embra_warning": _capi.Warning, "embra_panel_mesh_def": _capi.PanelMeshDef,
                "embra_tolerance": _capi.Tolerance, "embra_tolerances": _capi.Tolerances,
                "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics,

@@ -65,3 +65,25 @@ def test_residuals_by_kind_in_their_units():
     assert res["distance"]["unit"] == "m" and res["distance"]["count"] == 1
     assert res["distance"]["max"] == pytest.approx(abs(length - 1.0), abs=1e-15)
     assert res["distance"]["rms"] == res["distance"]["max"]
+
+
+def test_two_groups_pulling_a_cable_apart_are_named_first():
+    """A hanging cable's top held by two soft pins (1e-3 m/N) 0.5 m to either side, each in its own
+    group: 500 N each way on one particle."""
+    w = embra.World(damping=5.0)
+    b = w.create_body([[0, 0, -0.1 * i] for i in range(11)], mass=1.0)
+    w.add_constraints("distance", [[b.first + i, b.first + i + 1] for i in range(10)])
+    left, right = w.create_group(order=1), w.create_group(order=2)
+    pa = w.create_pin(b.first, [-0.5, 0, 0], compliance=1e-3, group=left)
+    pb = w.create_pin(b.first, [0.5, 0, 0], compliance=1e-3, group=right)
+    w.step(300)
+    first = w.group_conflicts()[0]
+    assert (first["a"], first["b"]) == (left, right)
+    assert first["force"] == pytest.approx(500, abs=10) and first["particles"] == 1
+    worst = w.worst_constraints(3)
+    assert {worst[0]["pin"], worst[1]["pin"]} == {pa, pb}
+    assert worst[0]["kind"] == "pins" and worst[0]["particles"] == [b.first] and worst[0]["unit"] == "m"
+    assert worst[0]["violation"] == pytest.approx(0.5, abs=0.02) and worst[0]["force"] == pytest.approx(500, abs=10)
+    assert worst[2]["kind"] == "distance" and len(worst[2]["particles"]) == 2 and worst[2]["force"] < 10
+    links = w.group_residuals(w.default_group(), "distance")
+    assert len(links) == 10 and max(links) < 2e-4

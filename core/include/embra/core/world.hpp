@@ -186,6 +186,26 @@ constexpr int kResidualPins = kKindCount;
 constexpr int kResidualContacts = kKindCount + 1;
 constexpr int kResidualKinds = kKindCount + 2;
 
+/// One constraint (or soft pin) of the last step, as the diagnostics see it (World::worst_constraints).
+struct ConstraintResidual {
+  int32_t kind = 0;  // Kind, or kResidualPins for a soft pin
+  Id group;
+  int32_t index = -1;  // in the group's constraints of that kind (ConstraintArray order); -1 for a pin
+  Id pin;              // the soft pin
+  std::array<int32_t, 4> particles{-1, -1, -1, -1};
+  double residual = 0.0;   // |C + alpha~ lambda| in the kind's unit
+  double violation = 0.0;  // |C|: how far from its rest, in the kind's unit
+  double force = 0.0;      // |lambda| / h^2 of the last substep: N (rad kinds: N m; volume: N/m^2)
+};
+
+/// Two groups pulling the same particles opposite ways (World::group_conflicts).
+struct GroupConflict {
+  Id a, b;                // a before b in the projection order
+  double force = 0.0;     // N: over their shared particles, the smaller of the two groups' forces on
+                          // each times how far they point against each other (-cos, where negative)
+  int64_t particles = 0;  // particles where their forces point more than 120 degrees apart
+};
+
 struct StepReport {
   int64_t frame = 0;            // frames stepped since creation
   double time = 0.0;            // simulated seconds
@@ -517,6 +537,14 @@ class World {
   /// iterations) it throws Error(cancelled); any other exception passes through the same way.
   void step(const StepControl& control = {});
   const StepReport& report() const { return report_; }
+  // Diagnostics of the last step (solver/diagnose.cpp): which constraints are fighting.
+  /// The `count` constraints and soft pins ranked by violation times force (J for every kind: a length
+  /// times a force, an angle times a torque, a volume times a pressure), the residual breaking ties.
+  std::vector<ConstraintResidual> worst_constraints(size_t count) const;
+  /// Every pair of groups whose forces on shared particles oppose, largest force first.
+  std::vector<GroupConflict> group_conflicts() const;
+  /// The residual of every constraint of `kind` in `group`, in the group's ConstraintArray order.
+  std::vector<double> constraint_residuals(Id group, Kind kind) const;
   const Warning& warning() const { return warning_; }
 
  private:

@@ -1,0 +1,169 @@
+// Which constraints are fighting: the last step's residual and force of every constraint, ranked,
+// and the groups whose forces on shared particles oppose (World::worst_constraints,
+// World::group_conflicts, World::constraint_residuals).
+//
+// A constraint's force is its multiplier of the last substep over h^2 (the XPBD multiplier is an
+// impulse times h), in the unit conjugate to its value: N for a length, N m for an angle, N/m^2 for
+// a volume. Its violation |C| (how far from its rest) times its force is then an energy for every
+// kind, which ranks constraints of different units on one scale: a constraint held far from its rest
+// while pushing hard ranks first. (A compliant constraint that has converged has a residual near 0
+// however hard it is stretched: the violation is what shows it fighting.)
+#include "embra/core/world.hpp"
+#include "model/kind_traits.hpp"
+#include "solver/residuals.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace embra {
+
+namespace {
+
+/// Calls f(kind, i, residual, violation, force) for every constraint of a group's solver arrays (i
+/// the solver-array index).
+template <class F>
+void each_constraint(ThreadPool& pool, const Group& g, const std::vector<Vec3>& x, double inv_h2, F&& f) {
+  std::vector<double> values, each, violation;
+  for (const KindInfo& info : kKinds)
+    visit_kind(info.kind, [&](auto k) {
+      const SolverArray& a = g.solve[static_cast<int>(info.kind)];
+      if (a.size() == 0) return;
+      if constexpr (k == Kind::weld) {
+        for (size_t i = 0; i < a.size(); ++i) {
+          const Vec3 l(a.lambda[3 * i], a.lambda[3 * i + 1], a.lambda[3 * i + 2]);
+          const Vec3 c = x[a.ids[2 * i]] - x[a.ids[2 * i + 1]];
+          f(info.kind, i, (c + a.compliance[i] * inv_h2 * l).norm(), c.norm(), l.norm() * inv_h2);
+        }
+      } else {
+        double max = 0.0, sq = 0.0;
+        residuals<k>(pool, a, inv_h2, x, max, sq, values, &each, &violation);
+        for (size_t i = 0; i < a.size(); ++i) f(info.kind, i, each[i], violation[i], std::abs(a.lambda[i]) * inv_h2);
+      }
+    });
+}
+
+}  // namespace
+
+std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
+  const double h = settings_.dt / settings_.substeps;
+  const double inv_h2 = 1.0 / (h * h);
+  std::vector<ConstraintResidual> all;
+  for (int32_t slot : order_) {
+    const Group& g = groups_[slot];
+    const Id gid{static_cast<uint32_t>(slot), g.generation};
+    each_constraint(*pool_, g, x_, inv_h2, [&](Kind kind, size_t i, double residual, double violation, double force) {
+      const SolverArray& a = g.solve[static_cast<int>(kind)];
+      ConstraintResidual c;
+      c.kind = static_cast<int32_t>(kind);
+      c.group = gid;
+      c.index = a.source[i];
+      const int n = arity(kind);
+      for (int m = 0; m < n; ++m) c.particles[m] = a.ids[i * n + m];
+      c.residual = residual;
+      c.violation = violation;
+      c.force = force;
+      all.push_back(c);
+    });
+    for (int32_t pi : g.soft_pins) {
+      const Pin& p = pins_[pi];
+      ConstraintResidual c;
+      c.kind = kResidualPins;
+      c.group = gid;
+      c.pin = Id{static_cast<uint32_t>(pi), p.generation};
+      c.particles[0] = p.particle;
+      c.residual = (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm();
+      c.violation = (x_[p.particle] - p.target).norm();
+      c.force = p.lambda.norm() * inv_h2;
+      all.push_back(c);
+    }
+  }
+  // Largest violation x force first, then the larger residual; stable, so equal ones keep the
+  // projection order (group order, kind, colour order).
+  const auto before = [](const ConstraintResidual& a, const ConstraintResidual& b) {
+    const double ea = a.violation * a.force, eb = b.violation * b.force;
+    if (ea != eb) return ea > eb;
+    return a.residual > b.residual;
+  };
+  std::stable_sort(all.begin(), all.end(), before);
+  if (all.size() > count) all.resize(count);
+  return all;
+}
+
+std::vector<GroupConflict> World::group_conflicts() const {
+  const double h = settings_.dt / settings_.substeps;
+  const double inv_h2 = 1.0 / (h * h);
+  // Each group's force on each particle: sum over its constraints of lambda / h^2 grad C.
+  std::vector<std::vector<Vec3>> force;
+  std::vector<int32_t> slots;
+  for (int32_t slot : order_) {
+    const Group& g = groups_[slot];
+    std::vector<Vec3> f(x_.size(), Vec3::Zero());
+    bool any = false;
+    for (const KindInfo& info : kKinds)
+      visit_kind(info.kind, [&](auto k) {
+        const SolverArray& a = g.solve[static_cast<int>(info.kind)];
+        if constexpr (k == Kind::weld) {
+          for (size_t i = 0; i < a.size(); ++i) {
+            const Vec3 l = inv_h2 * Vec3(a.lambda[3 * i], a.lambda[3 * i + 1], a.lambda[3 * i + 2]);
+            f[a.ids[2 * i]] += l;
+            f[a.ids[2 * i + 1]] -= l;
+            any = any || !l.isZero();
+          }
+        } else {
+          constexpr int N = arity(k);
+          for (size_t i = 0; i < a.size(); ++i) {
+            if (a.lambda[i] == 0.0) continue;
+            const auto e = KindTraits<k>::evaluate(&a.ids[i * N], x_);
+            if (!e.valid) continue;
+            for (int m = 0; m < N; ++m) f[a.ids[i * N + m]] += (a.lambda[i] * inv_h2) * e.grad[m];
+            any = true;
+          }
+        }
+      });
+    for (int32_t pi : g.soft_pins) {
+      f[pins_[pi].particle] += inv_h2 * pins_[pi].lambda;
+      any = any || !pins_[pi].lambda.isZero();
+    }
+    if (!any) continue;
+    force.push_back(std::move(f));
+    slots.push_back(slot);
+  }
+  std::vector<GroupConflict> out;
+  for (size_t a = 0; a < slots.size(); ++a)
+    for (size_t b = a + 1; b < slots.size(); ++b) {
+      GroupConflict c;
+      c.a = Id{static_cast<uint32_t>(slots[a]), groups_[slots[a]].generation};
+      c.b = Id{static_cast<uint32_t>(slots[b]), groups_[slots[b]].generation};
+      for (size_t p = 0; p < x_.size(); ++p) {
+        if (w_[p] == 0.0) continue;
+        const Vec3& fa = force[a][p];
+        const Vec3& fb = force[b][p];
+        const double na = fa.norm(), nb = fb.norm();
+        if (na == 0.0 || nb == 0.0) continue;
+        const double cosine = fa.dot(fb) / (na * nb);
+        if (cosine >= 0.0) continue;
+        c.force += std::min(na, nb) * -cosine;
+        if (cosine < -0.5) ++c.particles;
+      }
+      if (c.force > 0.0) out.push_back(c);
+    }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const GroupConflict& l, const GroupConflict& r) { return l.force > r.force; });
+  return out;
+}
+
+std::vector<double> World::constraint_residuals(Id group_id, Kind kind) const {
+  const Group& g = group(group_id);
+  const double h = settings_.dt / settings_.substeps;
+  const double inv_h2 = 1.0 / (h * h);
+  const SolverArray& a = g.solve[static_cast<int>(kind)];
+  std::vector<double> out(g.arrays[static_cast<int>(kind)].size(), 0.0);
+  // The solver arrays are the constraint arrays in colour order as of the last step; a constraint
+  // added since has no residual yet (0).
+  each_constraint(*pool_, g, x_, inv_h2, [&](Kind k, size_t i, double residual, double, double) {
+    if (k == kind && a.source[i] >= 0 && static_cast<size_t>(a.source[i]) < out.size()) out[a.source[i]] = residual;
+  });
+  return out;
+}
+
+}  // namespace embra
