@@ -5,6 +5,8 @@
 #include "embra/core/solve.hpp"
 #include "embra/io/scene.hpp"
 
+#include <algorithm>
+
 using namespace embra::capi;
 
 namespace {
@@ -39,6 +41,10 @@ embra_status embra_world_solve(embra_world* world, const embra_solve_def* def, e
     embra::SolveSettings s;
     s.until = static_cast<embra::SolveUntil>(d.until);
     to_core(kSolveCopies, d, s);
+    // A scene's actions (pins drawn in, a collider moved) are part of the problem: at rest before
+    // their last key is not the end.
+    for (const embra::io::Action& a : world->meta.actions)
+      for (int64_t f : a.frames) s.rest_from_frame = std::max(s.rest_from_frame, f);
     embra::StepControl control;
     if (!world->meta.actions.empty())
       control.before_frame = [world](embra::World& w) {

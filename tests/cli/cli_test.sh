@@ -48,6 +48,20 @@ awk -v rows=$rows '
 # 2 pi sqrt(1 / 9.81) (1 + 0.1^2 / 16) = 2.0073 s, to 1 %. A damped 8-link chain between two pins
 # comes to rest: exit 0. An unknown --until value is a usage error.
 "$embra" run "$tmp/none.json" --until forever >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "--until forever must exit 1"
+# An unsettled run names what fights: a cable's top held by two soft pins 1 m apart, each in its own
+# group, swinging (no damping): the two pins first, then the pair of groups, 500 N apart.
+cat >"$tmp/fight.json" <<'JSON'
+{"format": "embra-scene", "version": 1, "name": "fight", "frames": 120,
+ "groups": [{"name": "left", "order": 1}, {"name": "right", "order": 2}],
+ "bodies": [{"name": "cable", "mesh": {"vertices": [[0, 0, 0], [0, 0, -0.1], [0, 0, -0.2], [0, 0, -0.3]]}, "generate": []}],
+ "constraints": [{"kind": "distance", "particles": [[0, 1], [1, 2], [2, 3]]}],
+ "pins": [{"name": "a", "particle": {"body": "cable", "vertex": 0}, "target": [-0.5, 0, 0], "compliance": 0.001, "group": "left"},
+          {"name": "b", "particle": {"body": "cable", "vertex": 0}, "target": [0.5, 0, 0], "compliance": 0.001, "group": "right"}]}
+JSON
+"$embra" run "$tmp/fight.json" --out "$tmp/fight" >"$tmp/log" 2>&1 && ok || bad "the fight scene must run: $(cat "$tmp/log")"
+grep -q "^fighting  *pin [0-9]* on particle 0 of group" "$tmp/log" && ok || bad "no fighting pin named: $(cat "$tmp/log")"
+grep -q "^groups fighting  *groups 2 and 3 pull against each other: 4\.9[0-9]*e+02 N\|^groups fighting  *groups 2 and 3 pull against each other: 5\.0[0-9]*e+02 N" "$tmp/log" \
+  && ok || bad "the two groups are not named first at about 500 N: $(cat "$tmp/log")"
 cat >"$tmp/pendulum.json" <<'JSON'
 {"format": "embra-scene", "version": 1, "name": "pendulum",
  "bodies": [{"name": "p", "mesh": {"vertices": [[0, 0, 0], [0.09983341664682815, 0, -0.9950041652780258]],
@@ -70,6 +84,13 @@ JSON
 "$embra" run "$tmp/chain.json" --until tolerance --out "$tmp/chain" >"$tmp/log" 2>&1 && ok || bad "a damped chain must come to rest: $(cat "$tmp/log")"
 grep -q "at rest and within tolerance after" "$tmp/log" && ok || bad "the chain's reason is missing: $(cat "$tmp/log")"
 [ -s "$tmp/chain/final.json" ] && [ "$(wc -l <"$tmp/chain/metrics.jsonl")" -eq 1 ] && ok || bad "--until writes final.json and one metrics record"
+# The same chain with its right pin moved in over frames 0-150: at rest before frame 150 does not
+# count (the scene's actions are part of the problem), so it stops at frame 160 or later.
+sed 's/"pins": \[/"actions": [{"type": "pin_target", "pin": "b", "keys": [{"frame": 0, "value": [0.8, 0, 0]}, {"frame": 150, "value": [0.7, 0, 0]}]}], "pins": [/' \
+  "$tmp/chain.json" >"$tmp/chain_moved.json"
+"$embra" run "$tmp/chain_moved.json" --until settled --out "$tmp/chain_moved" >"$tmp/log" 2>&1 && ok || bad "the moved chain must come to rest: $(cat "$tmp/log")"
+after=$(sed -n 's/.*at rest and within tolerance after \([0-9]*\) frames.*/\1/p' "$tmp/log")
+[ -n "$after" ] && [ "$after" -ge 160 ] && ok || bad "at rest before the last action's frame counted: after '$after' frames"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -658,6 +658,8 @@ EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_gr
  * movable particles' positions are recorded every frame, and over the last three quarters of the
  * frames the one that varies most, less its trend, must rise through zero at least three times at
  * intervals within 10 % of their mean, the period.
+ * A loaded scene's actions (pins drawn in, colliders moved on a schedule) are part of the problem:
+ * at rest before the frame of their last key does not count.
  * A step that fails ends the call with its status (the world as before that frame; the frames
  * before it stay stepped; *out_result says how many).
  * ------------------------------------------------------------------------------------------- */

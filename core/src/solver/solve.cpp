@@ -135,7 +135,7 @@ SolveResult solve(World& world, const SolveSettings& settings, const Tolerances&
           sum += weight(i, k, 0) * x[i].x() + weight(i, k, 1) * x[i].y() + weight(i, k, 2) * x[i].z();
       signal[k].push_back(sum);
     }
-    at_rest = world.report().settled ? at_rest + 1 : 0;
+    at_rest = world.report().settled && world.report().frame >= settings.rest_from_frame ? at_rest + 1 : 0;
     if (at_rest == 0) ratio_then = std::numeric_limits<double>::infinity();
     if (at_rest >= settings.hold_frames) {
       result.worst = worst_metric(world, tolerances);

@@ -18,10 +18,12 @@ enum class SolveUntil : int32_t {
 
 struct SolveSettings {
   SolveUntil until = SolveUntil::tolerance;
-  int32_t max_frames = 1000;  // frame budget, >= 1
-  int32_t hold_frames = 10;   // frames in a row at rest that count as settled, >= 1
-  double max_seconds = 0.0;   // wall-clock budget (>= 0; 0 = none). With one, where the stepping stops
-                              // depends on the machine's speed; each frame is the same bits anyway.
+  int32_t max_frames = 1000;    // frame budget, >= 1
+  int32_t hold_frames = 10;     // frames in a row at rest that count as settled, >= 1
+  double max_seconds = 0.0;     // wall-clock budget (>= 0; 0 = none). With one, where the stepping stops
+                                // depends on the machine's speed; each frame is the same bits anyway.
+  int64_t rest_from_frame = 0;  // at rest counts only from this frame on (World::report().frame): a
+                                // scene's scheduled actions still drive the world before their last key
 };
 
 enum class SolveOutcome : int32_t {
