@@ -498,7 +498,7 @@ struct Scratch {
   std::vector<int32_t> tri_body, edge_body;
   // The particles that left their regions (points order) and the primitives holding them.
   std::vector<int32_t> left, changed_tris, changed_edges;
-  std::vector<uint8_t> changed, tri_changed, edge_changed;
+  std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<int32_t> cand;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
@@ -532,6 +532,7 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
 // Items per thread below which a detection loop is not split.
 constexpr size_t kPairGrain = 256;     // primitives queried against a grid
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
+constexpr size_t kBoxGrain = 4096;     // particles or primitives boxed
 
 /// A unit normal: `primary` if it has a length, else `fallback`, turned toward `side` (the vector
 /// from the second primitive to the first at the start of the substep).
@@ -615,9 +616,19 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
   };
   s.left.clear();
-  for (size_t k = 0; k < np; ++k) {
-    const int32_t i = s.points[k];
-    if (!cached || !inside(x0[i], i) || !inside(x1[i], i)) s.left.push_back(static_cast<int32_t>(k));
+  if (!cached) {
+    s.left.resize(np);
+    std::iota(s.left.begin(), s.left.end(), 0);
+  } else {
+    s.outside.assign(np, 0);
+    in.pool->run(0, np, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t k = begin; k < end; ++k) {
+        const int32_t i = s.points[k];
+        s.outside[k] = !inside(x0[i], i) || !inside(x1[i], i);
+      }
+    });
+    for (size_t k = 0; k < np; ++k)
+      if (s.outside[k]) s.left.push_back(static_cast<int32_t>(k));
   }
   if (!s.left.empty()) {
     if (!cached) {
@@ -806,7 +817,15 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
   // stays more than its thickness apart throughout the substep.
   s.swept_point.resize(x1.size());
-  for (int32_t i : s.points) s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+  const auto each = [&](size_t n, auto&& f) {  // independent items, split over the pool's threads
+    in.pool->run(0, n, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t k = begin; k < end; ++k) f(k);
+    });
+  };
+  each(s.points.size(), [&](size_t k) {
+    const int32_t i = s.points[k];
+    s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+  });
   auto swept = [&](std::initializer_list<int32_t> ids) {
     Box b = s.swept_point[*ids.begin()];
     for (int32_t i : ids) {
@@ -816,9 +835,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     return b;
   };
   s.swept_tri.resize(nt);
-  for (size_t t = 0; t < nt; ++t) s.swept_tri[t] = swept({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]});
+  each(nt, [&](size_t t) { s.swept_tri[t] = swept({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]}); });
   s.swept_edge.resize(ne);
-  for (size_t e = 0; e < ne; ++e) s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]});
+  each(ne, [&](size_t e) { s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]}); });
 
   // Point against triangle.
   gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
