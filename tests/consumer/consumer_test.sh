@@ -33,18 +33,25 @@ cmake --build "$work/cmake-build" >>"$work/cmake.log"
 grep -q "consumer ok" "$work/cmake-run.log"
 echo "ok:   find_package(embra) consumer built and ran"
 
-# 2. pkg-config, with the installed (relocatable) .pc file.
+# 2. pkg-config, with the installed (relocatable) .pc file, its flags alone (they carry the run path:
+#    the consumer runs with no LD_LIBRARY_PATH).
 export PKG_CONFIG_PATH="$libdir/pkgconfig"
 read -r -a flags <<<"$(pkg-config --cflags --libs embra)"
-"$cc" -std=c99 -Wall -Wextra -Wpedantic -Werror -o "$work/pc-consumer" "$here/consumer.c" "${flags[@]}" -lm \
-  -Wl,-rpath,"$(pkg-config --variable=libdir embra)"
+"$cc" -std=c99 -Wall -Wextra -Wpedantic -Werror -o "$work/pc-consumer" "$here/consumer.c" "${flags[@]}" -lm
 "$work/pc-consumer" | tee "$work/pc-run.log"
 grep -q "consumer ok" "$work/pc-run.log"
 [[ "$(pkg-config --modversion embra)" == "$(sed -n 's/.*EMBRA_VERSION_STRING "\(.*\)"/\1/p' "$prefix/include/embra/embra_version.h")" ]] ||
   { echo "FAIL: pkg-config version differs from embra_version.h"; exit 1; }
 echo "ok:   pkg-config consumer built and ran"
 
-# 3. Python: the installed package finds the installed library by itself.
+# 3. The installed command runs from the prefix, moved elsewhere too (its run path is relative).
+"$prefix/bin/embra" version | tee "$work/cli-run.log"
+grep -q "^embra .*(ABI [0-9]*)" "$work/cli-run.log" || { echo "FAIL: the installed embra did not run"; exit 1; }
+cp -a "$prefix" "$work/moved"
+"$work/moved/bin/embra" version >/dev/null || { echo "FAIL: the installed embra did not run from a moved prefix"; exit 1; }
+echo "ok:   installed embra ran (and from a moved prefix) with no LD_LIBRARY_PATH"
+
+# 4. Python: the installed package finds the installed library by itself.
 if [[ -n "$python" ]]; then
   PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$libdir/python3/dist-packages" "$python" "$here/consumer.py" |
     tee "$work/py-run.log"
@@ -53,7 +60,7 @@ if [[ -n "$python" ]]; then
   echo "ok:   Python consumer ran on the installed package"
 fi
 
-# 4. C#: compiled against the installed Embra.dll, which finds libembra.so beside itself.
+# 5. C#: compiled against the installed Embra.dll, which finds libembra.so beside itself.
 if [[ -n "$mcs" ]]; then
   "$mcs" -nologo -warnaserror+ -r:"$libdir/Embra.dll" -out:"$work/Consumer.exe" "$here/Consumer.cs"
   MONO_PATH="$libdir" mono "$work/Consumer.exe" | tee "$work/cs-run.log"
