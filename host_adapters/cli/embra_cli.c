@@ -59,6 +59,14 @@ static int usage(void) {
   return EXIT_USAGE;
 }
 
+/* A usage error that names what is wrong first, then the usage. */
+static int bad_usage(const char* format, const char* a, const char* b) {
+  fputs("embra: ", stderr);
+  fprintf(stderr, format, a, b);
+  fputs("\n", stderr);
+  return usage();
+}
+
 static int help(void) {
   fputs(kUsage, stdout);
   fputs(
@@ -145,6 +153,20 @@ static int parse_int(const char* text, long lo, long hi, long* out) {
   return 0;
 }
 
+/* The value of option `name` at argv[i + 1] as a whole number in [lo, hi] into *out; else names the
+ * problem and returns the usage exit code (0 when fine). */
+static int option_int(int argc, char** argv, int i, long lo, long hi, long* out) {
+  if (i + 1 >= argc) return bad_usage("%s needs a value%s", argv[i], "");
+  if (parse_int(argv[i + 1], lo, hi, out) != 0) {
+    char range[96];
+    snprintf(range, sizeof range, "a whole number from %ld to %ld, got '%%s'", lo, hi);
+    char message[160];
+    snprintf(message, sizeof message, "%%s: expected %s", range);
+    return bad_usage(message, argv[i], argv[i + 1]);
+  }
+  return 0;
+}
+
 static int make_dir(const char* path) {
   char buf[4096];
   if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
@@ -210,21 +232,24 @@ static void triangle_mesh(int32_t rows, double side, double* xyz, int32_t* tri, 
 }
 
 static int demo_tent(int argc, char** argv) {
-  int32_t frames = 600, every = 100, rows = 40;
+  long frames = 600, every = 100, rows = 40;
   const char* out = "out/tent";
   for (int i = 0; i < argc; ++i) {
-    if (i + 1 < argc && strcmp(argv[i], "--frames") == 0)
-      frames = atoi(argv[++i]);
-    else if (i + 1 < argc && strcmp(argv[i], "--out") == 0)
+    int rc = 0;
+    if (strcmp(argv[i], "--frames") == 0)
+      rc = option_int(argc, argv, i++, 0, 100000000, &frames);
+    else if (strcmp(argv[i], "--every") == 0)
+      rc = option_int(argc, argv, i++, 1, 100000000, &every);
+    else if (strcmp(argv[i], "--n") == 0)
+      rc = option_int(argc, argv, i++, 2, 1000, &rows);
+    else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
       out = argv[++i];
-    else if (i + 1 < argc && strcmp(argv[i], "--every") == 0)
-      every = atoi(argv[++i]);
-    else if (i + 1 < argc && strcmp(argv[i], "--n") == 0)
-      rows = atoi(argv[++i]);
+    else if (strcmp(argv[i], "--out") == 0)
+      return bad_usage("%s needs a value%s", argv[i], "");
     else
-      return usage();
+      return bad_usage("unknown option '%s' for demo tent%s", argv[i], " (see embra help)");
+    if (rc != 0) return rc;
   }
-  if (frames < 0 || every < 1 || rows < 2 || rows > 1000) return usage();
   if (make_dir(out) != 0) {
     fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
     return EXIT_INVALID;
@@ -319,7 +344,7 @@ static int demo_tent(int argc, char** argv) {
   if (write_obj(path, now, n, tri, t) != 0)
     rc = EXIT_INVALID;
   else
-    printf("wrote %s (%d frames, %.2f s simulated)\n", path, frames, report.time);
+    printf("wrote %s (%ld frames, %.2f s simulated)\n", path, frames, report.time);
 done_now:
   free(now);
 done:
@@ -734,26 +759,30 @@ static int cmd_run(int argc, char** argv) {
       allow_outside = 1;
       continue;
     }
-    if (i + 1 >= argc) return usage();
+    int rc = 0;
     if (strcmp(argv[i], "--frames") == 0) {
-      if (parse_int(argv[++i], 0, 100000000, &frames)) return usage();
+      rc = option_int(argc, argv, i++, 0, 100000000, &frames);
     } else if (strcmp(argv[i], "--every") == 0) {
-      if (parse_int(argv[++i], 1, 100000000, &every)) return usage();
+      rc = option_int(argc, argv, i++, 1, 100000000, &every);
     } else if (strcmp(argv[i], "--threads") == 0) {
-      if (parse_int(argv[++i], 0, EMBRA_MAX_THREADS, &threads)) return usage();
-    } else if (strcmp(argv[i], "--out") == 0) {
-      out = argv[++i];
-    } else if (strcmp(argv[i], "--until") == 0) {
-      ++i;
-      if (strcmp(argv[i], "settled") == 0)
-        until = EMBRA_SOLVE_UNTIL_SETTLED;
-      else if (strcmp(argv[i], "tolerance") == 0)
-        until = EMBRA_SOLVE_UNTIL_TOLERANCE;
-      else
-        return usage();
+      rc = option_int(argc, argv, i++, 0, EMBRA_MAX_THREADS, &threads);
+    } else if (strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--until") == 0) {
+      if (i + 1 >= argc) return bad_usage("%s needs a value%s", argv[i], "");
+      if (strcmp(argv[i], "--out") == 0) {
+        out = argv[++i];
+      } else {
+        ++i;
+        if (strcmp(argv[i], "settled") == 0)
+          until = EMBRA_SOLVE_UNTIL_SETTLED;
+        else if (strcmp(argv[i], "tolerance") == 0)
+          until = EMBRA_SOLVE_UNTIL_TOLERANCE;
+        else
+          return bad_usage("--until: expected settled or tolerance, got '%s'%s", argv[i], "");
+      }
     } else {
-      return usage();
+      return bad_usage("unknown option '%s' for run%s", argv[i], " (see embra help)");
     }
+    if (rc != 0) return rc;
   }
   embra_world* world = NULL;
   const int loaded = load_scene_file(scene, allow_outside, &world);
@@ -970,5 +999,5 @@ int main(int argc, char** argv) {
   if (strcmp(argv[1], "validate") == 0) return cmd_validate(argc - 2, argv + 2);
   if (strcmp(argv[1], "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(argv[1], "demo") == 0 && argc >= 3 && strcmp(argv[2], "tent") == 0) return demo_tent(argc - 3, argv + 3);
-  return usage();
+  return bad_usage("unknown command '%s'%s", argv[1], " (see embra help)");
 }

@@ -16,6 +16,12 @@ bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
 "$embra" demo tent --frames >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "a flag without value must exit 1"
 "$embra" demo tent --n 1 >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "--n 1 must exit 1"
 "$embra" demo tent --out /proc/embra-cannot-write >/dev/null 2>&1; [ $? -eq 2 ] && ok || bad "an unwritable --out must exit 2"
+# A usage error names what is wrong before the usage.
+"$embra" demo tent --frames abc 2>&1 | head -1 | grep -q "^embra: --frames: expected a whole number from 0 to 100000000, got 'abc'$" \
+  && ok || bad "--frames abc is not named"
+"$embra" run scene.json --fram 3 2>&1 | head -1 | grep -q "^embra: unknown option '--fram' for run" && ok || bad "--fram is not named"
+"$embra" frobnicate 2>&1 | head -1 | grep -q "^embra: unknown command 'frobnicate'" && ok || bad "an unknown command is not named"
+"$embra" help | grep -q "^Exit codes:" && ok || bad "embra help must print the help on stdout"
 
 rows=10
 "$embra" demo tent --frames 90 --every 30 --n $rows --out "$tmp/tent" >"$tmp/log" 2>&1 && ok || bad "demo tent failed: $(cat "$tmp/log")"
