@@ -362,7 +362,18 @@ def gen_python(h: Header) -> str:
             "    def __hash__(self):",
             "        return hash((type(self).__name__, self.index, self.generation))", "",
             "    def __repr__(self):",
-            '        return f"{type(self).__name__}(index={self.index}, generation={self.generation})"']
+            '        return f"{type(self).__name__}(index={self.index}, generation={self.generation})"',
+            "", "",
+            "class _Struct(ctypes.Structure):",
+            '    """A C struct that prints as its fields: StepReport(frame=1, time=0.016, ...)."""', "",
+            "    def __repr__(self):",
+            "        def show(v):",
+            "            if isinstance(v, (bytes, str)) or not hasattr(v, '__len__'):",
+            "                return repr(v)",
+            "            return '[' + ', '.join(show(x) for x in v) + ']'",
+            "",
+            "        fields = ', '.join(f'{n}={show(getattr(self, n))}' for n, *_ in self._fields_ if n != 'reserved0')",
+            '        return f"{type(self).__name__}({fields})"']
     for st in h.structs.values():
         name = struct_name(st.name)
         out += ["", ""]
@@ -370,7 +381,7 @@ def gen_python(h: Header) -> str:
             out += [f"class {name}(_Id):", f'    """{st.name}."""']
             continue
         noqa = "  # noqa: A001 - the C name" if hasattr(builtins, name) else ""
-        out.append(f"class {name}(ctypes.Structure):{noqa}")
+        out.append(f"class {name}(_Struct):{noqa}")
         out.append(f'    """{st.name}."""')
         out.append("    _fields_ = [")
         for f in st.fields:

@@ -36,6 +36,33 @@ def _flatten(values, name):
     return flat
 
 
+def check_rows(obj, width, name):
+    """Refuses data whose shape says its rows are not `width` wide: a 2-D array of shape (n, k) with
+    k != width (a transposed (3, n) array, quads passed as triangles), or a nested sequence whose
+    rows are not all `width` long. Flat data passes (its length is checked by the caller)."""
+    if obj is None:
+        return
+    shape = getattr(obj, "shape", None)
+    if shape is not None:
+        if len(shape) == 2 and shape[1] != width:
+            raise ValueError(f"{name}: expected an (n, {width}) array, got shape {tuple(shape)}")
+        if len(shape) > 2:
+            raise ValueError(f"{name}: expected an (n, {width}) or flat array, got shape {tuple(shape)}")
+        return
+    if isinstance(obj, (str, bytes)):
+        return
+    try:
+        rows = list(obj) if not isinstance(obj, (array, memoryview)) else []
+    except TypeError:
+        return
+    nested = [hasattr(r, "__len__") and not isinstance(r, (str, bytes)) for r in rows]
+    if any(nested):
+        for i, r in enumerate(rows):
+            if not nested[i] or len(r) != width:
+                got = len(r) if nested[i] else "a single number"
+                raise ValueError(f"{name}: expected rows of {width}, row {i} has {got}")
+
+
 def _from_memoryview(obj, fmt, ctype, pointer_type):
     try:
         mv = memoryview(obj)

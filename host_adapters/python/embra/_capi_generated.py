@@ -127,6 +127,19 @@ class _Id(ctypes.Structure):
         return f"{type(self).__name__}(index={self.index}, generation={self.generation})"
 
 
+class _Struct(ctypes.Structure):
+    """A C struct that prints as its fields: StepReport(frame=1, time=0.016, ...)."""
+
+    def __repr__(self):
+        def show(v):
+            if isinstance(v, (bytes, str)) or not hasattr(v, '__len__'):
+                return repr(v)
+            return '[' + ', '.join(show(x) for x in v) + ']'
+
+        fields = ', '.join(f'{n}={show(getattr(self, n))}' for n, *_ in self._fields_ if n != 'reserved0')
+        return f"{type(self).__name__}({fields})"
+
+
 class GroupId(_Id):
     """embra_group_id."""
 
@@ -143,7 +156,7 @@ class ColliderId(_Id):
     """embra_collider_id."""
 
 
-class SolverDef(ctypes.Structure):
+class SolverDef(_Struct):
     """embra_solver_def."""
     _fields_ = [
         ("version", c_int32),
@@ -163,7 +176,7 @@ class SolverDef(ctypes.Structure):
     ]
 
 
-class WorldCounts(ctypes.Structure):
+class WorldCounts(_Struct):
     """embra_world_counts."""
     _fields_ = [
         ("particles", c_int32),
@@ -176,7 +189,7 @@ class WorldCounts(ctypes.Structure):
     ]
 
 
-class GroupDef(ctypes.Structure):
+class GroupDef(_Struct):
     """embra_group_def."""
     _fields_ = [
         ("version", c_int32),
@@ -185,7 +198,7 @@ class GroupDef(ctypes.Structure):
     ]
 
 
-class Material(ctypes.Structure):
+class Material(_Struct):
     """embra_material."""
     _fields_ = [
         ("mass", c_double),
@@ -201,7 +214,7 @@ class Material(ctypes.Structure):
     ]
 
 
-class BodyDef(ctypes.Structure):
+class BodyDef(_Struct):
     """embra_body_def."""
     _fields_ = [
         ("version", c_int32),
@@ -224,7 +237,7 @@ class BodyDef(ctypes.Structure):
     ]
 
 
-class ConstraintDef(ctypes.Structure):
+class ConstraintDef(_Struct):
     """embra_constraint_def."""
     _fields_ = [
         ("version", c_int32),
@@ -238,7 +251,7 @@ class ConstraintDef(ctypes.Structure):
     ]
 
 
-class ConstraintBatchDef(ctypes.Structure):
+class ConstraintBatchDef(_Struct):
     """embra_constraint_batch_def."""
     _fields_ = [
         ("version", c_int32),
@@ -253,7 +266,7 @@ class ConstraintBatchDef(ctypes.Structure):
     ]
 
 
-class PinDef(ctypes.Structure):
+class PinDef(_Struct):
     """embra_pin_def."""
     _fields_ = [
         ("version", c_int32),
@@ -264,7 +277,7 @@ class PinDef(ctypes.Structure):
     ]
 
 
-class ColliderDef(ctypes.Structure):
+class ColliderDef(_Struct):
     """embra_collider_def."""
     _fields_ = [
         ("version", c_int32),
@@ -284,7 +297,7 @@ class ColliderDef(ctypes.Structure):
     ]
 
 
-class StepReport(ctypes.Structure):
+class StepReport(_Struct):
     """embra_step_report."""
     _fields_ = [
         ("frame", c_int64),
@@ -300,7 +313,7 @@ class StepReport(ctypes.Structure):
     ]
 
 
-class KindResidual(ctypes.Structure):
+class KindResidual(_Struct):
     """embra_kind_residual."""
     _fields_ = [
         ("kind", c_int32),
@@ -311,7 +324,7 @@ class KindResidual(ctypes.Structure):
     ]
 
 
-class ConstraintResidual(ctypes.Structure):
+class ConstraintResidual(_Struct):
     """embra_constraint_residual."""
     _fields_ = [
         ("kind", c_int32),
@@ -325,7 +338,7 @@ class ConstraintResidual(ctypes.Structure):
     ]
 
 
-class GroupConflict(ctypes.Structure):
+class GroupConflict(_Struct):
     """embra_group_conflict."""
     _fields_ = [
         ("a", GroupId),
@@ -335,7 +348,7 @@ class GroupConflict(ctypes.Structure):
     ]
 
 
-class GroupReport(ctypes.Structure):
+class GroupReport(_Struct):
     """embra_group_report."""
     _fields_ = [
         ("count", c_int64),
@@ -344,7 +357,7 @@ class GroupReport(ctypes.Structure):
     ]
 
 
-class SolveDef(ctypes.Structure):
+class SolveDef(_Struct):
     """embra_solve_def."""
     _fields_ = [
         ("version", c_int32),
@@ -355,7 +368,7 @@ class SolveDef(ctypes.Structure):
     ]
 
 
-class SolveResult(ctypes.Structure):
+class SolveResult(_Struct):
     """embra_solve_result."""
     _fields_ = [
         ("outcome", c_int32),
@@ -371,7 +384,7 @@ class SolveResult(ctypes.Structure):
     ]
 
 
-class Warning(ctypes.Structure):  # noqa: A001 - the C name
+class Warning(_Struct):  # noqa: A001 - the C name
     """embra_warning."""
     _fields_ = [
         ("frame", c_int64),
@@ -380,7 +393,7 @@ class Warning(ctypes.Structure):  # noqa: A001 - the C name
     ]
 
 
-class PanelMeshDef(ctypes.Structure):
+class PanelMeshDef(_Struct):
     """embra_panel_mesh_def."""
     _fields_ = [
         ("version", c_int32),
@@ -404,7 +417,7 @@ class PanelMeshDef(ctypes.Structure):
     ]
 
 
-class Tolerance(ctypes.Structure):
+class Tolerance(_Struct):
     """embra_tolerance."""
     _fields_ = [
         ("target", c_double),
@@ -412,7 +425,7 @@ class Tolerance(ctypes.Structure):
     ]
 
 
-class Tolerances(ctypes.Structure):
+class Tolerances(_Struct):
     """embra_tolerances."""
     _fields_ = [
         ("version", c_int32),
@@ -425,7 +438,7 @@ class Tolerances(ctypes.Structure):
     ]
 
 
-class MetricSummary(ctypes.Structure):
+class MetricSummary(_Struct):
     """embra_metric_summary."""
     _fields_ = [
         ("max", c_double),
@@ -437,7 +450,7 @@ class MetricSummary(ctypes.Structure):
     ]
 
 
-class PanelMetrics(ctypes.Structure):
+class PanelMetrics(_Struct):
     """embra_panel_metrics."""
     _fields_ = [
         ("version", c_int32),
@@ -454,7 +467,7 @@ class PanelMetrics(ctypes.Structure):
     ]
 
 
-class LoadOptions(ctypes.Structure):
+class LoadOptions(_Struct):
     """embra_load_options."""
     _fields_ = [
         ("version", c_int32),
@@ -467,7 +480,7 @@ class FieldId(_Id):
     """embra_field_id."""
 
 
-class WindDef(ctypes.Structure):
+class WindDef(_Struct):
     """embra_wind_def."""
     _fields_ = [
         ("version", c_int32),
@@ -481,7 +494,7 @@ class WindDef(ctypes.Structure):
     ]
 
 
-class PressureDef(ctypes.Structure):
+class PressureDef(_Struct):
     """embra_pressure_def."""
     _fields_ = [
         ("version", c_int32),
@@ -494,7 +507,7 @@ class PressureDef(ctypes.Structure):
     ]
 
 
-class SurfaceTensionDef(ctypes.Structure):
+class SurfaceTensionDef(_Struct):
     """embra_surface_tension_def."""
     _fields_ = [
         ("version", c_int32),
@@ -505,7 +518,7 @@ class SurfaceTensionDef(ctypes.Structure):
     ]
 
 
-class VortexDef(ctypes.Structure):
+class VortexDef(_Struct):
     """embra_vortex_def."""
     _fields_ = [
         ("version", c_int32),

@@ -317,12 +317,14 @@ class World:
         keep = []
 
         def elements(data, width, name):
+            buf.check_rows(data, width, name)
             p, n, k = buf.ints_in(data, name)
             if n % width:
                 raise ValueError(f"{name}: {n} indices is not a whole number of {width}-tuples")
             keep.append(k)
             return p, n // width
 
+        buf.check_rows(positions, 3, "positions")
         p, n, k = buf.doubles_in(positions, "positions")
         if n % 3:
             raise ValueError(f"positions: {n} numbers is not a whole number of xyz triples")
@@ -335,6 +337,7 @@ class World:
             keep.append(k)
             d.masses = p
         if uvs is not None:
+            buf.check_rows(uvs, 2, "uvs")
             p, m, k = buf.doubles_in(uvs, "uvs")
             if m != 2 * (n // 3):
                 raise ValueError(f"uvs: {m} numbers for {n // 3} vertices (2 per vertex)")
@@ -405,6 +408,8 @@ class World:
         if positions is not None or quads is not None:
             if positions is None or quads is None:
                 raise ValueError("positions and quads go together (neither: a grid)")
+            buf.check_rows(positions, 3, "positions")
+            buf.check_rows(quads, 4, "quads")
             p, n, k = buf.doubles_in(positions, "positions")
             if n % 3:
                 raise ValueError(f"positions: {n} numbers is not a whole number of xyz triples")
@@ -520,6 +525,8 @@ class World:
         d = lib.embra_default_constraint_batch_def()
         d.kind = _enum(kind, KINDS, "kind")
         arity = lib.embra_constraint_arity(d.kind)
+        if arity:
+            buf.check_rows(particles, arity, "particles")
         p, n, keep_p = buf.ints_in(particles, "particles")
         if arity and n % arity:
             raise ValueError(f"particles: {n} indices is not a whole number of {arity}-tuples")
@@ -581,12 +588,14 @@ class World:
         _fill(d, fields, "ColliderDef")
         keep = []
         if vertices is not None:
+            buf.check_rows(vertices, 3, "vertices")
             p, n, k = buf.doubles_in(vertices, "vertices")
             if n % 3:
                 raise ValueError(f"vertices: {n} numbers is not a whole number of xyz triples")
             d.vertices, d.vertex_count = p, buf.int32(n // 3, "vertex count")
             keep.append(k)
         if triangles is not None:
+            buf.check_rows(triangles, 3, "triangles")
             p, n, k = buf.ints_in(triangles, "triangles")
             if n % 3:
                 raise ValueError(f"triangles: {n} indices is not a whole number of triples")
@@ -758,6 +767,7 @@ class World:
         return self._read("embra_world_get_velocities", first, count, out)
 
     def _write(self, name, xyz, first):
+        buf.check_rows(xyz, 3, "xyz")
         p, n, keep = buf.doubles_in(xyz, "xyz")
         if n % 3:
             raise ValueError(f"xyz: {n} numbers is not a whole number of xyz triples")

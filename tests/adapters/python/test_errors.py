@@ -193,3 +193,32 @@ def test_values_at_the_limits_are_accepted_and_saved_scenes_load_back():
         with embra.World.load_json(text) as back:
             assert back.save_json() == text
             assert struct.pack("<6d", *flat(back.positions())) == struct.pack("<6d", *flat(w.positions()))
+
+
+def test_rows_of_the_wrong_width_are_refused_before_anything_is_built():
+    """A transposed (3, n) positions array, quads passed as triangles and pairs passed as points are
+    named, not read as other shapes; nothing is built."""
+    w = embra.World()
+    square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    with pytest.raises(ValueError, match=r"triangles: expected rows of 3, row 0 has 4"):
+        w.create_body(square, triangles=[[0, 1, 2, 3]])
+    with pytest.raises(ValueError, match=r"positions: expected rows of 3, row 0 has 2"):
+        w.create_body([[0, 0], [1, 0], [1, 1]])
+    with pytest.raises(ValueError, match=r"particles: expected rows of 2"):
+        w.add_constraints("distance", [[0, 1, 2]])
+    if embra.have_numpy():
+        import numpy as np
+        with pytest.raises(ValueError, match=r"positions: expected an \(n, 3\) array, got shape \(3, 4\)"):
+            w.create_body(np.array(square, dtype=float).T)
+        with pytest.raises(ValueError, match=r"quads: expected an \(n, 4\) array, got shape \(1, 3\)"):
+            w.create_panel_mesh(np.array(square, dtype=float), np.array([[0, 1, 2]]))
+    assert w.counts().particles == 0 and w.counts().constraints == 0
+
+
+def test_structs_print_as_their_fields():
+    w = embra.World()
+    w.create_body([[0, 0, 0]])
+    w.step()
+    text = repr(w.report())
+    assert text.startswith("StepReport(frame=1, time=0.01666") and "settled=" in text
+    assert "gravity=[0.0, 0.0, -9.81]" in repr(embra.default_solver_def())
