@@ -227,6 +227,8 @@ class Session {
   void op_read();
   void op_misuse();
   void op_step();
+  void op_solve();
+  void op_diagnose();
   void op_cancel();
   void roundtrip(bool replace);
 
@@ -992,6 +994,76 @@ void Session::op_step() {
     check_state(world_, "after a step");
 }
 
+/// embra_world_solve over a few frames: like steps, frames before a failing one stay stepped.
+void Session::op_solve() {
+  if (!fuzz::small_step(world_, kMaxStepWork)) {
+    note("(solve skipped: beyond the target's work bound)");
+    return;
+  }
+  embra_solve_def d = embra_default_solve_def();
+  d.version = version(EMBRA_SOLVE_DEF_VERSION);
+  d.until = in_.chance(8) ? in_.integer() : in_.u8() % 2;
+  d.max_frames = in_.chance(8) ? in_.integer() : 1 + in_.u8() % 3;
+  d.hold_frames = in_.chance(8) ? in_.integer() : 1 + in_.u8() % 3;
+  if (in_.chance(8)) d.max_seconds = in_.value();
+  embra_solve_result r{};
+  const embra_status s = embra_world_solve(world_, &d, in_.chance(32) ? nullptr : &r);
+  const std::string what = "embra_world_solve(until " + std::to_string(d.until) + ", frames " +
+                           std::to_string(d.max_frames) + ", hold " + std::to_string(d.hold_frames) + ")";
+  note(what + " -> " + embra_status_name(s));
+  if (s == EMBRA_ERROR_INTERNAL) fail(what + " returned EMBRA_ERROR_INTERNAL");
+  if (s != EMBRA_OK && embra_last_error_message()[0] == '\0') fail(what + " was refused without a message");
+  if (s == EMBRA_OK) {
+    if (r.outcome < EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE || r.outcome > EMBRA_SOLVE_DRIFTING)
+      fail(what + " returned outcome " + std::to_string(r.outcome));
+    if (r.frames < 1 || r.frames > d.max_frames) fail(what + " stepped " + std::to_string(r.frames) + " frames");
+    if (!std::isfinite(r.period) || r.period < 0.0) fail(what + " returned a period of " + fmt(r.period));
+    check_state(world_, "after a solve");
+  }
+  // Accepted, or a step that failed after others: the frames stepped stay (embra.h).
+  saved_ = save(world_, "after " + what);
+}
+
+/// The diagnostics of the last step: residuals by kind, the worst constraints, group conflicts and
+/// a group's per-constraint residuals. Reads: nothing may change.
+void Session::op_diagnose() {
+  const uint8_t what = in_.u8() % 4;
+  if (what == 0) {
+    std::vector<embra_kind_residual> out(64);
+    int32_t n = 0;
+    const int32_t capacity = in_.chance(4) ? in_.integer() : in_.u8() % 20;
+    if (call("embra_world_get_residuals(capacity " + std::to_string(capacity) + ")", false, [&] {
+          return embra_world_get_residuals(world_, capacity > 0 ? out.data() : nullptr, std::min(capacity, 64), &n);
+        }) == EMBRA_OK)
+      for (int32_t i = 0; i < n && i < 64 && capacity > 0; ++i)
+        if (!std::isfinite(out[i].max) || embra_residual_unit(out[i].kind) == nullptr)
+          fail("a residual by kind is not finite or has no unit");
+  } else if (what == 1) {
+    std::vector<embra_constraint_residual> out(32);
+    int32_t n = 0;
+    const int32_t capacity = in_.chance(8) ? in_.integer() : in_.u8() % 32;
+    call("embra_world_get_worst_constraints(capacity " + std::to_string(capacity) + ")", false, [&] {
+      return embra_world_get_worst_constraints(world_, in_.chance(16) ? nullptr : out.data(), std::min(capacity, 32),
+                                               &n);
+    });
+  } else if (what == 2) {
+    std::vector<embra_group_conflict> out(16);
+    int32_t n = 0;
+    const int32_t capacity = in_.chance(2) ? 0 : in_.u8() % 16;
+    call("embra_world_get_group_conflicts(capacity " + std::to_string(capacity) + ")", false,
+         [&] { return embra_world_get_group_conflicts(world_, capacity > 0 ? out.data() : nullptr, capacity, &n); });
+  } else {
+    const embra_group_id g = pick_id(in_, groups_);
+    const int32_t kind = in_.chance(8) ? in_.integer() : in_.u8() % 9;
+    std::vector<double> out(4096);
+    int64_t n = 0;
+    const int64_t capacity = in_.chance(2) ? 0 : in_.u8() * 16;
+    call("embra_group_get_residuals(kind " + std::to_string(kind) + ", capacity " + std::to_string(capacity) + ")",
+         false,
+         [&] { return embra_group_get_residuals(world_, g, kind, capacity > 0 ? out.data() : nullptr, capacity, &n); });
+  }
+}
+
 void Session::op_cancel() {
   call("embra_world_cancel", false, [&] { return embra_world_cancel(world_); });
   const embra_status s = call("embra_world_step (cancelled)", true, [&] { return embra_world_step(world_); });
@@ -1034,7 +1106,7 @@ void Session::run() {
   start();
   int calls = 0;
   while (!in_.done() && calls++ < 64) {
-    switch (in_.u8() % 28) {
+    switch (in_.u8() % 30) {
       case 0:
         op_solver();
         break;
@@ -1124,8 +1196,14 @@ void Session::run() {
       case 26:
         roundtrip(false);
         break;
-      default:
+      case 27:
         roundtrip(true);
+        break;
+      case 28:
+        op_solve();
+        break;
+      default:
+        op_diagnose();
     }
   }
   roundtrip(false);
