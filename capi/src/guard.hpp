@@ -120,6 +120,12 @@ bool fits(const T* out, int64_t capacity, int64_t n, const char* what) {
 /// needed, set also when the buffer is too small).
 void write_text(const std::string& text, char* out, int64_t capacity, int64_t* out_length);
 
+/// What a frame stepped through the C ABI reads: the scene's actions for the frame, and the world's
+/// cancel flag (capi/src/world.cpp).
+embra::StepControl frame_control(embra_world* world);
+/// After a call that stepped: a cancel request is consumed by the step it stopped.
+void consume_cancel(embra_world* world, embra_status status);
+
 template <class T>
 embra::Id to_id(T id) {
   return embra::Id{id.index, id.generation};

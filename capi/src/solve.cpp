@@ -45,12 +45,7 @@ embra_status embra_world_solve(embra_world* world, const embra_solve_def* def, e
     // their last key is not the end.
     for (const embra::io::Action& a : world->meta.actions)
       for (int64_t f : a.frames) s.rest_from_frame = std::max(s.rest_from_frame, f);
-    embra::StepControl control;
-    if (!world->meta.actions.empty())
-      control.before_frame = [world](embra::World& w) {
-        embra::io::apply_actions(w, world->meta, w.report().frame + 1);
-      };
-    control.cancel = &world->cancel;
+    const embra::StepControl control = frame_control(world);
     const embra::Tolerances tolerances = embra::io::parse_tolerances(world->meta.tolerances);
     const int64_t frame_before = world->world.report().frame;
     try {
@@ -71,7 +66,7 @@ embra_status embra_world_solve(embra_world* world, const embra_solve_def* def, e
     o.worst_target = r.worst.target;
     *out_result = o;
   });
-  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+  consume_cancel(world, status);
   return status;
 }
 

@@ -77,6 +77,22 @@ auto live_generation(const std::vector<T>& slots) {
 
 }  // namespace
 
+namespace embra::capi {
+
+StepControl frame_control(embra_world* world) {
+  StepControl control;
+  if (!world->meta.actions.empty())
+    control.before_frame = [world](World& w) { io::apply_actions(w, world->meta, w.report().frame + 1); };
+  control.cancel = &world->cancel;
+  return control;
+}
+
+void consume_cancel(embra_world* world, embra_status status) {
+  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+}
+
+}  // namespace embra::capi
+
 extern "C" {
 
 embra_solver_def embra_default_solver_def(void) {
@@ -176,16 +192,8 @@ embra_status embra_world_get_colliders(const embra_world* world, embra_collider_
 // --- stepping ----------------------------------------------------------------------------------
 
 embra_status embra_world_step(embra_world* world) {
-  const embra_status status = guard("embra_world_step", world, [&] {
-    embra::StepControl control;
-    if (!world->meta.actions.empty())
-      control.before_frame = [world](embra::World& w) {
-        embra::io::apply_actions(w, world->meta, w.report().frame + 1);
-      };
-    control.cancel = &world->cancel;
-    world->world.step(control);
-  });
-  if (status == EMBRA_ERROR_CANCELLED) world->cancel.store(false, std::memory_order_relaxed);
+  const embra_status status = guard("embra_world_step", world, [&] { world->world.step(frame_control(world)); });
+  consume_cancel(world, status);
   return status;
 }
 

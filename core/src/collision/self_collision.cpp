@@ -499,7 +499,6 @@ struct Scratch {
   // The particles that left their regions (points order) and the primitives holding them.
   std::vector<int32_t> left, changed_tris, changed_edges;
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
-  std::vector<int32_t> cand;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
   std::vector<std::vector<int32_t>> part_cand, part_pairs;

@@ -14,18 +14,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace embra {
 
 namespace {
 
 /// Calls f(kind, i, residual, violation, force) for every constraint of a group's solver arrays (i
-/// the solver-array index).
+/// the solver-array index), of kind `only` when given.
 template <class F>
-void each_constraint(ThreadPool& pool, const Group& g, const std::vector<Vec3>& x, double inv_h2, F&& f) {
+void each_constraint(ThreadPool& pool, const Group& g, const std::vector<Vec3>& x, double inv_h2, F&& f,
+                     std::optional<Kind> only = std::nullopt) {
   std::vector<double> values, each, violation;
   for (const KindInfo& info : kKinds)
     visit_kind(info.kind, [&](auto k) {
+      if (only && *only != info.kind) return;
       const SolverArray& a = g.solve[static_cast<int>(info.kind)];
       if (a.size() == 0) return;
       if constexpr (k == Kind::weld) {
@@ -160,9 +163,12 @@ std::vector<double> World::constraint_residuals(Id group_id, Kind kind) const {
   std::vector<double> out(g.arrays[static_cast<int>(kind)].size(), 0.0);
   // The solver arrays are the constraint arrays in colour order as of the last step; a constraint
   // added since has no residual yet (0).
-  each_constraint(*pool_, g, x_, inv_h2, [&](Kind k, size_t i, double residual, double, double) {
-    if (k == kind && a.source[i] >= 0 && static_cast<size_t>(a.source[i]) < out.size()) out[a.source[i]] = residual;
-  });
+  each_constraint(
+      *pool_, g, x_, inv_h2,
+      [&](Kind, size_t i, double residual, double, double) {
+        if (a.source[i] >= 0 && static_cast<size_t>(a.source[i]) < out.size()) out[a.source[i]] = residual;
+      },
+      kind);
   return out;
 }
 

@@ -35,6 +35,11 @@ double weight(size_t i, int k, int c) {
 
 constexpr int kProjections = 3;
 
+/// How far a metric is over its target (value / target; with a zero target, infinite when above it).
+double over_target(double value, double target) {
+  return target > 0.0 ? value / target : (value > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
+}
+
 /// The period in frames of an oscillating signal, or 0.
 double period_of(const std::vector<double>& s) {
   const size_t n = s.size();
@@ -84,7 +89,7 @@ WorstMetric worst_metric(const World& world, const Tolerances& tolerances) {
                             double target) {
     for (size_t e = 0; e < values.size(); ++e) {
       const double v = values[e];
-      const double ratio = target > 0.0 ? v / target : (v > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
+      const double ratio = over_target(v, target);
       if (ratio > worst_ratio) {
         worst_ratio = ratio;
         worst = WorstMetric{static_cast<int32_t>(metric), l.body, static_cast<int32_t>(e), layer, v, target};
@@ -115,10 +120,7 @@ SolveResult solve(World& world, const SolveSettings& settings, const Tolerances&
     return settings.max_seconds > 0.0 &&
            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= settings.max_seconds;
   };
-  const auto ratio = [](const WorstMetric& w) {
-    if (w.metric < 0) return 0.0;
-    return w.target > 0.0 ? w.value / w.target : (w.value > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
-  };
+  const auto ratio = [](const WorstMetric& w) { return w.metric < 0 ? 0.0 : over_target(w.value, w.target); };
   SolveResult result;
   std::array<std::vector<double>, kProjections> signal;
   int32_t at_rest = 0;
