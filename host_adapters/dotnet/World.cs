@@ -357,7 +357,7 @@ namespace Embra
 
         delegate int IdList<T>(IntPtr world, T[] ids, int capacity, out int count);
 
-        // The two-call id listing: the count first, then the ids.
+        // The two-call listing (ids, residuals, conflicts): the count first, then the items.
         T[] Ids<T>(IdList<T> list)
         {
             int count = 0;
@@ -763,14 +763,7 @@ namespace Embra
 
         /// <summary>The last step's residuals by kind, each in its own unit (Library.ResidualUnit):
         /// every kind the world holds, in kind order, then pins, then contacts.</summary>
-        public KindResidual[] Residuals()
-        {
-            int count = 0;
-            Call(w => Native.embra_world_get_residuals(w, null, 0, out count));
-            var res = new KindResidual[count];
-            Call(w => Native.embra_world_get_residuals(w, res, res.Length, out count));
-            return res;
-        }
+        public KindResidual[] Residuals() { return Ids<KindResidual>(Native.embra_world_get_residuals); }
 
         /// <summary>The `count` constraints and soft pins of the last step that fight hardest, worst
         /// first, ranked by Violation x Force (an energy for every kind; embra_world_get_worst_constraints).
@@ -788,14 +781,7 @@ namespace Embra
 
         /// <summary>Pairs of groups whose forces on shared particles oppose in the last step, largest
         /// first (embra_world_get_group_conflicts): A before B in the projection order, Force in N.</summary>
-        public GroupConflict[] GroupConflicts()
-        {
-            int n = 0;
-            Call(w => Native.embra_world_get_group_conflicts(w, null, 0, out n));
-            var res = new GroupConflict[n];
-            Call(w => Native.embra_world_get_group_conflicts(w, res, res.Length, out n));
-            return res;
-        }
+        public GroupConflict[] GroupConflicts() { return Ids<GroupConflict>(Native.embra_world_get_group_conflicts); }
 
         /// <summary>The residual of every constraint of `kind` in `group` after the last step, in the
         /// order they were added, in the kind's unit (embra_group_get_residuals).</summary>
