@@ -875,6 +875,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            found.push_back(c);
          });
 
+  const size_t point_triangle_contacts = out.size();
+
   // Edge against edge.
   gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
          [&](size_t pair, std::vector<SelfContact>& found, std::vector<int32_t>&) {
@@ -914,6 +916,17 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            c.mu_k = mean_mu(in.mu_k, c.ids);
            found.push_back(c);
          });
+
+  // The contacts in an order that depends on what they join only, never on the history of the kept
+  // pairs (kept ones first, then the ones found again): a world saved and loaded back, whose pairs
+  // are all found afresh, projects its contacts in the same order and steps to the same bits.
+  // Point-triangle contacts, then edge-edge ones, each by their particles (no two share all four).
+  const auto by_particles = [](const SelfContact& a, const SelfContact& b) {
+    return std::lexicographical_compare(a.ids, a.ids + 4, b.ids, b.ids + 4);
+  };
+  const auto split = out.begin() + static_cast<std::ptrdiff_t>(point_triangle_contacts);
+  std::sort(out.begin(), split, by_particles);
+  std::sort(split, out.end(), by_particles);
 }
 
 // --- resolution ------------------------------------------------------------------------------------
