@@ -6,8 +6,10 @@
 #       every committed input of tests/fuzz/regressions/TARGET (and the target's committed seeds),
 #       each run once: fails on any crash, sanitizer report or failed check.
 #   fuzz_run.sh short BINARY TARGET ROOT WORK RUNS [DICT]
-#       a fresh corpus in WORK/corpus from the target's seeds, then RUNS mutations with seed 1
-#       (deterministic); a finding is written to WORK/.
+#       a fresh corpus in WORK/corpus from the target's seeds, then RUNS mutations with seed 1. The
+#       mutations are seeded, but which inputs are kept follows the coverage they reach, and that
+#       varies a little from run to run (allocation addresses decide some sorts' paths), so two runs
+#       may try different inputs. A finding is written to WORK/ and printed last, gzip | base64.
 #   fuzz_run.sh seeds TARGET ROOT DIR
 #       copies the target's seeds into DIR (names prefixed by their folder, so none collide).
 #   fuzz_run.sh fuzz BINARY CORPUS FINDINGS SECONDS [DICT]
@@ -80,7 +82,22 @@ case "$mode" in
     echo "fuzz_run.sh: $target, $(find "$work/corpus" -type f | wc -l) seeds, $runs runs with seed 1"
     args=("${LIBFUZZER_OPTIONS[@]}" -runs="$runs" -seed=1 -artifact_prefix="$work/")
     [ -n "$dict" ] && args+=(-dict="$dict")
-    exec "$binary" "${args[@]}" "$work/corpus"
+    set +e
+    "$binary" "${args[@]}" "$work/corpus" 2>&1 | tee "$work/log"
+    rc=${PIPESTATUS[0]}
+    set -e
+    [ "$rc" -eq 0 ] && exit 0
+    # A finding in a fresh clone's build folder is gone with it: print what failed and the input
+    # itself (gzip, base64), last, where a shortened log still shows it. To replay:
+    #   base64 -d <<'EOF' | gunzip > finding; build-fuzz/tests/fuzz/TARGET finding
+    echo "fuzz_run.sh: $target failed (libFuzzer exited $rc):"
+    grep -E 'FAILED|ERROR|runtime error|SUMMARY' "$work/log" | head -5 || true
+    for finding in "$work"/crash-* "$work"/leak-* "$work"/timeout-* "$work"/oom-*; do
+      [ -f "$finding" ] || continue
+      echo "fuzz_run.sh: the input $(basename "$finding") ($(wc -c <"$finding") bytes), gzip | base64:"
+      gzip -9c "$finding" | base64 -w 100
+    done
+    exit "$rc"
     ;;
   seeds)
     copy_seeds "$2" "$3" "$4"
