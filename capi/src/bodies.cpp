@@ -109,4 +109,20 @@ embra_status embra_body_get_triangles(const embra_world* world, embra_body_id bo
   });
 }
 
+embra_status embra_body_set_material(embra_world* world, embra_body_id body, const embra_material* material) {
+  return guard("embra_body_set_material", world, [&] {
+    need(material, "material");
+    world->world.set_material(to_id(body), to_material(*material));
+  });
+}
+
+embra_status embra_body_get_material(const embra_world* world, embra_body_id body, embra_material* out_material) {
+  return guard("embra_body_get_material", world, [&] {
+    need(out_material, "out_material");
+    embra_material m{};
+    to_c(kMaterialCopies, world->world.body(to_id(body)).material, m);
+    *out_material = m;
+  });
+}
+
 }  // extern "C"

@@ -62,4 +62,59 @@ embra_status embra_constraints_add(embra_world* world, const embra_constraint_ba
   });
 }
 
+// --- edits -------------------------------------------------------------------------------------
+
+embra_status embra_group_get_constraint_count(const embra_world* world, embra_group_id group,
+                                              embra_constraint_kind kind, int32_t* out_count, int32_t* out_generated) {
+  return guard("embra_group_get_constraint_count", world, [&] {
+    need(out_count, "out_count");
+    const auto [count, generated] = world->world.constraint_count(to_id(group), static_cast<embra::Kind>(kind));
+    *out_count = static_cast<int32_t>(count);
+    if (out_generated) *out_generated = static_cast<int32_t>(generated);
+  });
+}
+
+embra_status embra_constraint_get(const embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                  int32_t index, embra_constraint_def* out_def) {
+  return guard("embra_constraint_get", world, [&] {
+    need(out_def, "out_def");
+    const embra::ConstraintInfo c = world->world.constraint(to_id(group), static_cast<embra::Kind>(kind), index);
+    embra_constraint_def d = embra_default_constraint_def();
+    d.kind = kind;
+    d.group = group;
+    for (int k = 0; k < 4; ++k) d.particles[k] = c.particles[k];
+    d.rest_from_current = 0;
+    d.rest = c.rest;
+    d.compliance = c.compliance;
+    *out_def = d;
+  });
+}
+
+embra_status embra_constraint_set_compliance(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                             int32_t index, double compliance) {
+  return guard("embra_constraint_set_compliance", world, [&] {
+    world->world.set_constraint_compliance(to_id(group), static_cast<embra::Kind>(kind), index, compliance);
+  });
+}
+
+embra_status embra_constraint_set_rest(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                       int32_t index, double rest) {
+  return guard("embra_constraint_set_rest", world,
+               [&] { world->world.set_constraint_rest(to_id(group), static_cast<embra::Kind>(kind), index, rest); });
+}
+
+embra_status embra_constraint_set_group(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                        int32_t index, embra_group_id to, int32_t* out_new_index) {
+  return guard("embra_constraint_set_group", world, [&] {
+    const int64_t at = world->world.move_constraint(to_id(group), static_cast<embra::Kind>(kind), index, to_id(to));
+    if (out_new_index) *out_new_index = static_cast<int32_t>(at);
+  });
+}
+
+embra_status embra_constraint_remove(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                     int32_t index) {
+  return guard("embra_constraint_remove", world,
+               [&] { world->world.remove_constraint(to_id(group), static_cast<embra::Kind>(kind), index); });
+}
+
 }  // extern "C"

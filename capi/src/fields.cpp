@@ -46,6 +46,32 @@ embra_field_id create_field(embra_world* world, const embra::FieldDesc& d) {
   return from_id<embra_field_id>(world->world.create_field(d));
 }
 
+/// A field's desc for an edit: kind and body as the def gives them (set_field refuses others).
+template <class Def, class Sub, class Rows>
+void set_field(embra_world* world, embra_field_id field, const Def* def, int32_t version, const char* name,
+               embra::FieldKind kind, Sub embra::FieldDesc::*sub, const Rows& rows, bool body_optional) {
+  need(def, "def");
+  need_version(def->version, version, name);
+  const embra::Field& f = world->world.field(to_id(field));
+  if (f.desc.kind != kind) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("the field is not one ") + name + " sets");
+  embra::FieldDesc d = f.desc;
+  d.body = field_body(world, def->body, body_optional, name);
+  to_core(rows, *def, d.*sub);
+  world->world.set_field(to_id(field), d);
+}
+
+/// A field's def as its embra_*_get gives it.
+template <class Def, class Sub, class Rows>
+void get_field(const embra_world* world, embra_field_id field, Def* out, Def def, embra::FieldKind kind,
+               Sub embra::FieldDesc::*sub, const Rows& rows, const char* name) {
+  need(out, "out_def");
+  const embra::Field& f = world->world.field(to_id(field));
+  if (f.desc.kind != kind) refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("the field is not one ") + name + " reads");
+  def.body = f.desc.body < 0 ? embra_body_id{0, 0} : embra_body_id{static_cast<uint32_t>(f.desc.body), 1};
+  to_c(rows, f.desc.*sub, def);
+  *out = def;
+}
+
 }  // namespace
 
 extern "C" {
@@ -132,6 +158,63 @@ embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def
     d.body = field_body(world, def->body, true, "embra_vortex_def");
     to_core(kVortexCopies, *def, d.vortex);
     *out_field = create_field(world, d);
+  });
+}
+
+embra_status embra_wind_set(embra_world* world, embra_field_id field, const embra_wind_def* def) {
+  return guard("embra_wind_set", world, [&] {
+    set_field(world, field, def, EMBRA_WIND_DEF_VERSION, "embra_wind_def", embra::FieldKind::wind,
+              &embra::FieldDesc::wind, kWindCopies, true);
+  });
+}
+
+embra_status embra_wind_get(const embra_world* world, embra_field_id field, embra_wind_def* out_def) {
+  return guard("embra_wind_get", world, [&] {
+    get_field(world, field, out_def, embra_default_wind_def(), embra::FieldKind::wind, &embra::FieldDesc::wind,
+              kWindCopies, "embra_wind_def");
+  });
+}
+
+embra_status embra_pressure_set(embra_world* world, embra_field_id field, const embra_pressure_def* def) {
+  return guard("embra_pressure_set", world, [&] {
+    set_field(world, field, def, EMBRA_PRESSURE_DEF_VERSION, "embra_pressure_def", embra::FieldKind::pressure,
+              &embra::FieldDesc::pressure, kPressureCopies, false);
+  });
+}
+
+embra_status embra_pressure_get(const embra_world* world, embra_field_id field, embra_pressure_def* out_def) {
+  return guard("embra_pressure_get", world, [&] {
+    get_field(world, field, out_def, embra_default_pressure_def(), embra::FieldKind::pressure,
+              &embra::FieldDesc::pressure, kPressureCopies, "embra_pressure_def");
+  });
+}
+
+embra_status embra_surface_tension_set(embra_world* world, embra_field_id field, const embra_surface_tension_def* def) {
+  return guard("embra_surface_tension_set", world, [&] {
+    set_field(world, field, def, EMBRA_SURFACE_TENSION_DEF_VERSION, "embra_surface_tension_def",
+              embra::FieldKind::surface_tension, &embra::FieldDesc::surface_tension, kSurfaceTensionCopies, false);
+  });
+}
+
+embra_status embra_surface_tension_get(const embra_world* world, embra_field_id field,
+                                       embra_surface_tension_def* out_def) {
+  return guard("embra_surface_tension_get", world, [&] {
+    get_field(world, field, out_def, embra_default_surface_tension_def(), embra::FieldKind::surface_tension,
+              &embra::FieldDesc::surface_tension, kSurfaceTensionCopies, "embra_surface_tension_def");
+  });
+}
+
+embra_status embra_vortex_set(embra_world* world, embra_field_id field, const embra_vortex_def* def) {
+  return guard("embra_vortex_set", world, [&] {
+    set_field(world, field, def, EMBRA_VORTEX_DEF_VERSION, "embra_vortex_def", embra::FieldKind::vortex,
+              &embra::FieldDesc::vortex, kVortexCopies, true);
+  });
+}
+
+embra_status embra_vortex_get(const embra_world* world, embra_field_id field, embra_vortex_def* out_def) {
+  return guard("embra_vortex_get", world, [&] {
+    get_field(world, field, out_def, embra_default_vortex_def(), embra::FieldKind::vortex, &embra::FieldDesc::vortex,
+              kVortexCopies, "embra_vortex_def");
   });
 }
 

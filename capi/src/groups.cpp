@@ -38,6 +38,20 @@ embra_status embra_group_set_weight(embra_world* world, embra_group_id group, in
   return guard("embra_group_set_weight", world, [&] { world->world.set_group_weight(to_id(group), weight); });
 }
 
+embra_status embra_group_set_enabled(embra_world* world, embra_group_id group, int32_t enabled) {
+  return guard("embra_group_set_enabled", world, [&] {
+    need_flag(enabled, "enabled");
+    world->world.set_group_enabled(to_id(group), enabled != 0);
+  });
+}
+
+embra_status embra_group_get_enabled(const embra_world* world, embra_group_id group, int32_t* out_enabled) {
+  return guard("embra_group_get_enabled", world, [&] {
+    need(out_enabled, "out_enabled");
+    *out_enabled = world->world.group(to_id(group)).desc.enabled ? 1 : 0;
+  });
+}
+
 embra_status embra_world_default_group(const embra_world* world, embra_group_id* out_group) {
   return guard("embra_world_default_group", world, [&] {
     need(out_group, "out_group");

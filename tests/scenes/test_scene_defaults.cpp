@@ -102,6 +102,19 @@ json panel_pins_name(int32_t pins) {
                                                 : "top_and_bottom_corners";
 }
 
+/// Whether a group the C ABI creates with the default def is enabled.
+bool group_enabled() {
+  embra_world* w = nullptr;
+  embra_group_def def = embra_default_group_def();
+  embra_group_id g{};
+  int32_t enabled = -1;
+  if (embra_world_create(&w, nullptr) != EMBRA_OK || embra_group_create(w, &def, &g) != EMBRA_OK ||
+      embra_group_get_enabled(w, g, &enabled) != EMBRA_OK)
+    throw std::runtime_error(std::string("a new group's enabled flag: ") + embra_last_error_message());
+  embra_world_destroy(w);
+  return enabled == 1;
+}
+
 /// A minimal scene holding one of each def with every optional key left out, as the loader
 /// reads and saves it.
 const char* const kMinimalScene = R"({
@@ -155,6 +168,7 @@ std::map<std::string, std::vector<json>> code_defaults() {
   const embra_group_def g = embra_default_group_def();
   c[d + "group/properties/order"] = {g.order, saved["groups"][2]["order"]};
   c[d + "group/properties/weight"] = {g.weight, saved["groups"][2]["weight"]};
+  c[d + "group/properties/enabled"] = {group_enabled(), saved["groups"][2]["enabled"]};
 
   const embra_material m = embra_default_material();
   const std::map<std::string, json> material = {{"mass", m.mass},

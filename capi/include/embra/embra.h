@@ -309,6 +309,12 @@ EMBRA_API embra_status embra_group_create(embra_world* world, const embra_group_
 EMBRA_API embra_status embra_group_destroy(embra_world* world, embra_group_id group);
 EMBRA_API embra_status embra_group_set_order(embra_world* world, embra_group_id group, int32_t order);
 EMBRA_API embra_status embra_group_set_weight(embra_world* world, embra_group_id group, int32_t weight);
+/* Enables (1) or disables (0) a group. A disabled group keeps its constraints and soft pins but is
+ * not projected, measured (embra_world_get_residuals, the settled test of embra_world_solve) or
+ * diagnosed until enabled again; its report reads 0. Positions and velocities are untouched. The
+ * contact group cannot be disabled. Saved in a scene as the group's "enabled". */
+EMBRA_API embra_status embra_group_set_enabled(embra_world* world, embra_group_id group, int32_t enabled);
+EMBRA_API embra_status embra_group_get_enabled(const embra_world* world, embra_group_id group, int32_t* out_enabled);
 EMBRA_API embra_status embra_world_default_group(const embra_world* world, embra_group_id* out_group);
 EMBRA_API embra_status embra_world_contact_group(const embra_world* world, embra_group_id* out_group);
 
@@ -384,6 +390,14 @@ EMBRA_API embra_status embra_body_get_particles(const embra_world* world, embra_
  * rest-scale ramp for this body stops. */
 EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_id body, double scale, double scale_u,
                                                  double scale_v);
+/* A body's material, from the next step on, without a rebuild: the compliances of the constraints
+ * it generated (stretch, shear, bend, volume: a stiffness slider), its particles' damping,
+ * thickness and friction. Positions, velocities and every other constraint stay as they were.
+ * Checked as embra_body_create checks it; mass and density must be the body's own (its particles'
+ * masses were set from them at creation). */
+EMBRA_API embra_status embra_body_set_material(embra_world* world, embra_body_id body, const embra_material* material);
+EMBRA_API embra_status embra_body_get_material(const embra_world* world, embra_body_id body,
+                                               embra_material* out_material);
 
 /* ---------------------------------------------------------------------------------------------
  * Constraints, one at a time or in bulk
@@ -445,6 +459,40 @@ typedef struct embra_constraint_batch_def {
 EMBRA_API embra_constraint_batch_def embra_default_constraint_batch_def(void);
 /* Adds all constraints of the batch or none. */
 EMBRA_API embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def);
+
+/* Edits without a rebuild. A constraint is named by its group ({0,0}: the default group), kind and
+ * index among the group's constraints of that kind: those bodies generated first (in body order),
+ * then the added ones in the order added, the numbering of embra_constraint_residual.index and
+ * embra_group_get_residuals. Each edit changes that constraint only, from the next step on;
+ * positions, velocities and every other constraint stay as they were. Only added constraints are
+ * edited one at a time: those a body generated follow its material (embra_body_set_material), and
+ * an edit naming one is refused. A body created later puts its generated constraints before the
+ * added ones of its groups, so their indices grow by that many. */
+
+/* How many constraints of `kind` the group holds (*out_count), and how many of those bodies
+ * generated (*out_generated, may be NULL): the added ones are [*out_generated, *out_count). */
+EMBRA_API embra_status embra_group_get_constraint_count(const embra_world* world, embra_group_id group,
+                                                        embra_constraint_kind kind, int32_t* out_count,
+                                                        int32_t* out_generated);
+/* One constraint as embra_constraint_add would take it: kind, group, particles (-1 past the arity),
+ * rest (before any body's rest scale) with rest_from_current 0, and compliance. */
+EMBRA_API embra_status embra_constraint_get(const embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                            int32_t index, embra_constraint_def* out_def);
+/* Compliance >= 0 and finite, in the kind's unit per newton. */
+EMBRA_API embra_status embra_constraint_set_compliance(embra_world* world, embra_group_id group,
+                                                       embra_constraint_kind kind, int32_t index, double compliance);
+/* Rest value in the kind's unit, checked as embra_constraint_add checks it (a distance >= 0, an
+ * angle in its range, a weld 0). */
+EMBRA_API embra_status embra_constraint_set_rest(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                                 int32_t index, double rest);
+/* Moves the constraint to the end of group `to`'s constraints of its kind; *out_new_index (may be NULL)
+ * receives its index there. The constraints after it in `group` move down by one. Not into the
+ * contact group. */
+EMBRA_API embra_status embra_constraint_set_group(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                                  int32_t index, embra_group_id to, int32_t* out_new_index);
+/* Removes the constraint; the constraints after it in its group move down by one. */
+EMBRA_API embra_status embra_constraint_remove(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                               int32_t index);
 
 /* ---------------------------------------------------------------------------------------------
  * Pins: a particle held at a target the host moves between steps (dragging, raising a tent)
@@ -941,7 +989,8 @@ EMBRA_API embra_status embra_world_get_scene_frames(const embra_world* world, in
  * each substep from the positions and velocities there and change the velocities of movable
  * particles (as gravity does; hard-pinned and immovable particles are not moved by them). A
  * pressure field's volume constraint is projected with XPBD before the groups in every pass.
- * A field's parameters are fixed at creation: destroy it and create another to change them.
+ * A field's parameters change between steps with embra_*_set (its kind and body stay those it was
+ * created with) and read back with embra_*_get.
  * ------------------------------------------------------------------------------------------- */
 
 typedef struct embra_field_id {
@@ -972,6 +1021,10 @@ EMBRA_API embra_wind_def embra_default_wind_def(void);
 /* Refused for a stale body id, a body without triangles, a zero or non-finite direction, or a
  * negative or non-finite number. */
 EMBRA_API embra_status embra_wind_create(embra_world* world, const embra_wind_def* def, embra_field_id* out_field);
+/* Checked as embra_wind_create checks it; refused for a field of another kind or def.body other
+ * than the field's. */
+EMBRA_API embra_status embra_wind_set(embra_world* world, embra_field_id field, const embra_wind_def* def);
+EMBRA_API embra_status embra_wind_get(const embra_world* world, embra_field_id field, embra_wind_def* out_def);
 
 /* Air pressure on a closed body (every edge shared by two triangles, wound counter-clockwise seen
  * from outside): each triangle is pushed along its outward normal by
@@ -996,6 +1049,10 @@ EMBRA_API embra_pressure_def embra_default_pressure_def(void);
  * non-finite number. */
 EMBRA_API embra_status embra_pressure_create(embra_world* world, const embra_pressure_def* def,
                                              embra_field_id* out_field);
+/* As embra_wind_set; rest_volume 0 is the volume enclosed now. embra_pressure_get gives the rest
+ * volume in use (measured at creation when it was 0). */
+EMBRA_API embra_status embra_pressure_set(embra_world* world, embra_field_id field, const embra_pressure_def* def);
+EMBRA_API embra_status embra_pressure_get(const embra_world* world, embra_field_id field, embra_pressure_def* out_def);
 
 /* Surface tension: a soap-film material on a body's triangles. The force on each vertex is
  * -tension * d(area)/dx, so a settled film between fixed boundaries is a minimal surface whatever
@@ -1018,6 +1075,10 @@ EMBRA_API embra_surface_tension_def embra_default_surface_tension_def(void);
  * number. */
 EMBRA_API embra_status embra_surface_tension_create(embra_world* world, const embra_surface_tension_def* def,
                                                     embra_field_id* out_field);
+EMBRA_API embra_status embra_surface_tension_set(embra_world* world, embra_field_id field,
+                                                 const embra_surface_tension_def* def);
+EMBRA_API embra_status embra_surface_tension_get(const embra_world* world, embra_field_id field,
+                                                 embra_surface_tension_def* out_def);
 
 /* Vortex: a volumetric torsion field about an axis through `center`. A particle at offset d from
  * the axis (r = |d|) and height s along it is accelerated (whatever its mass) by
@@ -1043,6 +1104,8 @@ EMBRA_API embra_vortex_def embra_default_vortex_def(void);
 /* Refused for a stale body id, a zero or non-finite axis, radius <= 0, a negative decay or a
  * non-finite number. */
 EMBRA_API embra_status embra_vortex_create(embra_world* world, const embra_vortex_def* def, embra_field_id* out_field);
+EMBRA_API embra_status embra_vortex_set(embra_world* world, embra_field_id field, const embra_vortex_def* def);
+EMBRA_API embra_status embra_vortex_get(const embra_world* world, embra_field_id field, embra_vortex_def* out_def);
 
 /* Destroys a field; its id becomes stale. */
 EMBRA_API embra_status embra_field_destroy(embra_world* world, embra_field_id field);

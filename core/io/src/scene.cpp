@@ -359,6 +359,9 @@ json json_of(double v) {
 json json_of(int32_t v) {
   return v;
 }
+json json_of(bool v) {
+  return v;
+}
 json json_of(const Vec3& v) {
   return vec_json(v);
 }
@@ -417,7 +420,8 @@ constexpr std::tuple kMaterialRows{Row{"mass", &Material::mass},
                                    Row{"friction_static", &Material::friction_static},
                                    Row{"friction_dynamic", &Material::friction_dynamic}};
 
-constexpr std::tuple kGroupRows{Row{"order", &GroupDesc::order}, Row{"weight", &GroupDesc::weight}};
+constexpr std::tuple kGroupRows{Row{"order", &GroupDesc::order}, Row{"weight", &GroupDesc::weight},
+                                Row{"enabled", &GroupDesc::enabled}};
 
 /// A pin's particle (a number or a body's vertex) and group (a name) are read and written beside these.
 constexpr std::tuple kPinRows{Row{"target", &PinDesc::target}, Row{"compliance", &PinDesc::compliance}};
@@ -832,6 +836,7 @@ class Builder {
         guard(at, [&] {
           w.set_group_order(it->second, d.order);
           w.set_group_weight(it->second, d.weight);
+          w.set_group_enabled(it->second, d.enabled);
           return 0;
         });
         return;

@@ -51,7 +51,7 @@ double enclosed_volume(const std::vector<Vec3>& x, const std::vector<int32_t>& t
   return v / 6.0;
 }
 
-Id World::create_field(const FieldDesc& desc) {
+FieldDesc World::checked_field(const FieldDesc& desc) const {
   const int kind = static_cast<int>(desc.kind);
   if (kind < 0 || kind >= kFieldKindCount) invalid("unknown field kind " + std::to_string(kind));
   FieldDesc d = desc;
@@ -61,7 +61,6 @@ Id World::create_field(const FieldDesc& desc) {
   if (needs_body && d.body < 0) invalid("a pressure or surface tension field needs a body");
   const BodyInfo* b = d.body >= 0 ? &bodies_[d.body] : nullptr;
   if (b && d.kind != FieldKind::vortex && b->triangles.empty()) invalid("the field's body has no triangles");
-  Field f;
   switch (d.kind) {
     case FieldKind::wind:
       unit_or_fail(d.wind.direction, "wind direction");  // kept as given (saved as given)
@@ -106,7 +105,14 @@ Id World::create_field(const FieldDesc& desc) {
       check_finite(d.vortex.start_time, "vortex start_time");
       break;
   }
+  return d;
+}
+
+Id World::create_field(const FieldDesc& desc) {
+  const FieldDesc d = checked_field(desc);
+  const BodyInfo* b = d.body >= 0 ? &bodies_[d.body] : nullptr;
   // Everything is valid: build and store.
+  Field f;
   f.desc = d;
   if (b) {
     f.triangles = b->triangles;
@@ -133,6 +139,14 @@ const Field& World::field(Id id) const {
   const Field* f = slots::find(fields_, id);
   if (f == nullptr) throw Error(ErrorCode::stale_id, "field id does not name a live field of this world");
   return *f;
+}
+
+void World::set_field(Id id, const FieldDesc& desc) {
+  const Field& f = field(id);
+  if (desc.kind != f.desc.kind || desc.body != f.desc.body)
+    invalid("a field keeps the kind and body it was created with; destroy it and create another");
+  const FieldDesc d = checked_field(desc);
+  fields_[id.index].desc = d;
 }
 
 void World::destroy_field(Id id) {

@@ -21,6 +21,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace embra {
@@ -99,6 +100,16 @@ struct GroupDesc {
   int32_t order = 0;   // groups are projected in increasing order (ties: creation order)
   int32_t weight = 1;  // projections of the group per solver iteration (>= 1)
   std::string name;
+  bool enabled = true;  // false: kept, but not projected, measured or diagnosed (World::set_group_enabled)
+};
+
+/// One constraint as a group holds it (World::constraint).
+struct ConstraintInfo {
+  Kind kind = Kind::distance;
+  std::array<int32_t, 4> particles{-1, -1, -1, -1};  // -1 past the kind's arity
+  double rest = 0.0;                                 // in the kind's unit, before any body's rest scale
+  double compliance = 0.0;
+  int32_t body = -1;  // the body that generated it (it follows the body's material), or -1: added
 };
 
 struct PinDesc {
@@ -485,6 +496,30 @@ class World {
   int64_t add_tethers(Id body, Id group, int32_t per_particle);
   int64_t constraint_count() const;
 
+  // --- edits: each changes only what it names; positions, velocities and every other constraint
+  // stay as they were. A constraint is named as the diagnostics name it: its group, kind and index
+  // in the group's constraints of that kind (ConstraintArray order: those bodies generated first, in
+  // body order, then the added ones in the order added). Only added constraints are edited one at
+  // a time; those a body generated follow its material (set_material).
+  /// How many constraints of `kind` the group holds, and how many of them bodies generated.
+  std::pair<int64_t, int64_t> constraint_count(Id group, Kind kind) const;
+  ConstraintInfo constraint(Id group, Kind kind, int64_t index) const;
+  void set_constraint_compliance(Id group, Kind kind, int64_t index, double compliance);
+  /// `rest` in the kind's unit, checked as embra_constraint_add checks it.
+  void set_constraint_rest(Id group, Kind kind, int64_t index, double rest);
+  /// Moves the constraint to the end of group `to`'s constraints of its kind; returns its index
+  /// there. The constraints after it in `group` move down by one.
+  int64_t move_constraint(Id group, Kind kind, int64_t index, Id to);
+  /// Removes the constraint; the constraints after it in `group` move down by one.
+  void remove_constraint(Id group, Kind kind, int64_t index);
+  /// A disabled group keeps its constraints and soft pins but is not projected, measured or
+  /// diagnosed until enabled again. The contact group is always enabled.
+  void set_group_enabled(Id group, bool enabled);
+  /// A body's material, from the next step on: the compliances of the constraints it generated,
+  /// and its particles' damping, thickness and friction. Its mass and density are refused: the
+  /// particles' masses were set from them at creation.
+  void set_material(Id body, const Material& material);
+
   // --- pins ------------------------------------------------------------------------------------
   Id create_pin(const PinDesc& desc);
   void destroy_pin(Id id);
@@ -529,6 +564,9 @@ class World {
   void destroy_field(Id id);
   const Field& field(Id id) const;
   size_t field_count() const;
+  /// A field's parameters, from the next step on, checked as create_field checks them; its kind
+  /// and body are those it was created with (a desc naming others is refused).
+  void set_field(Id id, const FieldDesc& desc);
 
   // --- stepping --------------------------------------------------------------------------------
   /// Advances one frame of settings().dt. A frame that does not complete leaves the world as the
@@ -549,6 +587,12 @@ class World {
 
  private:
   Group& group_mut(Id id);
+  /// The constraint array and slot an edit names (refused: stale group, unknown kind, index out of
+  /// range; `edit`: a generated constraint too).
+  ConstraintArray& edited_array(Id group, Kind kind, int64_t index, bool edit);
+  /// A field desc checked as create_field and set_field take it (a pressure's rest volume 0
+  /// measured now).
+  FieldDesc checked_field(const FieldDesc& desc) const;
   const Group* find_group(Id id) const;
   Id resolve_group(Id id) const;
   void check_particle(int64_t index, const char* what) const;
@@ -620,7 +664,7 @@ class World {
 
   std::vector<BodyInfo> bodies_;
   std::vector<Group> groups_;
-  std::vector<int32_t> order_;  // live group slots in projection order
+  std::vector<int32_t> order_;  // live, enabled group slots in projection order
   std::vector<Pin> pins_;
   std::vector<Collider> colliders_;
   std::vector<PanelLayout> panel_layouts_;

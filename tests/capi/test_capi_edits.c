@@ -1,0 +1,426 @@
+/* Edits without a rebuild: a constraint's compliance, rest and group, its removal, a group
+ * disabled and enabled, a body's material and a field's parameters, each changing only what it
+ * names. Checked against what one can work out by hand:
+ *   - a particle of mass m hanging from a fixed point by a distance of compliance c comes to rest
+ *     stretched by m g c (XPBD's steady state, exactly); after the compliance or the rest length is
+ *     edited it comes to rest where the new values put it;
+ *   - a disabled group, or a removed constraint, leaves the world stepping to the same bits as a
+ *     world that never had the constraint;
+ *   - a vortex field set to strength s accelerates a particle at distance r from its axis by
+ *     s exp(-r^2 / R^2) r / R;
+ *   - the saved scene differs from the one before an edit in that one number only, and the
+ *     positions and velocities are those before the edit, to the bit.
+ * Every refused edit leaves the saved world as it was. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "capi_test.h"
+
+static const double kG = 9.81;
+
+/* The one differing stretch of two texts (their common prefix and suffix cut off) is a single
+ * number in each: only digits, a point, a sign or an exponent. */
+static int only_one_number_differs(const char* a, const char* b) {
+  const size_t na = strlen(a), nb = strlen(b);
+  size_t p = 0, s = 0, i;
+  while (p < na && p < nb && a[p] == b[p]) ++p;
+  while (s < na - p && s < nb - p && a[na - 1 - s] == b[nb - 1 - s]) ++s;
+  if (p == na && p == nb) return 0; /* no difference at all */
+  for (i = p; i < na - s; ++i)
+    if (!strchr("0123456789.eE+-", a[i])) return 0;
+  for (i = p; i < nb - s; ++i)
+    if (!strchr("0123456789.eE+-", b[i])) return 0;
+  return 1;
+}
+
+/* World holding particle `first` fixed at the origin and `first + 1` of mass `m` 1 m below it. */
+static embra_world* hanging_world(double damping, double m, int32_t* first) {
+  embra_world* w = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def b = embra_default_body_def();
+  embra_body_id body;
+  const double xyz[6] = {0, 0, 0, 0, 0, -1};
+  double masses[2];
+  masses[0] = 0.0;
+  masses[1] = m;
+  s.damping = damping;
+  s.settle_speed = 1e-7; /* at rest: swinging less than 1e-7 / omega, a few nanometres */
+  CHECK_OK(embra_world_create(&w, &s));
+  b.vertex_count = 2;
+  b.positions = xyz;
+  b.masses = masses;
+  CHECK_OK(embra_body_create(w, &b, &body, first));
+  return w;
+}
+
+static double z_of(const embra_world* w, int32_t particle) {
+  double xyz[6] = {0};
+  CHECK_OK(embra_world_get_positions(w, xyz, 6, 0, 2));
+  return xyz[3 * particle + 2];
+}
+
+static void solve_to_rest(embra_world* w) {
+  embra_solve_def d = embra_default_solve_def();
+  embra_solve_result r;
+  d.until = EMBRA_SOLVE_UNTIL_SETTLED;
+  d.max_frames = 3000;
+  CHECK_OK(embra_world_solve(w, &d, &r));
+  CHECK_INT(r.outcome, EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE);
+}
+
+static int same_bits(const embra_world* a, const embra_world* b) {
+  double pa[6], pb[6], va[6], vb[6];
+  CHECK_OK(embra_world_get_positions(a, pa, 6, 0, 2));
+  CHECK_OK(embra_world_get_positions(b, pb, 6, 0, 2));
+  CHECK_OK(embra_world_get_velocities(a, va, 6, 0, 2));
+  CHECK_OK(embra_world_get_velocities(b, vb, 6, 0, 2));
+  return memcmp(pa, pb, sizeof pa) == 0 && memcmp(va, vb, sizeof va) == 0;
+}
+
+/* Compliance and rest edits of an added distance: the rest state moves to m g c and to the new
+ * rest length; the edit itself moves nothing, and the saved scene differs in that number only. */
+static void test_compliance_and_rest(void) {
+  const double m = 2.0, c1 = 1e-3, c2 = 4e-3;
+  int32_t first = 0, count = 0, generated = -1;
+  embra_world* w = hanging_world(6.0, m, &first);
+  embra_group_id def = {0, 0};
+  embra_constraint_def c = embra_default_constraint_def(), got;
+  double before[6], after[6];
+  char *saved_before, *saved_after;
+  c.particles[0] = first;
+  c.particles[1] = first + 1;
+  c.rest_from_current = 0;
+  c.rest = 1.0;
+  c.compliance = c1;
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, &generated));
+  CHECK_INT(count, 1);
+  CHECK_INT(generated, 0); /* the body's stretch went nowhere: a point pair without edges */
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, m * kG * c1, 1e-6);
+
+  CHECK_OK(embra_world_get_positions(w, before, 6, 0, 2));
+  saved_before = capi_test_save(w);
+  CHECK_OK(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, c2));
+  saved_after = capi_test_save(w);
+  CHECK_OK(embra_world_get_positions(w, after, 6, 0, 2));
+  CHECK(memcmp(before, after, sizeof before) == 0);
+  CHECK(saved_before && saved_after && only_one_number_differs(saved_before, saved_after));
+  CHECK_OK(embra_constraint_get(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, &got));
+  CHECK_SAME_DOUBLE(got.compliance, c2);
+  CHECK_SAME_DOUBLE(got.rest, 1.0);
+  CHECK_INT(got.particles[0], first);
+  CHECK_INT(got.particles[1], first + 1);
+  CHECK_INT(got.particles[2], -1);
+  CHECK_INT(got.rest_from_current, 0);
+  free(saved_before);
+  free(saved_after);
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, m * kG * c2, 1e-6);
+
+  saved_before = capi_test_save(w);
+  CHECK_OK(embra_constraint_set_rest(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, 1.5));
+  saved_after = capi_test_save(w);
+  CHECK(saved_before && saved_after && only_one_number_differs(saved_before, saved_after));
+  free(saved_before);
+  free(saved_after);
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.5, m * kG * c2, 1e-6);
+  embra_world_destroy(w);
+}
+
+/* A disabled group, and a removed constraint: the world steps to the bits of one that never had
+ * the constraint (the particle falls freely); enabled again, the group holds the particle again. */
+static void test_disable_move_remove(void) {
+  int32_t first = 0, fa = 0, index = -1, enabled = -1, count = -1;
+  embra_world* w = hanging_world(0.0, 1.0, &first);
+  embra_world* free_fall = hanging_world(0.0, 1.0, &fa);
+  embra_group_def gd = embra_default_group_def();
+  embra_group_id g, def = {0, 0};
+  embra_constraint_def c = embra_default_constraint_def(), got;
+  embra_kind_residual res[16];
+  int32_t n = 0, f;
+  char* saved;
+  embra_world* loaded = NULL;
+  c.particles[0] = first;
+  c.particles[1] = first + 1;
+  /* Three copies of the link: the middle one moves to group g, the other two are removed. */
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_group_create(w, &gd, &g));
+  CHECK_OK(embra_constraint_set_group(w, def, EMBRA_CONSTRAINT_DISTANCE, 1, g, &index));
+  CHECK_INT(index, 0);
+  CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, NULL));
+  CHECK_INT(count, 2);
+  /* Remove the two left in the default group: the one in g holds the particle alone. */
+  CHECK_OK(embra_constraint_remove(w, def, EMBRA_CONSTRAINT_DISTANCE, 1));
+  CHECK_OK(embra_constraint_remove(w, def, EMBRA_CONSTRAINT_DISTANCE, 0));
+  CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, NULL));
+  CHECK_INT(count, 0);
+  CHECK_OK(embra_constraint_get(w, g, EMBRA_CONSTRAINT_DISTANCE, 0, &got));
+  CHECK_INT(got.particles[1], first + 1);
+
+  /* Disabled: the same bits as the world without any constraint, frame after frame. */
+  CHECK_OK(embra_group_set_enabled(w, g, 0));
+  CHECK_OK(embra_group_get_enabled(w, g, &enabled));
+  CHECK_INT(enabled, 0);
+  for (f = 0; f < 20; ++f) {
+    CHECK_OK(embra_world_step(w));
+    CHECK_OK(embra_world_step(free_fall));
+  }
+  CHECK(same_bits(w, free_fall));
+  CHECK(z_of(w, first + 1) < -1.5); /* it fell: 0.5 g t^2 = 0.54 m in 1/3 s */
+  CHECK_OK(embra_world_get_residuals(w, res, 16, &n));
+  for (f = 0; f < n; ++f) CHECK(res[f].kind != EMBRA_CONSTRAINT_DISTANCE); /* not measured while disabled */
+
+  /* Saved and loaded back disabled. */
+  saved = capi_test_save(w);
+  CHECK(saved != NULL && strstr(saved, "\"enabled\": false") != NULL);
+  CHECK_OK(embra_world_load_json(&loaded, saved, (int64_t)strlen(saved), "."));
+  if (loaded) {
+    embra_group_id groups[4];
+    int32_t ng = 0, k, disabled = 0;
+    CHECK_OK(embra_world_get_groups(loaded, groups, 4, &ng));
+    for (k = 0; k < ng; ++k) {
+      CHECK_OK(embra_group_get_enabled(loaded, groups[k], &enabled));
+      disabled += enabled == 0;
+    }
+    CHECK_INT(disabled, 1);
+    embra_world_destroy(loaded);
+  }
+  free(saved);
+
+  /* Enabled again, the link pulls the particle back to 1 m. */
+  CHECK_OK(embra_group_set_enabled(w, g, 1));
+  CHECK_OK(embra_world_step(w));
+  {
+    double xyz[6];
+    CHECK_OK(embra_world_get_positions(w, xyz, 6, 0, 2));
+    CHECK_NEAR(sqrt(xyz[3] * xyz[3] + xyz[4] * xyz[4] + xyz[5] * xyz[5]), 1.0, 1e-9);
+  }
+  embra_world_destroy(w);
+  embra_world_destroy(free_fall);
+
+  /* A removed constraint is the same as none. */
+  w = hanging_world(0.0, 1.0, &first);
+  free_fall = hanging_world(0.0, 1.0, &fa);
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_set_positions(w, (const double[6]){0, 0, 0, 0, 0, -1}, first, 2));
+  CHECK_OK(embra_world_set_velocities(w, (const double[6]){0}, first, 2));
+  CHECK_OK(embra_constraint_remove(w, def, EMBRA_CONSTRAINT_DISTANCE, 0));
+  for (f = 0; f < 10; ++f) {
+    CHECK_OK(embra_world_step(w));
+    CHECK_OK(embra_world_step(free_fall));
+  }
+  CHECK(same_bits(w, free_fall));
+  embra_world_destroy(w);
+  embra_world_destroy(free_fall);
+}
+
+/* A body's material: its generated stretch follows the material's compliance (rest at m g c, then
+ * at the new m g c'); editing the generated constraint itself, or the mass, is refused. */
+static void test_material(void) {
+  embra_world* w = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def b = embra_default_body_def();
+  embra_body_id body;
+  embra_material mat, got;
+  embra_group_id def = {0, 0};
+  const double xyz[6] = {0, 0, 0, 0, 0, -1}, masses[2] = {0.0, 2.0};
+  const int32_t edge[2] = {0, 1};
+  int32_t first = 0, count = 0, generated = 0;
+  char *saved_before, *saved_after;
+  s.damping = 6.0;
+  s.settle_speed = 1e-7;
+  s.tethers = 0;
+  CHECK_OK(embra_world_create(&w, &s));
+  b.vertex_count = 2;
+  b.positions = xyz;
+  b.masses = masses;
+  b.edges = edge;
+  b.edge_count = 1;
+  b.material.stretch_compliance = 1e-3;
+  CHECK_OK(embra_body_create(w, &b, &body, &first));
+  CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, &generated));
+  CHECK_INT(count, 1);
+  CHECK_INT(generated, 1);
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, 2.0 * kG * 1e-3, 1e-6);
+
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "embra_body_set_material");
+  CHECK_STATUS(embra_constraint_remove(w, def, EMBRA_CONSTRAINT_DISTANCE, 0), EMBRA_ERROR_INVALID_ARGUMENT);
+
+  CHECK_OK(embra_body_get_material(w, body, &mat));
+  CHECK_SAME_DOUBLE(mat.stretch_compliance, 1e-3);
+  mat.mass = 5.0;
+  CHECK_STATUS(embra_body_set_material(w, body, &mat), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "mass");
+  CHECK_OK(embra_body_get_material(w, body, &mat));
+  mat.stretch_compliance = 3e-3;
+  saved_before = capi_test_save(w);
+  CHECK_OK(embra_body_set_material(w, body, &mat));
+  saved_after = capi_test_save(w);
+  CHECK(saved_before && saved_after && only_one_number_differs(saved_before, saved_after));
+  free(saved_before);
+  free(saved_after);
+  CHECK_OK(embra_body_get_material(w, body, &got));
+  CHECK_SAME_DOUBLE(got.stretch_compliance, 3e-3);
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, 2.0 * kG * 3e-3, 1e-6);
+  mat.damping = -1.0;
+  CHECK_STATUS(embra_body_set_material(w, body, &mat), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_set_material(w, body, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_get_material(w, body, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  body.index += 7;
+  CHECK_STATUS(embra_body_get_material(w, body, &got), EMBRA_ERROR_STALE_ID);
+  embra_world_destroy(w);
+}
+
+/* A vortex field edited between steps: strength 0 leaves a weightless particle where it is; set to
+ * s, it is pushed along axis x d at s exp(-r^2/R^2) r / R. */
+static void test_field(void) {
+  embra_world* w = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def b = embra_default_body_def();
+  embra_body_id body;
+  embra_vortex_def v = embra_default_vortex_def(), got;
+  embra_wind_def wind = embra_default_wind_def();
+  embra_field_id field;
+  const double xyz[3] = {0.5, 0, 0};
+  double p[3], vel[3];
+  const double strength = 2.0, radius = 1.0, r = 0.5;
+  const double a = strength * exp(-r * r / (radius * radius)) * r / radius;
+  int32_t first = 0;
+  char *saved_before, *saved_after;
+  s.gravity[2] = 0.0;
+  CHECK_OK(embra_world_create(&w, &s));
+  b.vertex_count = 1;
+  b.positions = xyz;
+  CHECK_OK(embra_body_create(w, &b, &body, &first));
+  CHECK_OK(embra_vortex_create(w, &v, &field));
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_positions(w, p, 3, 0, 1));
+  CHECK_SAME_DOUBLE(p[1], 0.0);
+
+  v.strength = strength;
+  v.radius = radius;
+  saved_before = capi_test_save(w);
+  CHECK_OK(embra_vortex_set(w, field, &v));
+  saved_after = capi_test_save(w);
+  CHECK(saved_before && saved_after && only_one_number_differs(saved_before, saved_after));
+  free(saved_before);
+  free(saved_after);
+  CHECK_OK(embra_vortex_get(w, field, &got));
+  CHECK_SAME_DOUBLE(got.strength, strength);
+  CHECK_INT(got.body.generation, 0);
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_velocities(w, vel, 3, 0, 1));
+  CHECK_NEAR(vel[1], a / 60.0, 1e-3 * a / 60.0); /* one frame of 1/60 s from rest */
+
+  /* Refused, nothing changed: another kind's setter, a non-finite strength, another body. */
+  saved_before = capi_test_save(w);
+  CHECK_STATUS(embra_wind_set(w, field, &wind), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_wind_get(w, field, &wind), EMBRA_ERROR_INVALID_ARGUMENT);
+  v.strength = NAN;
+  CHECK_STATUS(embra_vortex_set(w, field, &v), EMBRA_ERROR_INVALID_ARGUMENT);
+  v.strength = 1.0;
+  v.body = body;
+  CHECK_STATUS(embra_vortex_set(w, field, &v), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "body");
+  v.body.index = 0;
+  v.body.generation = 0;
+  v.version = 99;
+  CHECK_STATUS(embra_vortex_set(w, field, &v), EMBRA_ERROR_VERSION);
+  CHECK_STATUS(embra_vortex_set(w, field, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_vortex_get(w, field, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  saved_after = capi_test_save(w);
+  CHECK(saved_before && saved_after && strcmp(saved_before, saved_after) == 0);
+  free(saved_before);
+  free(saved_after);
+  CHECK_OK(embra_field_destroy(w, field));
+  CHECK_STATUS(embra_vortex_get(w, field, &got), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_vortex_set(w, field, &got), EMBRA_ERROR_STALE_ID);
+  embra_world_destroy(w);
+}
+
+/* Every refusal names what is wrong and leaves the saved world as it was. */
+static void test_refusals(void) {
+  int32_t first = 0, out = -7;
+  embra_world* w = hanging_world(0.0, 1.0, &first);
+  embra_group_def gd = embra_default_group_def();
+  embra_group_id def = {0, 0}, g, contacts, stale;
+  embra_constraint_def c = embra_default_constraint_def();
+  char *before, *after;
+  int32_t count = 0;
+  c.particles[0] = first;
+  c.particles[1] = first + 1;
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_group_create(w, &gd, &stale));
+  CHECK_OK(embra_group_destroy(w, stale));
+  CHECK_OK(embra_group_create(w, &gd, &g));
+  CHECK_OK(embra_world_contact_group(w, &contacts));
+  CHECK_OK(embra_world_step(w));
+  before = capi_test_save(w);
+
+  CHECK_STATUS(embra_constraint_set_compliance(w, stale, EMBRA_CONSTRAINT_DISTANCE, 0, 1.0), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, -1, 0, 1.0), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, 99, 0, 1.0), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, -1, 1.0),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 1, 1.0),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "outside [0, 1)");
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_TETHER, 0, 1.0), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, NAN),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, -1.0),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, INFINITY),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_rest(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, NAN), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_rest(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, -0.5), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_rest(w, stale, EMBRA_CONSTRAINT_DISTANCE, 0, 1.0), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_constraint_set_group(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, contacts, &out),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_group(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, stale, &out), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_constraint_set_group(w, def, EMBRA_CONSTRAINT_DISTANCE, 3, g, &out), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_INT(out, -7);
+  CHECK_STATUS(embra_constraint_remove(w, def, EMBRA_CONSTRAINT_DISTANCE, 1), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_remove(w, stale, EMBRA_CONSTRAINT_DISTANCE, 0), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_constraint_get(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_get(w, def, EMBRA_CONSTRAINT_DISTANCE, 5, &c), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, NULL, NULL),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_group_get_constraint_count(w, stale, EMBRA_CONSTRAINT_DISTANCE, &count, NULL),
+               EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_group_get_constraint_count(w, def, 42, &count, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_group_set_enabled(w, contacts, 0), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "contact");
+  CHECK_STATUS(embra_group_set_enabled(w, g, 2), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_group_set_enabled(w, stale, 0), EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_group_get_enabled(w, g, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_compliance(NULL, def, EMBRA_CONSTRAINT_DISTANCE, 0, 1.0),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_group_set_enabled(NULL, g, 0), EMBRA_ERROR_INVALID_ARGUMENT);
+
+  after = capi_test_save(w);
+  CHECK(before && after && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+  embra_world_destroy(w);
+}
+
+int main(void) {
+  RUN(test_compliance_and_rest);
+  RUN(test_disable_move_remove);
+  RUN(test_material);
+  RUN(test_field);
+  RUN(test_refusals);
+  return capi_test_finish();
+}
