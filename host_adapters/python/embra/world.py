@@ -18,7 +18,7 @@ from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
                     ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef,
-                    StepReport,
+                    StepReport, PressureDef, SurfaceTensionDef, VortexDef, WindDef,
                     Tolerances, Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
 
@@ -303,6 +303,16 @@ class World:
         self._call("embra_group_get_report", _id(group, GroupId, "group"), byref(r))
         return r
 
+    def set_group_enabled(self, group, enabled):
+        """Enables or disables a group (embra_group_set_enabled): a disabled group keeps its constraints
+        and soft pins but is not projected, measured or diagnosed. Not the contact group."""
+        self._call("embra_group_set_enabled", _id(group, GroupId, "group"), 1 if _flag(enabled, "enabled") else 0)
+
+    def group_enabled(self, group):
+        e = c_int32()
+        self._call("embra_group_get_enabled", _id(group, GroupId, "group"), byref(e))
+        return e.value == 1
+
     # --- bodies --------------------------------------------------------------------------------
     def create_body(self, positions, *, triangles=None, edges=None, tets=None, masses=None, uvs=None,
                     generate=None, material=None, stretch_group=None, shear_group=None, bend_group=None,
@@ -373,6 +383,23 @@ class World:
         first, count = c_int32(), c_int32()
         self._call("embra_body_get_particles", _id(body, BodyId, "body"), byref(first), byref(count))
         return first.value, count.value
+
+    def material(self, body):
+        """The body's Material (embra_body_get_material)."""
+        m = Material()
+        self._call("embra_body_get_material", _id(body, BodyId, "body"), byref(m))
+        return m
+
+    def set_material(self, body, material=None, **fields):
+        """Changes a body's material from the next step on, without a rebuild (embra_body_set_material):
+        the compliances of what it generated, its damping, thickness and friction. Starts from the
+        body's material; `material` (a Material or dict) and keyword fields override it. Mass and
+        density must stay the body's own."""
+        m = self.material(body)
+        if material is not None:
+            _fill(m, as_dict(material) if isinstance(material, Material) else dict(material), "Material")
+        _fill(m, fields, "Material")
+        self._call("embra_body_set_material", _id(body, BodyId, "body"), byref(m))
 
     def set_rest_scale(self, body, scale=1.0, scale_u=1.0, scale_v=1.0):
         self._call("embra_body_set_rest_scale", _id(body, BodyId, "body"), float(scale), float(scale_u),
@@ -550,6 +577,45 @@ class World:
         self._call("embra_constraints_add", byref(d))
         return count
 
+    # Edits of one constraint, named as the diagnostics name it: group (None: the default group), kind
+    # and index among the group's constraints of that kind (those bodies generated first, then the
+    # added ones in the order added). Only added constraints are edited; a body's follow its material.
+    def constraint_count(self, group, kind):
+        """(count, generated): the group's constraints of `kind` and how many of them bodies generated."""
+        n, g = c_int32(), c_int32()
+        self._call("embra_group_get_constraint_count", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   byref(n), byref(g))
+        return n.value, g.value
+
+    def constraint(self, group, kind, index):
+        """One constraint as a dict: kind, group, particles (its arity), rest, compliance."""
+        d = ConstraintDef()
+        k = _enum(kind, KINDS, "kind")
+        self._call("embra_constraint_get", _id(group, GroupId, "group"), k, buf.int32(index, "index"), byref(d))
+        arity = lib.embra_constraint_arity(d.kind)
+        return {"kind": d.kind, "group": GroupId(d.group.index, d.group.generation),
+                "particles": tuple(d.particles[:arity]), "rest": d.rest, "compliance": d.compliance}
+
+    def set_constraint_compliance(self, group, kind, index, compliance):
+        self._call("embra_constraint_set_compliance", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"), float(compliance))
+
+    def set_constraint_rest(self, group, kind, index, rest):
+        self._call("embra_constraint_set_rest", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"), float(rest))
+
+    def set_constraint_group(self, group, kind, index, to):
+        """Moves the constraint to the end of group `to`'s; returns its index there."""
+        at = c_int32()
+        self._call("embra_constraint_set_group", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"), _id(to, GroupId, "to"), byref(at))
+        return at.value
+
+    def remove_constraint(self, group, kind, index):
+        """Removes the constraint; those after it in its group move down by one."""
+        self._call("embra_constraint_remove", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"))
+
     # --- pins ----------------------------------------------------------------------------------
     def create_pin(self, particle, target, compliance=0.0, group=None):
         """Holds `particle` at `target` (m); compliance 0 = hard, > 0 (m/N) a soft pin in `group`."""
@@ -647,6 +713,42 @@ class World:
         """A decaying torsion field about an axis: VortexDef fields as keywords (body, None = every
         particle; center, axis, strength, radius, twist, decay, start_time). Returns its FieldId."""
         return self._create_field("embra_default_vortex_def", "embra_vortex_create", "VortexDef", fields)
+
+    def _field(self, get, cls, field):
+        d = cls()
+        self._call(get, _id(field, FieldId, "field"), byref(d))
+        return d
+
+    def _set_field(self, get, set_, cls, what, field, fields):
+        d = _fill(self._field(get, cls, field), fields, what)  # the field's parameters, those given changed
+        self._call(set_, _id(field, FieldId, "field"), byref(d))
+
+    def wind(self, field):
+        """A wind field's WindDef (embra_wind_get)."""
+        return self._field("embra_wind_get", WindDef, field)
+
+    def set_wind(self, field, **fields):
+        """Changes the given WindDef fields of a wind field from the next step on (embra_wind_set)."""
+        self._set_field("embra_wind_get", "embra_wind_set", WindDef, "WindDef", field, fields)
+
+    def pressure(self, field):
+        return self._field("embra_pressure_get", PressureDef, field)
+
+    def set_pressure(self, field, **fields):
+        self._set_field("embra_pressure_get", "embra_pressure_set", PressureDef, "PressureDef", field, fields)
+
+    def surface_tension(self, field):
+        return self._field("embra_surface_tension_get", SurfaceTensionDef, field)
+
+    def set_surface_tension(self, field, **fields):
+        self._set_field("embra_surface_tension_get", "embra_surface_tension_set", SurfaceTensionDef,
+                        "SurfaceTensionDef", field, fields)
+
+    def vortex(self, field):
+        return self._field("embra_vortex_get", VortexDef, field)
+
+    def set_vortex(self, field, **fields):
+        self._set_field("embra_vortex_get", "embra_vortex_set", VortexDef, "VortexDef", field, fields)
 
     def destroy_field(self, field):
         """Destroys a field; its id becomes stale."""
