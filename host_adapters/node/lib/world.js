@@ -407,6 +407,21 @@ class World {
     return r;
   }
 
+  /**
+   * Enables or disables a group (embra_group_set_enabled): a disabled group keeps its constraints and
+   * soft pins but is not projected, measured or diagnosed. Not the contact group.
+   */
+  setGroupEnabled(group, enabled) {
+    if (typeof enabled !== 'boolean') throw new TypeError(`enabled: expected true or false, got ${buf.describe(enabled)}`);
+    this.#call('embra_group_set_enabled', toId(group, GroupId, 'group'), enabled ? 1 : 0);
+  }
+
+  groupEnabled(group) {
+    const e = [0];
+    this.#call('embra_group_get_enabled', toId(group, GroupId, 'group'), e);
+    return e[0] === 1;
+  }
+
   // --- bodies -------------------------------------------------------------------------------------
 
   /**
@@ -469,6 +484,23 @@ class World {
   }
 
   /** Scales the rest lengths of a body's generated stretch constraints (and volumes by scale^3). */
+  /** The body's embra_material (embra_body_get_material). */
+  material(body) {
+    const m = {};
+    this.#call('embra_body_get_material', toId(body, BodyId, 'body'), m);
+    return m;
+  }
+
+  /**
+   * Changes a body's material from the next step on, without a rebuild (embra_body_set_material): the
+   * compliances of what it generated, its damping, thickness and friction. Starts from the body's material;
+   * the given fields override it. Mass and density must stay the body's own.
+   */
+  setMaterial(body, fields) {
+    const m = fill(this.material(body), capi.Material, fields, 'Material');
+    this.#call('embra_body_set_material', toId(body, BodyId, 'body'), m);
+  }
+
   setRestScale(body, scale = 1.0, scaleU = 1.0, scaleV = 1.0) {
     this.#call('embra_body_set_rest_scale', toId(body, BodyId, 'body'), buf.number(scale, 'scale'),
       buf.number(scaleU, 'scaleU'), buf.number(scaleV, 'scaleV'));
@@ -657,6 +689,56 @@ class World {
     return count;
   }
 
+  // Edits of one constraint, named as the diagnostics name it: group (null: the default group), kind and
+  // index among the group's constraints of that kind (those bodies generated first, then the added ones in
+  // the order added). Only added constraints are edited; a body's follow its material (setMaterial).
+
+  /** {count, generated}: the group's constraints of `kind` and how many of them bodies generated. */
+  constraintCount(group, kind) {
+    const n = [0];
+    const g = [0];
+    this.#call('embra_group_get_constraint_count', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'), n, g);
+    return { count: n[0], generated: g[0] };
+  }
+
+  /** One constraint: {kind, group, particles (its arity), rest, compliance}. */
+  constraint(group, kind, index) {
+    const d = {};
+    this.#call('embra_constraint_get', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), d);
+    return {
+      kind: d.kind,
+      group: new GroupId(d.group.index, d.group.generation),
+      particles: d.particles.slice(0, lib.embra_constraint_arity(d.kind)),
+      rest: d.rest,
+      compliance: d.compliance,
+    };
+  }
+
+  setConstraintCompliance(group, kind, index, compliance) {
+    this.#call('embra_constraint_set_compliance', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), buf.number(compliance, 'compliance'));
+  }
+
+  setConstraintRest(group, kind, index, rest) {
+    this.#call('embra_constraint_set_rest', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), buf.number(rest, 'rest'));
+  }
+
+  /** Moves the constraint to the end of group `to`'s; returns its index there. */
+  setConstraintGroup(group, kind, index, to) {
+    const at = [0];
+    this.#call('embra_constraint_set_group', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), toId(to, GroupId, 'to'), at);
+    return at[0];
+  }
+
+  /** Removes the constraint; those after it in its group move down by one. */
+  removeConstraint(group, kind, index) {
+    this.#call('embra_constraint_remove', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'));
+  }
+
   // --- pins ---------------------------------------------------------------------------------------
 
   /** Holds `particle` at `target` (m); options {compliance: 0 = hard, > 0 (m/N) a soft pin in `group`}. */
@@ -774,6 +856,52 @@ class World {
   createVortex(fields) {
     return this.#createField(lib.embra_default_vortex_def(), capi.VortexDef, 'embra_vortex_create', 'VortexDef',
       fields);
+  }
+
+  #field(get, field) {
+    const d = {};
+    this.#call(get, toId(field, FieldId, 'field'), d);
+    return d;
+  }
+
+  #setField(get, set, type, what, field, fields) {
+    const d = fill(this.#field(get, field), type, fields, what); // the field's parameters, those given changed
+    this.#call(set, toId(field, FieldId, 'field'), d);
+  }
+
+  /** A wind field's embra_wind_def (embra_wind_get). */
+  wind(field) {
+    return wrapIds(this.#field('embra_wind_get', field), capi.WindDef);
+  }
+
+  /** Changes the given embra_wind_def fields of a wind field from the next step on (embra_wind_set). */
+  setWind(field, fields) {
+    this.#setField('embra_wind_get', 'embra_wind_set', capi.WindDef, 'WindDef', field, fields);
+  }
+
+  pressure(field) {
+    return wrapIds(this.#field('embra_pressure_get', field), capi.PressureDef);
+  }
+
+  setPressure(field, fields) {
+    this.#setField('embra_pressure_get', 'embra_pressure_set', capi.PressureDef, 'PressureDef', field, fields);
+  }
+
+  surfaceTension(field) {
+    return wrapIds(this.#field('embra_surface_tension_get', field), capi.SurfaceTensionDef);
+  }
+
+  setSurfaceTension(field, fields) {
+    this.#setField('embra_surface_tension_get', 'embra_surface_tension_set', capi.SurfaceTensionDef,
+      'SurfaceTensionDef', field, fields);
+  }
+
+  vortex(field) {
+    return wrapIds(this.#field('embra_vortex_get', field), capi.VortexDef);
+  }
+
+  setVortex(field, fields) {
+    this.#setField('embra_vortex_get', 'embra_vortex_set', capi.VortexDef, 'VortexDef', field, fields);
   }
 
   /** Destroys a field; its id becomes stale. */
