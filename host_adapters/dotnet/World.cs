@@ -399,6 +399,20 @@ namespace Embra
             return r;
         }
 
+        /// <summary>Enables or disables a group (embra_group_set_enabled): a disabled group keeps its
+        /// constraints and soft pins but is not projected, measured or diagnosed. Not the contact group.</summary>
+        public void SetGroupEnabled(GroupId group, bool enabled)
+        {
+            Call(w => Native.embra_group_set_enabled(w, group, enabled ? 1 : 0));
+        }
+
+        public bool GroupEnabled(GroupId group)
+        {
+            int e = 0;
+            Call(w => Native.embra_group_get_enabled(w, group, out e));
+            return e == 1;
+        }
+
         // --- bodies -----------------------------------------------------------------------------
         /// <summary>Adds a body (embra_body_create). positions: xyz per vertex; triangles, edges, tets:
         /// body-local indices, 3, 2, 4 per element; masses (kg per vertex) and uvs (2 per vertex) optional.
@@ -444,6 +458,22 @@ namespace Embra
             Call(w => Native.embra_body_get_particles(w, body, out f, out c));
             first = f;
             count = c;
+        }
+
+        /// <summary>The body's material (embra_body_get_material).</summary>
+        public Material GetMaterial(BodyId body)
+        {
+            var m = new Material();
+            Call(w => Native.embra_body_get_material(w, body, out m));
+            return m;
+        }
+
+        /// <summary>A body's material from the next step on, without a rebuild (embra_body_set_material): the
+        /// compliances of what it generated, its damping, thickness and friction. Start from GetMaterial;
+        /// mass and density must stay the body's own.</summary>
+        public void SetMaterial(BodyId body, Material material)
+        {
+            Call(w => Native.embra_body_set_material(w, body, ref material));
         }
 
         public void SetRestScale(BodyId body, double scale, double scaleU = 1.0, double scaleV = 1.0)
@@ -599,6 +629,51 @@ namespace Embra
             return count;
         }
 
+        // Edits of one constraint, named as the diagnostics name it: group (default: the default group),
+        // kind and index among the group's constraints of that kind (those bodies generated first, then the
+        // added ones in the order added). Only added constraints are edited; a body's follow its material.
+
+        /// <summary>The group's constraints of `kind`, and how many of them bodies generated.</summary>
+        public void ConstraintCount(GroupId group, ConstraintKind kind, out int count, out int generated)
+        {
+            int n = 0, g = 0;
+            Call(w => Native.embra_group_get_constraint_count(w, group, (int)kind, out n, out g));
+            count = n;
+            generated = g;
+        }
+
+        /// <summary>One constraint as AddConstraint takes it (rest given, RestFromCurrent 0).</summary>
+        public ConstraintDef Constraint(GroupId group, ConstraintKind kind, int index)
+        {
+            var d = new ConstraintDef();
+            Call(w => Native.embra_constraint_get(w, group, (int)kind, index, out d));
+            return d;
+        }
+
+        public void SetConstraintCompliance(GroupId group, ConstraintKind kind, int index, double compliance)
+        {
+            Call(w => Native.embra_constraint_set_compliance(w, group, (int)kind, index, compliance));
+        }
+
+        public void SetConstraintRest(GroupId group, ConstraintKind kind, int index, double rest)
+        {
+            Call(w => Native.embra_constraint_set_rest(w, group, (int)kind, index, rest));
+        }
+
+        /// <summary>Moves the constraint to the end of group `to`'s; returns its index there.</summary>
+        public int SetConstraintGroup(GroupId group, ConstraintKind kind, int index, GroupId to)
+        {
+            int at = 0;
+            Call(w => Native.embra_constraint_set_group(w, group, (int)kind, index, to, out at));
+            return at;
+        }
+
+        /// <summary>Removes the constraint; those after it in its group move down by one.</summary>
+        public void RemoveConstraint(GroupId group, ConstraintKind kind, int index)
+        {
+            Call(w => Native.embra_constraint_remove(w, group, (int)kind, index));
+        }
+
         // --- pins -------------------------------------------------------------------------------
         /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
@@ -718,6 +793,25 @@ namespace Embra
             Call(w => Native.embra_vortex_create(w, ref def, out f));
             return f;
         }
+
+        /// <summary>A field's parameters, read back and changed between steps (embra_*_get, embra_*_set): the
+        /// kind and body stay those it was created with.</summary>
+        public WindDef GetWind(FieldId field) { var d = new WindDef(); Call(w => Native.embra_wind_get(w, field, out d)); return d; }
+        public void SetWind(FieldId field, WindDef def) { Call(w => Native.embra_wind_set(w, field, ref def)); }
+        public PressureDef GetPressure(FieldId field) { var d = new PressureDef(); Call(w => Native.embra_pressure_get(w, field, out d)); return d; }
+        public void SetPressure(FieldId field, PressureDef def) { Call(w => Native.embra_pressure_set(w, field, ref def)); }
+        public SurfaceTensionDef GetSurfaceTension(FieldId field)
+        {
+            var d = new SurfaceTensionDef();
+            Call(w => Native.embra_surface_tension_get(w, field, out d));
+            return d;
+        }
+        public void SetSurfaceTension(FieldId field, SurfaceTensionDef def)
+        {
+            Call(w => Native.embra_surface_tension_set(w, field, ref def));
+        }
+        public VortexDef GetVortex(FieldId field) { var d = new VortexDef(); Call(w => Native.embra_vortex_get(w, field, out d)); return d; }
+        public void SetVortex(FieldId field, VortexDef def) { Call(w => Native.embra_vortex_set(w, field, ref def)); }
 
         /// <summary>Destroys a field; its id becomes stale.</summary>
         public void DestroyField(FieldId field) { Call(w => Native.embra_field_destroy(w, field)); }

@@ -1706,4 +1706,143 @@ namespace Embra.Tests
             }
         }
     }
+    // Edits without a rebuild: a particle of mass m hanging on a link of compliance c rests stretched
+    // m g c, and after each edit where the new value puts it; a disabled group steps to the bits of a world
+    // without its constraint; the saved scene changes in the edited value only; refusals change nothing.
+    public class EditTests
+    {
+        const double G = 9.81;
+
+        static World Hanging(out Body b, double damping = 6.0)
+        {
+            var s = Library.DefaultSolverDef();
+            s.Damping = damping;
+            s.SettleSpeed = 1e-7;
+            s.Tethers = 0;
+            var w = new World(s);
+            b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, masses: new[] { 0.0, 2.0 });
+            return w;
+        }
+
+        static double Drop(World w, Body b)
+        {
+            var r = w.Solve(SolveUntil.Settled, 3000);
+            Assert.AreEqual((int)Solve.SettledWithinTolerance, r.Outcome);
+            return -w.GetPositions()[3 * (b.First + 1) + 2] - 1.0;
+        }
+
+        /// <summary>The one differing stretch of two texts is a single number in each.</summary>
+        static bool OnlyOneNumberDiffers(string a, string b)
+        {
+            int p = 0, s = 0;
+            while (p < a.Length && p < b.Length && a[p] == b[p]) ++p;
+            while (s < a.Length - p && s < b.Length - p && a[a.Length - 1 - s] == b[b.Length - 1 - s]) ++s;
+            Func<string, bool> number = t => t.Length > 0 && t.All(c => "0123456789.eE+-".IndexOf(c) >= 0);
+            return number(a.Substring(p, a.Length - p - s)) && number(b.Substring(p, b.Length - p - s));
+        }
+
+        [Test]
+        public void ComplianceAndRestEditsMoveTheRestState()
+        {
+            Body b;
+            using (var w = Hanging(out b))
+            {
+                var none = default(GroupId);
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 }, 1.0, 1e-3);
+                Assert.AreEqual(2.0 * G * 1e-3, Drop(w, b), 1e-6);
+                string before = w.SaveJson();
+                var xyz = w.GetPositions();
+                w.SetConstraintCompliance(none, ConstraintKind.Distance, 0, 4e-3);
+                CollectionAssert.AreEqual(xyz, w.GetPositions());
+                Assert.IsTrue(OnlyOneNumberDiffers(before, w.SaveJson()));
+                Assert.AreEqual(4e-3, w.Constraint(none, ConstraintKind.Distance, 0).Compliance);
+                Assert.AreEqual(2.0 * G * 4e-3, Drop(w, b), 1e-6);
+                w.SetConstraintRest(none, ConstraintKind.Distance, 0, 1.5);
+                Assert.AreEqual(2.0 * G * 4e-3, Drop(w, b) - 0.5, 1e-6);
+                int count, generated;
+                w.ConstraintCount(none, ConstraintKind.Distance, out count, out generated);
+                Assert.AreEqual(1, count);
+                Assert.AreEqual(0, generated);
+                var e = Assert.Throws<EmbraArgumentException>(() => w.SetConstraintCompliance(none, ConstraintKind.Distance, 1, 0.0));
+                StringAssert.Contains("outside [0, 1)", e.Message);
+            }
+        }
+
+        [Test]
+        public void ADisabledGroupStepsLikeNoConstraint()
+        {
+            Body b, fb;
+            using (var w = Hanging(out b, 0.0))
+            using (var free = Hanging(out fb, 0.0))
+            {
+                var g = w.CreateGroup();
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 }, group: g);
+                w.SetGroupEnabled(g, false);
+                Assert.IsFalse(w.GroupEnabled(g));
+                w.Step(20);
+                free.Step(20);
+                CollectionAssert.AreEqual(free.GetPositions(), w.GetPositions());
+                CollectionAssert.AreEqual(free.GetVelocities(), w.GetVelocities());
+                StringAssert.Contains("\"enabled\": false", w.SaveJson());
+                Assert.Throws<EmbraArgumentException>(() => w.SetGroupEnabled(w.ContactGroup, false));
+                var h = w.CreateGroup();
+                Assert.AreEqual(0, w.SetConstraintGroup(g, ConstraintKind.Distance, 0, h));
+                w.RemoveConstraint(h, ConstraintKind.Distance, 0);
+                int count, generated;
+                w.ConstraintCount(h, ConstraintKind.Distance, out count, out generated);
+                Assert.AreEqual(0, count);
+            }
+        }
+
+        [Test]
+        public void AMaterialEditMovesTheGeneratedStretch()
+        {
+            var s = Library.DefaultSolverDef();
+            s.Damping = 6.0;
+            s.SettleSpeed = 1e-7;
+            s.Tethers = 0;
+            using (var w = new World(s))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Material.StretchCompliance = 1e-3;
+                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, edges: new[] { 0, 1 }, masses: new[] { 0.0, 2.0 }, def: def);
+                Assert.AreEqual(2.0 * G * 1e-3, Drop(w, b), 1e-6);
+                Assert.Throws<EmbraArgumentException>(() => w.SetConstraintCompliance(default(GroupId), ConstraintKind.Distance, 0, 0.0));
+                var m = w.GetMaterial(b.Id);
+                m.StretchCompliance = 3e-3;
+                string before = w.SaveJson();
+                w.SetMaterial(b.Id, m);
+                Assert.IsTrue(OnlyOneNumberDiffers(before, w.SaveJson()));
+                Assert.AreEqual(2.0 * G * 3e-3, Drop(w, b), 1e-6);
+                m.Mass = 5.0;
+                var e = Assert.Throws<EmbraArgumentException>(() => w.SetMaterial(b.Id, m));
+                StringAssert.Contains("mass", e.Message);
+            }
+        }
+
+        [Test]
+        public void AVortexEditedBetweenSteps()
+        {
+            using (var w = new World())
+            {
+                w.SetGravity(0.0, 0.0, 0.0);
+                w.CreateBody(new[] { 0.5, 0.0, 0.0 });
+                var f = w.CreateVortex(Library.DefaultVortexDef());
+                w.Step();
+                Assert.AreEqual(0.0, w.GetPositions()[1]);
+                var v = w.GetVortex(f);
+                v.Strength = 2.0;
+                w.SetVortex(f, v);
+                Assert.AreEqual(2.0, w.GetVortex(f).Strength);
+                w.Step();
+                double a = 2.0 * Math.Exp(-0.25) * 0.5;
+                Assert.AreEqual(a / 60, w.GetVelocities()[1], 1e-3 * a / 60);
+                string before = w.SaveJson();
+                Assert.Throws<EmbraArgumentException>(() => w.SetWind(f, Library.DefaultWindDef()));
+                v.Radius = 0.0;
+                Assert.Throws<EmbraArgumentException>(() => w.SetVortex(f, v));
+                Assert.AreEqual(before, w.SaveJson());
+            }
+        }
+    }
 }
