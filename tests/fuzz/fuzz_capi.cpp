@@ -229,6 +229,7 @@ class Session {
   void op_step();
   void op_solve();
   void op_diagnose();
+  void op_edit();
   void op_cancel();
   void roundtrip(bool replace);
 
@@ -1102,11 +1103,125 @@ void Session::roundtrip(bool replace) {
   embra_world_destroy(copy);
 }
 
+void Session::op_edit() {
+  const embra_group_id g = pick_id(in_, groups_);
+  const int32_t kind = any_kind(in_);
+  const int32_t index = in_.chance(2) ? in_.u8() % 8 : in_.integer();
+  const std::string at = "(group {" + std::to_string(g.index) + ", " + std::to_string(g.generation) + "}, kind " +
+                         std::to_string(kind) + ", index " + std::to_string(index);
+  switch (in_.u8() % 10) {
+    case 0: {
+      const double c = in_.value();
+      call("embra_constraint_set_compliance" + at + ", " + fmt(c) + ")", true,
+           [&] { return embra_constraint_set_compliance(world_, g, kind, index, c); });
+      break;
+    }
+    case 1: {
+      const double r = in_.value();
+      call("embra_constraint_set_rest" + at + ", " + fmt(r) + ")", true,
+           [&] { return embra_constraint_set_rest(world_, g, kind, index, r); });
+      break;
+    }
+    case 2: {
+      const embra_group_id to = pick_id(in_, groups_);
+      int32_t out = 0;
+      int32_t* p = in_.chance(4) ? nullptr : &out;
+      call("embra_constraint_set_group" + at + ", to {" + std::to_string(to.index) + ", " +
+               std::to_string(to.generation) + "})",
+           true, [&] { return embra_constraint_set_group(world_, g, kind, index, to, p); });
+      break;
+    }
+    case 3:
+      call("embra_constraint_remove" + at + ")", true, [&] { return embra_constraint_remove(world_, g, kind, index); });
+      break;
+    case 4: {
+      const int32_t e = in_.chance(4) ? in_.integer() : in_.u8() % 2;
+      call("embra_group_set_enabled" + at + ", " + std::to_string(e) + ")", true,
+           [&] { return embra_group_set_enabled(world_, g, e); });
+      break;
+    }
+    case 5: {
+      embra_constraint_def d{};
+      int32_t count = 0, generated = 0;
+      call("embra_constraint_get" + at + ")", false,
+           [&] { return embra_constraint_get(world_, g, kind, index, in_.chance(16) ? nullptr : &d); });
+      call("embra_group_get_constraint_count" + at + ")", false, [&] {
+        return embra_group_get_constraint_count(world_, g, kind, &count, in_.chance(2) ? nullptr : &generated);
+      });
+      int32_t enabled = 0;
+      call("embra_group_get_enabled" + at + ")", false, [&] { return embra_group_get_enabled(world_, g, &enabled); });
+      break;
+    }
+    case 6:
+    case 7: {  // a body's material: its own, one setting changed
+      const embra_body_id b = pick_id(in_, bodies_);
+      embra_material m = embra_default_material();
+      embra_body_get_material(world_, b, &m);
+      double* settings[] = {&m.mass,
+                            &m.density,
+                            &m.stretch_compliance,
+                            &m.shear_compliance,
+                            &m.bend_compliance,
+                            &m.volume_compliance,
+                            &m.damping,
+                            &m.thickness,
+                            &m.friction_static,
+                            &m.friction_dynamic};
+      const uint8_t which = in_.u8() % 10;
+      *settings[which] = in_.value();
+      call("embra_body_set_material(setting " + std::to_string(which) + " = " + fmt(*settings[which]) + ")", true,
+           [&] { return embra_body_set_material(world_, b, &m); });
+      break;
+    }
+    default: {  // a field's parameters: its own, through the setter of a kind (maybe not its own)
+      const embra_field_id f = pick_id(in_, fields_);
+      const double v = in_.value();
+      switch (in_.u8() % 4) {
+        case 0: {
+          embra_wind_def d = embra_default_wind_def();
+          embra_wind_get(world_, f, &d);
+          d.speed = v;
+          call("embra_wind_set(speed " + fmt(v) + ")", true, [&] { return embra_wind_set(world_, f, &d); });
+          break;
+        }
+        case 1: {
+          embra_pressure_def d = embra_default_pressure_def();
+          embra_pressure_get(world_, f, &d);
+          d.inside_pressure = v;
+          call("embra_pressure_set(inside " + fmt(v) + ")", true, [&] { return embra_pressure_set(world_, f, &d); });
+          break;
+        }
+        case 2: {
+          embra_surface_tension_def d = embra_default_surface_tension_def();
+          embra_surface_tension_get(world_, f, &d);
+          d.tension = v;
+          call("embra_surface_tension_set(tension " + fmt(v) + ")", true,
+               [&] { return embra_surface_tension_set(world_, f, &d); });
+          break;
+        }
+        default: {
+          embra_vortex_def d = embra_default_vortex_def();
+          embra_vortex_get(world_, f, &d);
+          d.strength = v;
+          if (in_.chance(4)) d.radius = in_.value();
+          call("embra_vortex_set(strength " + fmt(v) + ", radius " + fmt(d.radius) + ")", true,
+               [&] { return embra_vortex_set(world_, f, &d); });
+        }
+      }
+    }
+  }
+}
+
 void Session::run() {
   start();
   int calls = 0;
   while (!in_.done() && calls++ < 64) {
-    switch (in_.u8() % 30) {
+    const uint8_t op = in_.u8();
+    if (op >= 240) {  // the edits (bytes below 240 decode as they did before the edits came)
+      op_edit();
+      continue;
+    }
+    switch (op % 30) {
       case 0:
         op_solver();
         break;
