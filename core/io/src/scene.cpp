@@ -281,22 +281,24 @@ const CompiledSchema& tolerances_schema_compiled() {
 // constraint."; the schema as written says what the place accepts, so the message can say it too.
 
 /// Every subschema of `schema` that applies at `path` below it ($ref, allOf, anyOf, oneOf, then and
-/// else followed; properties, additionalProperties and items descended).
+/// else followed; properties, additionalProperties and items descended). At most kSchemaVisits
+/// subschemas are visited, whatever the document's path (the schemas are fixed, the path is not).
+constexpr int kSchemaVisits = 4096;
 void schemas_at(const json& root, const json& schema, std::span<const std::string> path, std::vector<const json*>& out,
-                int depth = 0) {
-  if (!schema.is_object() || depth > 64) return;
+                int& visits) {
+  if (!schema.is_object() || ++visits > kSchemaVisits) return;
   if (const auto ref = schema.find("$ref"); ref != schema.end() && ref->is_string()) {
     const std::string& r = ref->get_ref<const std::string&>();
     if (r.starts_with("#")) {
       const json::json_pointer at(r.substr(1));
-      if (root.contains(at)) schemas_at(root, root.at(at), path, out, depth + 1);
+      if (root.contains(at)) schemas_at(root, root.at(at), path, out, visits);
     }
   }
   for (const char* combinator : {"allOf", "anyOf", "oneOf"})
     if (const auto list = schema.find(combinator); list != schema.end() && list->is_array())
-      for (const json& sub : *list) schemas_at(root, sub, path, out, depth + 1);
+      for (const json& sub : *list) schemas_at(root, sub, path, out, visits);
   for (const char* branch : {"then", "else"})
-    if (const auto sub = schema.find(branch); sub != schema.end()) schemas_at(root, *sub, path, out, depth + 1);
+    if (const auto sub = schema.find(branch); sub != schema.end()) schemas_at(root, *sub, path, out, visits);
   if (path.empty()) {
     out.push_back(&schema);
     return;
@@ -304,14 +306,14 @@ void schemas_at(const json& root, const json& schema, std::span<const std::strin
   const std::string& token = path.front();
   const auto properties = schema.find("properties");
   if (properties != schema.end() && properties->is_object() && properties->contains(token)) {
-    schemas_at(root, properties->at(token), path.subspan(1), out, depth + 1);
+    schemas_at(root, properties->at(token), path.subspan(1), out, visits);
   } else if (const auto extra = schema.find("additionalProperties"); extra != schema.end() && extra->is_object()) {
-    schemas_at(root, *extra, path.subspan(1), out, depth + 1);
+    schemas_at(root, *extra, path.subspan(1), out, visits);
   }
   if (const auto items = schema.find("items"); items != schema.end() && all_digits(token)) {
-    if (items->is_object()) schemas_at(root, *items, path.subspan(1), out, depth + 1);
+    if (items->is_object()) schemas_at(root, *items, path.subspan(1), out, visits);
     const size_t i = std::stoul(token);
-    if (items->is_array() && i < items->size()) schemas_at(root, items->at(i), path.subspan(1), out, depth + 1);
+    if (items->is_array() && i < items->size()) schemas_at(root, items->at(i), path.subspan(1), out, visits);
   }
 }
 
@@ -380,7 +382,8 @@ const json* value_at(const json& doc, std::span<const std::string> path) {
 std::string error_words(const std::string& description, const json& doc, const json& schema,
                         const std::vector<std::string>& path) {
   std::vector<const json*> here;
-  schemas_at(schema, schema, path, here);
+  int visits = 0;
+  schemas_at(schema, schema, path, here, visits);
   constexpr std::string_view kUnknown =
       "could not be validated using 'properties' or 'additionalProperties' constraints: '";
   if (const auto at = description.find(kUnknown); at != std::string::npos) {
