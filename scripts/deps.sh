@@ -10,7 +10,7 @@ packages=(
   clang-format binutils
   clang-14 libclang-rt-14-dev llvm-14
   python3-jsonschema
-  python3-pytest python3-numpy
+  python3-pytest python3-numpy python3-matplotlib
   mono-mcs nunit-console libnunit-cil-dev
   abigail-tools
   chromium

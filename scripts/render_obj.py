@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Renders OBJ meshes written by `embra` to a PNG (Debian's python3-matplotlib).
+"""Renders OBJ meshes written by `embra` to a PNG (Debian's python3-matplotlib, which
+scripts/deps.sh installs): faces shaded, and `l` lines (a hanging net's links) drawn as lines.
 
 usage: scripts/render_obj.py OUT.png MESH.obj [MESH.obj ...] [--title T] [--elev E] [--azim A]
 Several meshes are drawn side by side (e.g. frames of a run)."""
@@ -9,12 +10,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 import numpy as np  # noqa: E402
 
 
 def read_obj(path):
-    verts, faces = [], []
+    verts, faces, lines = [], [], []
     with open(path) as f:
         for line in f:
             p = line.split()
@@ -24,7 +25,10 @@ def read_obj(path):
                 verts.append([float(c) for c in p[1:4]])
             elif p[0] == "f":
                 faces.append([int(c.split("/")[0]) - 1 for c in p[1:]])
-    return np.array(verts), faces
+            elif p[0] == "l":
+                ids = [int(c.split("/")[0]) - 1 for c in p[1:]]
+                lines.extend(zip(ids, ids[1:]))
+    return np.array(verts), faces, lines
 
 
 def main():
@@ -40,7 +44,7 @@ def main():
     light = np.array([0.3, -0.5, 1.0])
     light /= np.linalg.norm(light)
     for k, path in enumerate(a.meshes):
-        v, faces = read_obj(path)
+        v, faces, lines = read_obj(path)
         ax = fig.add_subplot(1, n, k + 1, projection="3d")
         polys = [v[f] for f in faces]
         shade = []
@@ -49,7 +53,10 @@ def main():
             nrm /= max(np.linalg.norm(nrm), 1e-300)
             shade.append(0.35 + 0.6 * abs(nrm @ light))
         colors = [(0.85 * s, 0.78 * s, 0.62 * s) for s in shade]
-        ax.add_collection3d(Poly3DCollection(polys, facecolors=colors, edgecolors=(0, 0, 0, 0.08), linewidths=0.2))
+        if polys:
+            ax.add_collection3d(Poly3DCollection(polys, facecolors=colors, edgecolors=(0, 0, 0, 0.08), linewidths=0.2))
+        if lines:
+            ax.add_collection3d(Line3DCollection([v[[a, b]] for a, b in lines], colors=(0.25, 0.2, 0.12), linewidths=0.8))
         lo, hi = v.min(axis=0), v.max(axis=0)
         c, r = (lo + hi) / 2, (hi - lo).max() / 2
         ax.set_xlim(c[0] - r, c[0] + r)

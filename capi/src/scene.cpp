@@ -2,6 +2,7 @@
 #include "guard.hpp"
 
 #include "embra/core/limits.hpp"
+#include "embra/io/obj.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -22,6 +23,26 @@ embra_world* load(std::string_view text, const std::string& base_dir) {
   embra::io::LoadOptions options;
   options.base_dir = base_dir;
   return load_with(text, options);
+}
+
+/// Writes `text` to `path` through a temporary file beside it: the file is replaced whole or not at all.
+void replace_file(const char* path, const std::string& text) {
+  const std::string tmp = std::string(path) + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (f == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp + ": " + std::strerror(errno));
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path) != 0) {
+    std::remove(tmp.c_str());
+    refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot replace ") + path + ": " + std::strerror(errno));
+  }
+}
+
+std::string obj_text(const embra_world* world) {
+  return embra::io::export_obj(world->world, std::string("embra ") + embra_version_string());
 }
 
 std::string folder_of(const std::string& path) {
@@ -88,19 +109,21 @@ embra_status embra_world_save_json(const embra_world* world, char* out, int64_t 
 embra_status embra_world_save_file(const embra_world* world, const char* path) {
   return guard("embra_world_save_file", world, [&] {
     need(path, "path");
-    const std::string text = embra::io::save_scene(world->world, world->meta);
-    const std::string tmp = std::string(path) + ".tmp";
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (f == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp + ": " + std::strerror(errno));
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (std::fclose(f) != 0 || !ok) {
-      std::remove(tmp.c_str());
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp);
-    }
-    if (std::rename(tmp.c_str(), path) != 0) {
-      std::remove(tmp.c_str());
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot replace ") + path + ": " + std::strerror(errno));
-    }
+    replace_file(path, embra::io::save_scene(world->world, world->meta));
+  });
+}
+
+embra_status embra_world_export_obj(const embra_world* world, char* out, int64_t capacity, int64_t* out_length) {
+  return guard("embra_world_export_obj", world, [&] {
+    need(out_length, "out_length");
+    write_text(obj_text(world), out, capacity, out_length);
+  });
+}
+
+embra_status embra_world_write_obj(const embra_world* world, const char* path) {
+  return guard("embra_world_write_obj", world, [&] {
+    need(path, "path");
+    replace_file(path, obj_text(world));
   });
 }
 

@@ -4,15 +4,16 @@
  *   embra help
  *   embra validate SCENE.json [--allow-outside-paths]
  *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]
- *             [--allow-outside-paths]
- *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]
+ *             [--allow-outside-paths] [--force]
+ *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS] [--force]
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
  * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames; with
  * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
  * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
- * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses.
+ * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses. A DIR
+ * that holds anything is refused (exit 1) unless --force, which writes into it.
  * --threads T steps on T threads (0: one per core; default: the scene's solver.threads): the same
  * bits at any T, and final.json keeps the scene's own setting. --until settled|tolerance steps with
  * embra_world_solve (N frames at most, 1000 by default) and prints why it stopped; it writes the
@@ -29,9 +30,10 @@
  * second (moving pin targets, as a designer would drag them), then held while the form settles.
  * It prints convergence as it goes and writes OBJ files of the shell.
  *
- * Exit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state), 4 --until:
- * the world did not come to rest within tolerance. */
+ * Exit codes: 0 ok, 1 usage (a non-empty DIR without --force too), 2 invalid input, 3 the simulation
+ * failed (non-finite state), 4 --until: the world did not come to rest within tolerance. */
 #define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -51,8 +53,8 @@ static const char kUsage[] =
     "       embra help\n"
     "       embra validate SCENE.json [--allow-outside-paths]\n"
     "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]\n"
-    "                 [--allow-outside-paths]\n"
-    "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS]\n";
+    "                 [--allow-outside-paths] [--force]\n"
+    "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS] [--force]\n";
 
 static int usage(void) {
   fputs(kUsage, stderr);
@@ -81,7 +83,11 @@ static int help(void) {
       "          and says why it stopped: at rest within or out of tolerance (the worst metric and where),\n"
       "          or still moving, oscillating (with its period) or drifting. N defaults to 1000 there; the\n"
       "          per-frame lines and frame OBJs are not written, metrics.jsonl holds the last frame.\n"
-      "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files.\n"
+      "          DIR defaults to ./out. OBJ files hold triangles as f lines, a net's edges as l lines.\n"
+      "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files\n"
+      "          (DIR defaults to ./out/tent).\n"
+      "--force   run and demo tent refuse a DIR that holds anything (an earlier run's files are not\n"
+      "          replaced silently); --force writes into it, replacing files of the same name.\n"
       "\n"
       "OBJ files a scene names: paths are relative to the scene file's folder and must stay inside it\n"
       "(an absolute path, or \"..\" or a symbolic link leading out, is refused: a scene file may come\n"
@@ -90,8 +96,8 @@ static int help(void) {
   printf("be a regular file (no folder, device or pipe) of at most %lld bytes (EMBRA_MAX_OBJ_BYTES).\n",
          (long long)EMBRA_MAX_OBJ_BYTES);
   fputs(
-      "\nExit codes: 0 ok, 1 usage, 2 invalid input, 3 the simulation failed (non-finite state),\n"
-      "4 --until: the world did not come to rest within tolerance.\n",
+      "\nExit codes: 0 ok, 1 usage (a non-empty DIR without --force too), 2 invalid input, 3 the\n"
+      "simulation failed (non-finite state), 4 --until: the world did not come to rest within tolerance.\n",
       stdout);
   return 0;
 }
@@ -180,23 +186,45 @@ static int make_dir(const char* path) {
   return 0;
 }
 
+/* Whether `path` is a folder with anything in it (a missing folder, or a file, is not). */
+static int folder_has_entries(const char* path) {
+  DIR* d = opendir(path);
+  if (d == NULL) return 0;
+  int found = 0;
+  for (struct dirent* e; !found && (e = readdir(d)) != NULL;)
+    found = strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+  closedir(d);
+  return found;
+}
+
+/* The output folder: refused when it holds anything and `force` is not set (an earlier run's files
+ * are not replaced silently); otherwise made with its parents. */
+static int open_out_dir(const char* out, int force) {
+  if (!force && folder_has_entries(out)) {
+    fprintf(stderr,
+            "embra: %s is not empty: pass --force to write into it (files of the same name are replaced), "
+            "or --out another folder\n",
+            out);
+    return EXIT_USAGE;
+  }
+  if (make_dir(out) != 0) {
+    fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
+    return EXIT_INVALID;
+  }
+  return 0;
+}
+
 static int check(embra_status s, const char* what) {
   if (s == EMBRA_OK) return 0;
   fprintf(stderr, "embra: %s failed: %s (%s)\n", what, embra_last_error_message(), embra_status_name(s));
   return s == EMBRA_ERROR_NUMERICAL ? EXIT_SIM : EXIT_INVALID;
 }
 
-static int write_obj(const char* path, const double* xyz, int32_t n, const int32_t* tri, int32_t t) {
-  FILE* f = fopen(path, "w");
-  if (!f) {
-    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
-    return -1;
-  }
-  fprintf(f, "# embra %s\n", embra_version_string());
-  for (int32_t i = 0; i < n; ++i) fprintf(f, "v %.17g %.17g %.17g\n", xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  for (int32_t i = 0; i < t; ++i) fprintf(f, "f %d %d %d\n", tri[3 * i] + 1, tri[3 * i + 1] + 1, tri[3 * i + 2] + 1);
-  fclose(f);
-  return 0;
+/* Writes the world as OBJ (embra_world_write_obj: triangles as `f`, a net's edges as `l` lines). */
+static int write_world_obj(const char* path, const embra_world* world) {
+  if (embra_world_write_obj(world, path) == EMBRA_OK) return 0;
+  fprintf(stderr, "embra: %s\n", embra_last_error_message());
+  return -1;
 }
 
 /* An equilateral triangle of side `side` (m) in the z = 0 plane, split into rows^2 triangles. */
@@ -234,6 +262,7 @@ static void triangle_mesh(int32_t rows, double side, double* xyz, int32_t* tri, 
 static int demo_tent(int argc, char** argv) {
   long frames = 600, every = 100, rows = 40;
   const char* out = "out/tent";
+  int force = 0;
   for (int i = 0; i < argc; ++i) {
     int rc = 0;
     if (strcmp(argv[i], "--frames") == 0)
@@ -246,14 +275,14 @@ static int demo_tent(int argc, char** argv) {
       out = argv[++i];
     else if (strcmp(argv[i], "--out") == 0)
       return bad_usage("%s needs a value%s", argv[i], "");
+    else if (strcmp(argv[i], "--force") == 0)
+      force = 1;
     else
       return bad_usage("unknown option '%s' for demo tent%s", argv[i], " (see embra help)");
     if (rc != 0) return rc;
   }
-  if (make_dir(out) != 0) {
-    fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
-    return EXIT_INVALID;
-  }
+  const int opened = open_out_dir(out, force);
+  if (opened != 0) return opened;
 
   const int32_t n = (rows + 1) * (rows + 2) / 2, t = rows * rows;
   double* xyz = malloc(sizeof(double) * 3 * (size_t)n);
@@ -334,14 +363,14 @@ static int demo_tent(int argc, char** argv) {
              report.kinetic_energy, report.max_speed, apex, report.settled ? "yes" : "no");
     if (f % every == 0 || f == frames) {
       snprintf(path, sizeof path, "%s/frame_%05d.obj", out, f);
-      if (write_obj(path, now, n, tri, t) != 0) {
+      if (write_world_obj(path, world) != 0) {
         rc = EXIT_INVALID;
         goto done_now;
       }
     }
   }
   snprintf(path, sizeof path, "%s/final.obj", out);
-  if (write_obj(path, now, n, tri, t) != 0)
+  if (write_world_obj(path, world) != 0)
     rc = EXIT_INVALID;
   else
     printf("wrote %s (%ld frames, %.2f s simulated)\n", path, frames, report.time);
@@ -372,44 +401,6 @@ static embra_body_id* world_bodies(const embra_world* world, int32_t* count) {
   }
   free(ids);
   return NULL;
-}
-
-/* Writes every body's triangles as one OBJ, a group per body. */
-static int write_world_obj(const char* path, embra_world* world) {
-  embra_world_counts counts;
-  if (embra_world_get_counts(world, &counts) != EMBRA_OK) return -1;
-  double* xyz = malloc(sizeof(double) * 3 * (size_t)(counts.particles > 0 ? counts.particles : 1));
-  if (!xyz) return -1;
-  if (embra_world_get_positions(world, xyz, 3 * (int64_t)counts.particles, 0, counts.particles) != EMBRA_OK) {
-    free(xyz);
-    return -1;
-  }
-  FILE* f = fopen(path, "w");
-  if (!f) {
-    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
-    free(xyz);
-    return -1;
-  }
-  fprintf(f, "# embra %s\n", embra_version_string());
-  for (int32_t i = 0; i < counts.particles; ++i)
-    fprintf(f, "v %.17g %.17g %.17g\n", xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  int32_t body_count = 0;
-  embra_body_id* bodies = world_bodies(world, &body_count);
-  for (int32_t b = 0; b < body_count; ++b) {
-    const embra_body_id body = bodies[b];
-    int64_t n = 0;
-    if (embra_body_get_triangles(world, body, NULL, 0, &n) != EMBRA_OK || n == 0) continue;
-    int32_t* tri = malloc(sizeof(int32_t) * (size_t)n);
-    if (!tri) break;
-    if (embra_body_get_triangles(world, body, tri, n, &n) == EMBRA_OK) {
-      fprintf(f, "g body_%u\n", body.index);
-      for (int64_t k = 0; k < n; k += 3) fprintf(f, "f %d %d %d\n", tri[k] + 1, tri[k + 1] + 1, tri[k + 2] + 1);
-    }
-    free(tri);
-  }
-  free(bodies);
-  free(xyz);
-  return fclose(f) == 0 ? 0 : -1;
 }
 
 /* Panel meshes: the bodies of the world that are panel meshes (up to 64). */
@@ -753,10 +744,14 @@ static int cmd_run(int argc, char** argv) {
   const char* out = "out";
   long frames = -1, every = 0, threads = -1;
   int until = -1; /* EMBRA_SOLVE_UNTIL_*, or -1: step N frames */
-  int allow_outside = 0;
+  int allow_outside = 0, force = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--allow-outside-paths") == 0) {
       allow_outside = 1;
+      continue;
+    }
+    if (strcmp(argv[i], "--force") == 0) {
+      force = 1;
       continue;
     }
     int rc = 0;
@@ -810,10 +805,10 @@ static int cmd_run(int argc, char** argv) {
   /* --until: one call to embra_world_solve stands for the loop's frames. */
   const long calls = until >= 0 ? (frames > 0 ? 1 : 0) : frames;
   long stepped = 0;
-  if (make_dir(out) != 0) {
-    fprintf(stderr, "embra: cannot create %s: %s\n", out, strerror(errno));
+  const int opened = open_out_dir(out, force);
+  if (opened != 0) {
     embra_world_destroy(world);
-    return EXIT_INVALID;
+    return opened;
   }
   char path[4200];
   snprintf(path, sizeof path, "%s/metrics.jsonl", out);

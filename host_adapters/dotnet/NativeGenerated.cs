@@ -570,6 +570,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_positions(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_velocities(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_export_obj(IntPtr world, [Out] byte[] buffer, long capacity, out long length);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_write_obj(IntPtr world, byte[] path);
         [DllImport(Library, CallingConvention = C)] public static extern PanelMeshDef embra_default_panel_mesh_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_create(IntPtr world, ref PanelMeshDef def, out BodyId body, out int firstParticle);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_panel_count(IntPtr world, BodyId body, out int count);

@@ -949,6 +949,26 @@ namespace Embra
             Call(w => Native.embra_world_save_file(w, p));
         }
 
+        // --- OBJ -------------------------------------------------------------------------------
+        /// <summary>The world as Wavefront OBJ text (embra_world_export_obj): every particle a `v` line in
+        /// world order, each body's triangles as `f` lines, a body without triangles (a hanging net) as `l`
+        /// lines of its edges.</summary>
+        public string ExportObj()
+        {
+            long n = 0;
+            Call(w => Native.embra_world_export_obj(w, null, 0, out n));
+            var text = new byte[n];
+            Call(w => Native.embra_world_export_obj(w, text, text.LongLength, out n));
+            return Encoding.UTF8.GetString(text, 0, (int)n - 1);
+        }
+
+        /// <summary>Writes ExportObj()'s text to a file (replaced whole; no partial file on failure).</summary>
+        public void WriteObj(string path)
+        {
+            byte[] p = CString(path);
+            Call(w => Native.embra_world_write_obj(w, p));
+        }
+
         public long SceneFrames
         {
             get { long f = 0; Call(w => Native.embra_world_get_scene_frames(w, out f)); return f; }

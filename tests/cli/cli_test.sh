@@ -98,5 +98,57 @@ sed 's/"pins": \[/"actions": [{"type": "pin_target", "pin": "b", "keys": [{"fram
 after=$(sed -n 's/.*at rest and within tolerance after \([0-9]*\) frames.*/\1/p' "$tmp/log")
 [ -n "$after" ] && [ "$after" -ge 160 ] && ok || bad "at rest before the last action's frame counted: after '$after' frames"
 
+# An output folder that holds anything is not written into unless --force: the chain's folder from
+# above is refused (exit 1, the folder and the way out named, its final.json untouched), taken with
+# --force; an empty folder is taken as it is; demo tent does the same.
+before=$(sha256sum <"$tmp/chain/final.json")
+"$embra" run "$tmp/chain.json" --frames 5 --out "$tmp/chain" >"$tmp/log" 2>&1; rc=$?
+[ $rc -eq 1 ] && ok || bad "a non-empty --out must exit 1, not $rc"
+grep -q "^embra: $tmp/chain is not empty: pass --force to write into it" "$tmp/log" && ok || bad "the refusal does not say why: $(cat "$tmp/log")"
+[ "$(sha256sum <"$tmp/chain/final.json")" = "$before" ] && ok || bad "a refused run changed final.json"
+"$embra" run "$tmp/chain.json" --frames 5 --out "$tmp/chain" --force >"$tmp/log" 2>&1 && ok || bad "--force must write into the folder: $(cat "$tmp/log")"
+[ "$(wc -l <"$tmp/chain/metrics.jsonl")" -eq 5 ] && ok || bad "--force must replace metrics.jsonl"
+mkdir "$tmp/empty"
+"$embra" run "$tmp/chain.json" --frames 1 --out "$tmp/empty" >"$tmp/log" 2>&1 && [ -s "$tmp/empty/final.json" ] && ok || bad "an empty folder must be taken: $(cat "$tmp/log")"
+"$embra" demo tent --frames 1 --n 2 --out "$tmp/tent" >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "demo tent into a non-empty folder must exit 1"
+"$embra" demo tent --frames 1 --n 2 --out "$tmp/tent" --force >/dev/null 2>&1 && ok || bad "demo tent --force must run"
+"$embra" help | grep -q "^--force" && ok || bad "embra help must explain --force"
+
+# Schema errors in words, each at its JSON pointer: an unknown key with the nearest known one, a
+# value of the wrong type with what was expected and what was found.
+sed 's/"solver": {"damping": 4.0}/"solver": {"damping": 4.0, "gravty": [0, 0, -9.81]}/' "$tmp/chain.json" >"$tmp/typo.json"
+"$embra" validate "$tmp/typo.json" >"$tmp/log" 2>&1; rc=$?
+[ $rc -eq 2 ] && grep -q "^embra: $tmp/typo.json: embra_world_load_file: /solver: unknown key 'gravty' (did you mean 'gravity'?)$" "$tmp/log" \
+  && ok || bad "an unknown key must be named with the nearest known one (exit $rc): $(cat "$tmp/log")"
+sed 's/"generate": \[\]}/"generate": [], "material": {"mass": "heavy"}}/' "$tmp/chain.json" >"$tmp/mass.json"
+"$embra" validate "$tmp/mass.json" >"$tmp/log" 2>&1; rc=$?
+[ $rc -eq 2 ] && grep -q "/bodies/0/material/mass: expected a number, got a string$" "$tmp/log" \
+  && ok || bad "a string for a number must be named as such (exit $rc): $(cat "$tmp/log")"
+sed 's/"name": "chain"/"name": "chain", "frames": [3]/' "$tmp/chain.json" >"$tmp/frames.json"
+"$embra" validate "$tmp/frames.json" >"$tmp/log" 2>&1; rc=$?
+[ $rc -eq 2 ] && grep -q ": /frames: expected a whole number, got an array$" "$tmp/log" \
+  && ok || bad "an array for an integer must be named as such (exit $rc): $(cat "$tmp/log")"
+
+# A hanging net (edges, no triangles) writes its links as OBJ `l` lines: the scene's 220 edges,
+# 1-based, no faces, beside its 121 vertices.
+source_dir=$(cd "$(dirname "$0")/../.." && pwd)
+"$embra" run "$source_dir/examples/hanging_net.json" --frames 10 --out "$tmp/net" >"$tmp/log" 2>&1 && ok || bad "the net must run: $(cat "$tmp/log")"
+sed 's/.*"edges": \[\(.*\)\]}, "material".*/\1/' "$source_dir/examples/hanging_net.json" | grep -o '\[[0-9]*, [0-9]*\]' |
+  awk -F'[][, ]+' '{ print "l " $2 + 1 " " $3 + 1 }' | sort >"$tmp/net_edges"
+grep '^l ' "$tmp/net/final.obj" | sort >"$tmp/net_lines"
+[ "$(wc -l <"$tmp/net_edges")" -eq 220 ] && cmp -s "$tmp/net_edges" "$tmp/net_lines" && ok || bad "the net's l lines are not its edges"
+[ "$(grep -c '^v ' "$tmp/net/final.obj")" -eq 121 ] && ! grep -q '^f ' "$tmp/net/final.obj" && ok || bad "the net's OBJ must hold 121 vertices, no faces"
+
+# scripts/build_progress.sh (what demo.sh shows while it builds): off a terminal, one line per tenth
+# of the build; deps.sh's lines and errors pass through; the log keeps everything.
+printf '%s\n' "embra: installing libfoo" "[  1%] Building CXX object a.o" "[  5%] Building CXX object b.o" \
+  "[ 12%] Building CXX object c.o" "[ 12%] Linking CXX static library d.a" "x.cpp:1:2: error: boom" \
+  "[100%] Built target embra" >"$tmp/build_out"
+bash "$source_dir/scripts/build_progress.sh" "$tmp/build_log" <"$tmp/build_out" 2>"$tmp/progress" >/dev/null
+printf '%s\n' "embra: installing libfoo" "build: 1% (Building CXX object a.o)" "build: 12% (Building CXX object c.o)" \
+  "x.cpp:1:2: error: boom" "build: 100% (Built target embra)" >"$tmp/progress_expected"
+cmp -s "$tmp/progress" "$tmp/progress_expected" && ok || bad "build progress: $(cat "$tmp/progress")"
+cmp -s "$tmp/build_out" "$tmp/build_log" && ok || bad "the build log must keep every line"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

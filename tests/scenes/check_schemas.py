@@ -23,6 +23,7 @@ import argparse
 import glob
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -160,6 +161,7 @@ def main():
     for i, scene in enumerate(args.scenes):
         for frames in (0, 30):
             out = os.path.join(args.work, "run_%d_%s_%d" % (i, os.path.basename(scene)[:-5], frames))
+            shutil.rmtree(out, ignore_errors=True)  # the work folder stays between runs; `run` refuses a non-empty --out
             r = subprocess.run([args.embra, "run", scene, "--frames", str(frames), "--out", out],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120)
             if not check(r.returncode == 0, "embra run %s --frames %d exited %d: %s" %

@@ -15,6 +15,7 @@ for scene in examples/cloth_drape.json:60 tests/scenes/kernels/pinned_cloth.json
   for set in scalar vec2 avx2; do
     if [ "$set" = avx2 ] && ! grep -q avx2 /proc/cpuinfo; then continue; fi
     out=$work/$name.$set
+    rm -rf "$out"  # the work folder stays between runs; `embra run` refuses a non-empty --out
     if ! EMBRA_KERNELS=$set "$cli" run "$path" --frames "$frames" --out "$out" --every 100000 >"$out.log" 2>&1; then
       echo "FAIL $name with $set kernels: embra run exited non-zero"; cat "$out.log"; fail=1; continue
     fi

@@ -15,6 +15,7 @@ for path in "$source"/examples/*.json "$source"/examples/large/*.json; do
   first="" first_metrics=""
   for threads in 1 2 3 8; do
     out=$work/$name.t$threads
+    rm -rf "$out"  # the work folder stays between runs; `embra run` refuses a non-empty --out
     if ! "$cli" run "$path" --frames "$n" --threads "$threads" --out "$out" --every 1000000 >"$out.log" 2>&1; then
       echo "FAIL $name on $threads threads: embra run exited non-zero"; cat "$out.log"; fail=1; continue
     fi

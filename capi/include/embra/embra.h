@@ -785,6 +785,18 @@ EMBRA_API embra_status embra_world_set_velocities(embra_world* world, const doub
 EMBRA_API embra_status embra_body_get_triangles(const embra_world* world, embra_body_id body, int32_t* out,
                                                 int64_t capacity, int64_t* out_count);
 
+/* The world as Wavefront OBJ text (UTF-8, NUL-terminated): the line "# embra <version>", every
+ * particle as a `v` line in world order (%.17g: each double exactly; OBJ vertex k + 1 is particle
+ * k), then per body a group `g body_<index>` holding its triangles as `f` lines or, for a body
+ * without triangles (a hanging net, a chain), its edges as `l` lines: the edges it was made of
+ * (given, or its tetrahedra's) and every distance constraint added between two of its particles,
+ * each pair once, lower particle first, in increasing order. A body with neither (loose particles)
+ * has no group. Two-call pattern as embra_world_save_json: *out_length includes the terminating NUL. */
+EMBRA_API embra_status embra_world_export_obj(const embra_world* world, char* out, int64_t capacity,
+                                              int64_t* out_length);
+/* The same OBJ text written to a file (replaced whole; no partial file on failure). */
+EMBRA_API embra_status embra_world_write_obj(const embra_world* world, const char* path);
+
 /* ---------------------------------------------------------------------------------------------
  * Panel meshes: Planar Offset Quads (the paper's section 4)
  *

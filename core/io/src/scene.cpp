@@ -31,6 +31,7 @@
 #include <new>
 #include <numbers>
 #include <set>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -78,15 +79,22 @@ json parse(std::string_view text) {
   }
 }
 
-/// valijson's context ("<root>", "[bodies]", "[0]", ...) as a JSON pointer.
-std::string pointer_of(const std::vector<std::string>& context) {
-  std::string p;
+/// valijson's context ("<root>", "[bodies]", "[0]", ...) as the tokens of a JSON pointer.
+std::vector<std::string> tokens_of(const std::vector<std::string>& context) {
+  std::vector<std::string> tokens;
   for (const std::string& c : context) {
     if (c == "<root>") continue;
     std::string token = c.size() >= 2 && c.front() == '[' && c.back() == ']' ? c.substr(1, c.size() - 2) : c;
     if (token.size() >= 2 && token.front() == '"' && token.back() == '"') token = token.substr(1, token.size() - 2);
-    p += "/" + token;
+    tokens.push_back(std::move(token));
   }
+  return tokens;
+}
+
+/// valijson's context as a JSON pointer.
+std::string pointer_of(const std::vector<std::string>& context) {
+  std::string p;
+  for (const std::string& token : tokens_of(context)) p += "/" + token;
   return p.empty() ? "/" : p;
 }
 
@@ -245,23 +253,183 @@ std::unique_ptr<valijson::Schema> parse_schema(std::string_view text) {
   return s;
 }
 
-/// The schemas, parsed once (thread-safe static initialisation).
-const valijson::Schema& scene_schema_compiled() {
-  static const std::unique_ptr<valijson::Schema> schema = parse_schema(scene_schema());
-  return *schema;
+bool all_digits(const std::string& token) {
+  return !token.empty() && token.size() < 10 &&
+         std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-const valijson::Schema& tolerances_schema_compiled() {
-  static const std::unique_ptr<valijson::Schema> schema = parse_schema(kTolerancesSchema);
-  return *schema;
+/// A schema, compiled for valijson, and as written (for the words of its error messages).
+struct CompiledSchema {
+  std::unique_ptr<valijson::Schema> schema;
+  json source;
+};
+
+/// The schemas, parsed once (thread-safe static initialisation).
+const CompiledSchema& scene_schema_compiled() {
+  static const CompiledSchema schema{parse_schema(scene_schema()), json::parse(scene_schema())};
+  return schema;
+}
+
+const CompiledSchema& tolerances_schema_compiled() {
+  static const CompiledSchema schema{parse_schema(kTolerancesSchema), json::parse(kTolerancesSchema)};
+  return schema;
+}
+
+// --- errors in words ---------------------------------------------------------------------------------
+// valijson says "Object contains a property that could not be validated using 'properties' or
+// 'additionalProperties' constraints: 'gravty'." and "Value type not permitted by 'type'
+// constraint."; the schema as written says what the place accepts, so the message can say it too.
+
+/// Every subschema of `schema` that applies at `path` below it ($ref, allOf, anyOf, oneOf, then and
+/// else followed; properties, additionalProperties and items descended). At most kSchemaVisits
+/// subschemas are visited, whatever the document's path (the schemas are fixed, the path is not).
+constexpr int kSchemaVisits = 4096;
+void schemas_at(const json& root, const json& schema, std::span<const std::string> path, std::vector<const json*>& out,
+                int& visits) {
+  if (!schema.is_object() || ++visits > kSchemaVisits) return;
+  if (const auto ref = schema.find("$ref"); ref != schema.end() && ref->is_string()) {
+    const std::string& r = ref->get_ref<const std::string&>();
+    if (r.starts_with("#")) {
+      const json::json_pointer at(r.substr(1));
+      if (root.contains(at)) schemas_at(root, root.at(at), path, out, visits);
+    }
+  }
+  for (const char* combinator : {"allOf", "anyOf", "oneOf"})
+    if (const auto list = schema.find(combinator); list != schema.end() && list->is_array())
+      for (const json& sub : *list) schemas_at(root, sub, path, out, visits);
+  for (const char* branch : {"then", "else"})
+    if (const auto sub = schema.find(branch); sub != schema.end()) schemas_at(root, *sub, path, out, visits);
+  if (path.empty()) {
+    out.push_back(&schema);
+    return;
+  }
+  const std::string& token = path.front();
+  const auto properties = schema.find("properties");
+  if (properties != schema.end() && properties->is_object() && properties->contains(token)) {
+    schemas_at(root, properties->at(token), path.subspan(1), out, visits);
+  } else if (const auto extra = schema.find("additionalProperties"); extra != schema.end() && extra->is_object()) {
+    schemas_at(root, *extra, path.subspan(1), out, visits);
+  }
+  if (const auto items = schema.find("items"); items != schema.end() && all_digits(token)) {
+    if (items->is_object()) schemas_at(root, *items, path.subspan(1), out, visits);
+    const size_t i = std::stoul(token);
+    if (items->is_array() && i < items->size()) schemas_at(root, items->at(i), path.subspan(1), out, visits);
+  }
+}
+
+/// The number of single-character edits from a to b (both short: keys of a schema).
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// "a number", "a whole number", ... : a JSON Schema type as people say it.
+std::string type_words(const std::string& type) {
+  if (type == "integer") return "a whole number";
+  if (type == "array" || type == "object") return "an " + type;
+  if (type == "boolean") return "true or false";
+  if (type == "null") return "null";
+  return "a " + type;
+}
+
+/// What a JSON value is, as people say it.
+std::string value_words(const json& v) {
+  switch (v.type()) {
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return v.get<bool>() ? "true" : "false";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::number_float:
+      return "the number " + number_text(v.get<double>());
+    default:
+      return "a whole number";
+  }
+}
+
+/// The value of `doc` at `path` (null when there is none).
+const json* value_at(const json& doc, std::span<const std::string> path) {
+  const json* v = &doc;
+  for (const std::string& token : path) {
+    if (v->is_object() && v->contains(token)) {
+      v = &v->at(token);
+    } else if (v->is_array() && all_digits(token) && std::stoul(token) < v->size()) {
+      v = &v->at(std::stoul(token));
+    } else {
+      return nullptr;
+    }
+  }
+  return v;
+}
+
+/// One validation error in words: an unknown key with the nearest known one, a missing key, a wrong
+/// type with the types accepted and the value found; any other error as valijson says it.
+std::string error_words(const std::string& description, const json& doc, const json& schema,
+                        const std::vector<std::string>& path) {
+  std::vector<const json*> here;
+  int visits = 0;
+  schemas_at(schema, schema, path, here, visits);
+  constexpr std::string_view kUnknown =
+      "could not be validated using 'properties' or 'additionalProperties' constraints: '";
+  if (const auto at = description.find(kUnknown); at != std::string::npos) {
+    std::string key = description.substr(at + kUnknown.size());
+    while (!key.empty() && (key.back() == '.' || key.back() == '\'')) key.pop_back();
+    std::vector<std::string> known;
+    for (const json* s : here)
+      if (const auto p = s->find("properties"); p != s->end() && p->is_object())
+        for (auto it = p->begin(); it != p->end(); ++it) known.push_back(it.key());
+    if (std::find(known.begin(), known.end(), key) != known.end())
+      return "key '" + key + "' cannot be used together with the other keys here";
+    std::string nearest;
+    size_t best = std::max<size_t>(1, key.size() / 3) + 1;
+    for (const std::string& k : known)
+      if (const size_t d = edit_distance(key, k); d < best) best = d, nearest = k;
+    return "unknown key '" + key + "'" + (nearest.empty() ? "" : " (did you mean '" + nearest + "'?)");
+  }
+  constexpr std::string_view kMissing = "Missing required property '";
+  if (description.starts_with(kMissing)) {
+    std::string key = description.substr(kMissing.size());
+    while (!key.empty() && (key.back() == '.' || key.back() == '\'')) key.pop_back();
+    return "missing key '" + key + "'";
+  }
+  if (description.starts_with("Value type not permitted by 'type' constraint")) {
+    std::vector<std::string> types;
+    for (const json* s : here)
+      if (const auto t = s->find("type"); t != s->end())
+        for (const json& name : t->is_array() ? *t : json::array({*t}))
+          if (name.is_string() && std::find(types.begin(), types.end(), name.get<std::string>()) == types.end())
+            types.push_back(name.get<std::string>());
+    if (types.empty()) return description;
+    std::string expected;
+    for (size_t i = 0; i < types.size(); ++i)
+      expected += (i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + type_words(types[i]);
+    const json* value = value_at(doc, path);
+    return "expected " + expected + (value ? ", got " + value_words(*value) : "");
+  }
+  return description;
 }
 
 /// Validates `doc` against `schema`; errors name their pointer below `prefix`.
-void validate(const json& doc, const valijson::Schema& schema, const std::string& prefix, const char* what) {
+void validate(const json& doc, const CompiledSchema& schema, const std::string& prefix, const char* what) {
   valijson::Validator validator;
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter adapter(doc);
-  if (validator.validate(schema, adapter, &results)) return;
+  if (validator.validate(*schema.schema, adapter, &results)) return;
   // oneOf and anyOf failures report every alternative; the deepest error is the most telling, and
   // every distinct error at its place says what would have been accepted (0, or at least 1e-300).
   std::vector<valijson::ValidationResults::Error> errors;
@@ -276,11 +444,18 @@ void validate(const json& doc, const valijson::Schema& schema, const std::string
     return d.starts_with("Failed to validate against child schema #") ||
            d.starts_with("Failed to validate against a conditional schema");
   };
+  const std::vector<std::string> path = tokens_of(deepest->context);
   std::vector<std::string> said;
-  for (const auto& err : errors)
-    if (err.context == deepest->context && (!wrapper(err.description) || err.description == deepest->description) &&
-        std::find(said.begin(), said.end(), err.description) == said.end())
-      said.push_back(err.description);
+  bool in_words = false;  // some error said in the schema's words: no need to name the schema
+  for (const auto& err : errors) {
+    if (err.context != deepest->context || (wrapper(err.description) && err.description != deepest->description))
+      continue;
+    const std::string words = error_words(err.description, doc, schema.source, path);
+    in_words = in_words || words != err.description;
+    if (std::find(said.begin(), said.end(), words) == said.end()) said.push_back(words);
+  }
+  // Said in words, the place needs no "Failed to validate against any schemas allowed by anyOf".
+  if (in_words) std::erase_if(said, [](const std::string& d) { return d.starts_with("Failed to validate against"); });
   std::string message;
   for (std::string d : said) {
     if (said.size() > 1 && d.ends_with('.')) d.pop_back();
@@ -288,7 +463,9 @@ void validate(const json& doc, const valijson::Schema& schema, const std::string
   }
   const std::string pointer = pointer_of(deepest->context);
   fail(prefix.empty() ? pointer : prefix + (pointer == "/" ? "" : pointer),
-       std::string("does not match the ") + what + " schema: " + message);
+       !in_words                           ? std::string("does not match the ") + what + " schema: " + message
+       : std::string_view(what) != "scene" ? message + " (the " + what + " schema)"
+                                           : message);
 }
 
 constexpr const char* kColliderShapeNames[kColliderShapeCount] = {"plane",   "sphere", "box",

@@ -514,6 +514,8 @@ const PROTOTYPES = {
   embra_world_set_positions: 'embra_status embra_world_set_positions(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_set_velocities: 'embra_status embra_world_set_velocities(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_body_get_triangles: 'embra_status embra_body_get_triangles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
+  embra_world_export_obj: 'embra_status embra_world_export_obj(const embra_world *world, char *out, int64_t capacity, _Out_ int64_t *out_length)',
+  embra_world_write_obj: 'embra_status embra_world_write_obj(const embra_world *world, const char *path)',
   embra_default_panel_mesh_def: 'embra_panel_mesh_def embra_default_panel_mesh_def(void)',
   embra_panel_mesh_create: 'embra_status embra_panel_mesh_create(embra_world *world, const embra_panel_mesh_def *def, _Out_ embra_body_id *out_body, _Out_ int32_t *out_first_particle)',
   embra_panel_mesh_get_panel_count: 'embra_status embra_panel_mesh_get_panel_count(const embra_world *world, embra_body_id body, _Out_ int32_t *out_count)',

@@ -1179,6 +1179,24 @@ class World {
     this.#call('embra_world_save_file', buf.cString(path, 'path'));
   }
 
+  // --- OBJ ---------------------------------------------------------------------------------------
+
+  /** The world as Wavefront OBJ text (embra_world_export_obj): every particle a `v` line in world
+   * order, each body's triangles as `f` lines, a body without triangles (a hanging net) as `l`
+   * lines of its edges. */
+  exportObj() {
+    const n = [0];
+    this.#call('embra_world_export_obj', null, 0, n);
+    const out = Buffer.alloc(n[0]);
+    this.#call('embra_world_export_obj', out, out.length, n);
+    return out.toString('utf8', 0, n[0] - 1);
+  }
+
+  /** Writes exportObj()'s text to a file (replaced whole; no partial file on failure). */
+  writeObj(path) {
+    this.#call('embra_world_write_obj', buf.cString(path, 'path'));
+  }
+
   /** The scene's own frame count (600 for a world not loaded from a scene). */
   sceneFrames() {
     const f = [0];

@@ -610,6 +610,8 @@ PROTOTYPES = {
     "embra_world_set_positions": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_set_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_body_get_triangles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
+    "embra_world_export_obj": (c_int32, [c_void_p, POINTER(c_char), c_int64, POINTER(c_int64)]),
+    "embra_world_write_obj": (c_int32, [c_void_p, c_char_p]),
     "embra_default_panel_mesh_def": (PanelMeshDef, []),
     "embra_panel_mesh_create": (c_int32, [c_void_p, POINTER(PanelMeshDef), POINTER(BodyId), POINTER(c_int32)]),
     "embra_panel_mesh_get_panel_count": (c_int32, [c_void_p, BodyId, POINTER(c_int32)]),

@@ -895,6 +895,21 @@ class World:
     def save_file(self, path):
         self._call("embra_world_save_file", str(path).encode())
 
+    # --- OBJ -----------------------------------------------------------------------------------
+    def export_obj(self):
+        """The world as Wavefront OBJ text (embra_world_export_obj): every particle as a `v` line in
+        world order, each body's triangles as `f` lines, a body without triangles (a hanging net)
+        as `l` lines of its edges."""
+        n = c_int64()
+        self._call("embra_world_export_obj", None, 0, byref(n))
+        out = (c_char * n.value)()
+        self._call("embra_world_export_obj", out, n.value, byref(n))
+        return out.raw[:n.value - 1].decode("utf-8")
+
+    def write_obj(self, path):
+        """Writes export_obj()'s text to the file `path` (replaced whole; no partial file on failure)."""
+        self._call("embra_world_write_obj", os.fsencode(path))
+
     def scene_frames(self):
         f = c_int64()
         self._call("embra_world_get_scene_frames", byref(f))

@@ -156,6 +156,44 @@ namespace Embra.Tests
         }
 
         [Test]
+        public void HangingNetIsWrittenWithItsLinksAsObjLines()
+        {
+            // examples/hanging_net.json: edges, no triangles; its OBJ holds the stepped positions exactly
+            // and its 220 links as `l` lines, so an edge-only mesh renders (embra_world_export_obj).
+            string scene = Path.Combine(Env.Source, "examples", "hanging_net.json");
+            using (var w = World.LoadFile(scene))
+            {
+                w.Step(20);
+                string dir = Env.TempDir();
+                string file = Path.Combine(dir, "net.obj");
+                w.WriteObj(file);
+                string text = File.ReadAllText(file);
+                Assert.AreEqual(w.ExportObj(), text);
+                string[] lines = text.Split('\n');
+                double[] v = lines.Where(l => l.StartsWith("v ")).SelectMany(l => l.Split(' ').Skip(1))
+                    .Select(t => double.Parse(t, System.Globalization.CultureInfo.InvariantCulture)).ToArray();
+                Env.AssertBitIdentical(w.GetPositions(), v);
+                Assert.Less(Enumerable.Range(0, v.Length / 3).Min(i => v[3 * i + 2]), -0.01);  // it has sagged
+                Assert.AreEqual(0, lines.Count(l => l.StartsWith("f ")));
+                var links = lines.Where(l => l.StartsWith("l ")).ToList();
+                Assert.AreEqual(220, links.Count);
+                int first, count;
+                w.GetBodyParticles(w.Bodies()[0], out first, out count);
+                // The scene's edges, in its text: [[0, 1], [0, 11], ...].
+                string json = File.ReadAllText(scene);
+                string edges = json.Substring(json.IndexOf("\"edges\": [") + 10);
+                edges = edges.Substring(0, edges.IndexOf("]]") + 2);
+                var expected = System.Text.RegularExpressions.Regex.Matches(edges, @"\[(\d+), (\d+)\]").Cast<System.Text.RegularExpressions.Match>()
+                    .Select(m => "l " + (first + int.Parse(m.Groups[1].Value) + 1) + " " + (first + int.Parse(m.Groups[2].Value) + 1)).ToList();
+                expected.Sort(string.CompareOrdinal);
+                links.Sort(string.CompareOrdinal);
+                CollectionAssert.AreEqual(expected, links);
+                Assert.Throws<EmbraArgumentException>(() => w.WriteObj(Path.Combine(dir, "missing", "net.obj")));
+                Directory.Delete(dir, true);
+            }
+        }
+
+        [Test]
         public void TentSceneLoadedInCSharpMatchesTheCHostBitForBit()
         {
             string scene = Path.Combine(Env.Source, "examples", "gaudi_tent.json");

@@ -212,6 +212,10 @@ def test_rows_of_the_wrong_width_are_refused_before_anything_is_built():
             w.create_body(np.array(square, dtype=float).T)
         with pytest.raises(ValueError, match=r"quads: expected an \(n, 4\) array, got shape \(1, 3\)"):
             w.create_panel_mesh(np.array(square, dtype=float), np.array([[0, 1, 2]]))
+        with pytest.raises(ValueError, match=r"triangles: expected an \(n, 3\) array, got shape \(2, 4\)"):
+            w.create_body(np.array(square, dtype=float), triangles=np.array([[0, 1, 2, 3], [0, 2, 3, 1]]))
+        with pytest.raises(ValueError, match=r"positions: expected an \(n, 3\) or flat array, got shape \(3, 3, 1\)"):
+            w.create_body(np.zeros((3, 3, 1)))
     assert w.counts().particles == 0 and w.counts().constraints == 0
 
 
