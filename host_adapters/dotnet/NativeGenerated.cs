@@ -293,6 +293,16 @@ namespace Embra
         public long Particles;
     }
 
+    /// <summary>embra_reaction.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct Reaction
+    {
+        public PinId Pin;
+        public int Particle;
+        public int Reserved0;
+        public fixed double Force[3];
+    }
+
     /// <summary>embra_group_report.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GroupReport
@@ -551,6 +561,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_worst_constraints(IntPtr world, [Out] ConstraintResidual[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_group_conflicts(IntPtr world, [Out] GroupConflict[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_residuals(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_forces(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_reactions(IntPtr world, [Out] Reaction[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);
@@ -559,6 +571,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_velocities(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_positions(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_velocities(IntPtr world, double[] xyz, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_loads(IntPtr world, double[] xyz, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_loads(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern PanelMeshDef embra_default_panel_mesh_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_create(IntPtr world, ref PanelMeshDef def, out BodyId body, out int firstParticle);

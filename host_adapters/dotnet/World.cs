@@ -794,6 +794,23 @@ namespace Embra
             return res;
         }
 
+        /// <summary>The force of every constraint of `kind` in `group` after the last step, in the order
+        /// they were added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or
+        /// tether its tension in N (positive pulling its ends together).</summary>
+        public double[] ConstraintForces(GroupId group, ConstraintKind kind)
+        {
+            long n = 0;
+            Call(w => Native.embra_group_get_forces(w, group, (int)kind, null, 0, out n));
+            var res = new double[n];
+            Call(w => Native.embra_group_get_forces(w, group, (int)kind, res, res.Length, out n));
+            return res;
+        }
+
+        /// <summary>The force (N) every live pin exerts on its particle after the last step
+        /// (embra_world_get_reactions), pins in creation-slot order: at a static rest they sum to minus
+        /// the weights and point loads.</summary>
+        public Reaction[] Reactions() { return Ids<Reaction>(Native.embra_world_get_reactions); }
+
         public StepReport Report
         {
             get { var r = new StepReport(); Call(w => Native.embra_world_get_report(w, out r)); return r; }
@@ -837,6 +854,20 @@ namespace Embra
         {
             Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
             Call(w => Native.embra_world_set_velocities(w, xyz, first, xyz.Length / 3));
+        }
+
+        /// <summary>Point loads (N) of particles [first, first + count), as GetPositions.</summary>
+        public double[] GetLoads(int first = 0, int count = -1, double[] into = null)
+        {
+            return Read(Native.embra_world_get_loads, first, count, into);
+        }
+
+        /// <summary>Sets point loads (N, xyz per particle) on particles [first, first + xyz.Length / 3):
+        /// forces applied every substep beside gravity until set again.</summary>
+        public void SetLoads(double[] xyz, int first = 0)
+        {
+            Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
+            Call(w => Native.embra_world_set_loads(w, xyz, first, xyz.Length / 3));
         }
 
         // --- JSON scenes ------------------------------------------------------------------------

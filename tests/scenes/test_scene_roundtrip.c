@@ -4,7 +4,7 @@
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
  * orders and weights, hard and soft pins, a plane and a sphere, non-default solver settings, a rest
- * scale, initial velocities, and a destroyed group, pin and collider whose slots are reused):
+ * scale, initial velocities, point loads, and a destroyed group, pin and collider whose slots are reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -440,6 +440,11 @@ static embra_world* build_api_world(void) {
     double v[3 * BLOCK_N];
     for (i = 0; i < 3 * BLOCK_N; ++i) v[i] = 0.01 * (i % 5) - 0.02;
     CHECK_OK(embra_world_set_velocities(w, v, b0, BLOCK_N));
+  }
+  {
+    /* Point loads on two particles (N), written to the scene's "loads" with every bit. */
+    const double loads[6] = {0.1, -0.2, -1.0 / 3.0, 0.0, 0.0, 0.7};
+    CHECK_OK(embra_world_set_loads(w, loads, b0, 2));
   }
   if (capi_test_failed != failed_before) {
     embra_world_destroy(w);

@@ -846,6 +846,7 @@ class Builder {
     section("constraints", [&](const json& c, const std::string& at) { constraints(w, c, at); });
     if (doc_.contains("state")) state(w, doc_["state"]);
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
+    section("loads", [&](const json& l, const std::string& at) { load(w, l, at); });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
@@ -1147,7 +1148,8 @@ class Builder {
                   "pin");
   }
 
-  void pins(World& w, const json& p, const std::string& at) {
+  /// The particles of a pin or load: its "particle", or every vertex of its body's named "set".
+  std::vector<int32_t> particles_of(const World& w, const json& p, const std::string& at) {
     std::vector<int32_t> particles;
     if (p.contains("particle")) {
       if (p.contains("body") || p.contains("set")) fail(at, "give either \"particle\" or \"body\" and \"set\"");
@@ -1161,6 +1163,23 @@ class Builder {
         fail(at + "/set", "body '" + p["body"].get<std::string>() + "' has no vertex set '" + set + "'");
       for (int32_t v : it->second) particles.push_back(w.body(body).first_particle + v);
     }
+    return particles;
+  }
+
+  /// A point load on each of its particles, added to what earlier loads put there.
+  void load(World& w, const json& l, const std::string& at) {
+    const Vec3 force = vec3(l["force"]);
+    for (int32_t i : particles_of(w, l, at)) {
+      const Vec3 sum = w.loads()[i] + force;
+      guard(at + "/force", [&] {
+        w.set_loads(i, std::span<const double>(sum.data(), 3));
+        return 0;
+      });
+    }
+  }
+
+  void pins(World& w, const json& p, const std::string& at) {
+    const std::vector<int32_t> particles = particles_of(w, p, at);
     for (size_t i = 0; i < particles.size(); ++i) {
       PinDesc d;
       d.particle = particles[i];
@@ -1466,6 +1485,11 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     pins.push_back(j);
   }
   doc["pins"] = pins;
+
+  json loads = json::array();
+  for (int32_t i = 0; i < w.particle_count(); ++i)
+    if (!w.loads()[i].isZero()) loads.push_back({{"particle", i}, {"force", vec_json(w.loads()[i])}});
+  if (!loads.empty()) doc["loads"] = loads;
 
   json colliders = json::array();
   std::set<std::string> used_colliders = given_names(meta.collider_names);

@@ -447,6 +447,7 @@ Id World::create_body(const BodyDesc& d) {
     w_.push_back(inv_mass_.back());
     radius_.push_back(0.5 * d.material.thickness);
     damping_.push_back(d.material.damping);
+    load_.push_back(Vec3::Zero());
     mu_s_.push_back(d.material.friction_static);
     mu_k_.push_back(d.material.friction_dynamic);
     body_of_.push_back(body_index);
@@ -1234,6 +1235,14 @@ void World::set_velocities(int32_t first, std::span<const double> xyz) {
   if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
   for (double c : xyz) check_finite(c, "velocity coordinate");
   for (int64_t i = 0; i < n; ++i) v_[first + i] = at(xyz, i);
+}
+
+void World::set_loads(int32_t first, std::span<const double> xyz) {
+  if (xyz.size() % 3 != 0) invalid("load array length is not a multiple of 3");
+  const int64_t n = static_cast<int64_t>(xyz.size() / 3);
+  if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
+  for (double c : xyz) check_finite(c, "load coordinate");
+  for (int64_t i = 0; i < n; ++i) load_[first + i] = at(xyz, i);
 }
 
 }  // namespace embra

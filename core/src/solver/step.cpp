@@ -3,7 +3,8 @@
 //   begin_frame                hard pins' start, control.before_frame, solver arrays brought up to date
 //   for each substep:
 //     move_colliders           collider poses along their path over the frame
-//     predict                  fields, x <- x + h v + h^2 g; hard-pinned particles follow their target
+//     predict                  fields, x <- x + h v + h^2 (g + w f) (f: point load); hard-pinned
+//                              particles follow their target
 //     find_contacts            particles against colliders (swept over the substep), cloth against
 //     find_self_contacts       itself (self_collision.cpp), panel faces against spheres
 //     find_face_contacts
@@ -118,6 +119,7 @@ void World::predict(double h, double alpha) {
     x_prev_[i] = x_[i];
     if (w_[i] == 0.0) return;
     v_[i] += dv;
+    if (!load_[i].isZero()) v_[i] += (h * w_[i]) * load_[i];  // point loads (N)
     x_[i] += h * v_[i];
   });
   for (const Pin& p : pins_)

@@ -271,6 +271,12 @@ const GroupConflict = koffi.struct('embra_group_conflict', {
   force: 'double',
   particles: 'int64_t',
 });
+const Reaction = koffi.struct('embra_reaction', {
+  pin: PinIdType,
+  particle: 'int32_t',
+  reserved0: 'int32_t',
+  force: koffi.array('double', 3, 'Array'),
+});
 const GroupReport = koffi.struct('embra_group_report', {
   count: 'int64_t',
   residual_max: 'double',
@@ -421,6 +427,7 @@ const STRUCTS = {
   embra_kind_residual: KindResidual,
   embra_constraint_residual: ConstraintResidual,
   embra_group_conflict: GroupConflict,
+  embra_reaction: Reaction,
   embra_group_report: GroupReport,
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
@@ -495,6 +502,8 @@ const PROTOTYPES = {
   embra_world_get_worst_constraints: 'embra_status embra_world_get_worst_constraints(const embra_world *world, embra_constraint_residual *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_world_get_group_conflicts: 'embra_status embra_world_get_group_conflicts(const embra_world *world, embra_group_conflict *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_residuals: 'embra_status embra_group_get_residuals(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
+  embra_group_get_forces: 'embra_status embra_group_get_forces(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
+  embra_world_get_reactions: 'embra_status embra_world_get_reactions(const embra_world *world, embra_reaction *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
   embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
   embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
@@ -503,6 +512,8 @@ const PROTOTYPES = {
   embra_world_get_velocities: 'embra_status embra_world_get_velocities(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
   embra_world_set_positions: 'embra_status embra_world_set_positions(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_set_velocities: 'embra_status embra_world_set_velocities(embra_world *world, const double *xyz, int32_t first, int32_t count)',
+  embra_world_set_loads: 'embra_status embra_world_set_loads(embra_world *world, const double *xyz, int32_t first, int32_t count)',
+  embra_world_get_loads: 'embra_status embra_world_get_loads(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
   embra_body_get_triangles: 'embra_status embra_body_get_triangles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_default_panel_mesh_def: 'embra_panel_mesh_def embra_default_panel_mesh_def(void)',
   embra_panel_mesh_create: 'embra_status embra_panel_mesh_create(embra_world *world, const embra_panel_mesh_def *def, _Out_ embra_body_id *out_body, _Out_ int32_t *out_first_particle)',
@@ -552,7 +563,7 @@ module.exports = {
   CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
   PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
   SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef,
-  StepReport, KindResidual, ConstraintResidual, GroupConflict, GroupReport, SolveDef, SolveResult, Warning,
-  PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef,
-  PressureDef, SurfaceTensionDef, VortexDef,
+  StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef, SolveResult,
+  Warning, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType,
+  WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

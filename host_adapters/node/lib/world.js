@@ -982,6 +982,41 @@ class World {
     return out;
   }
 
+  /**
+   * The force of every constraint of `kind` in `group` after the last step, in the order they were
+   * added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or tether its
+   * tension in N (positive pulling its ends together). A Float64Array.
+   */
+  constraintForces(group, kind) {
+    if (!(group instanceof GroupId)) throw new TypeError(`group: expected a GroupId, got ${buf.describe(group)}`);
+    const k = enumValue(kind, KINDS, 'kind');
+    const n = [0];
+    this.#call('embra_group_get_forces', group, k, null, 0, n);
+    const out = new Float64Array(Number(n[0]));
+    this.#call('embra_group_get_forces', group, k, out, out.length, n);
+    return out;
+  }
+
+  /**
+   * The force (N) every live pin exerts on its particle after the last step
+   * (embra_world_get_reactions): [{pin (PinId), particle, force ([x, y, z])}], pins in creation-slot
+   * order. At a static rest they sum to minus the weights and point loads.
+   */
+  reactions() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_reactions', null, 0, n);
+    const size = koffi.sizeof(capi.Reaction);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_reactions', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const r = koffi.decode(out, k * size, capi.Reaction);
+      result.push({ pin: new PinId(r.pin.index, r.pin.generation), particle: r.particle, force: Array.from(r.force) });
+    }
+    return result;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);
@@ -1033,6 +1068,19 @@ class World {
   /** Sets particles' velocities (m/s), as setPositions. */
   setVelocities(xyz, first = 0) {
     this.#write('embra_world_set_velocities', xyz, first);
+  }
+
+  /** Point loads (N) of particles [first, first + count), as positions(). */
+  loads(first = 0, count = null, out = null) {
+    return this.#read('embra_world_get_loads', first, count, out);
+  }
+
+  /**
+   * Sets point loads (N, flat xyz per particle) on particles [first, first + xyz.length / 3): forces
+   * applied every substep beside gravity until set again.
+   */
+  setLoads(xyz, first = 0) {
+    this.#write('embra_world_set_loads', xyz, first);
   }
 
   // --- JSON scenes --------------------------------------------------------------------------------

@@ -348,6 +348,16 @@ class GroupConflict(_Struct):
     ]
 
 
+class Reaction(_Struct):
+    """embra_reaction."""
+    _fields_ = [
+        ("pin", PinId),
+        ("particle", c_int32),
+        ("reserved0", c_int32),
+        ("force", c_double * 3),
+    ]
+
+
 class GroupReport(_Struct):
     """embra_group_report."""
     _fields_ = [
@@ -591,6 +601,8 @@ PROTOTYPES = {
     "embra_world_get_worst_constraints": (c_int32, [c_void_p, POINTER(ConstraintResidual), c_int32, POINTER(c_int32)]),
     "embra_world_get_group_conflicts": (c_int32, [c_void_p, POINTER(GroupConflict), c_int32, POINTER(c_int32)]),
     "embra_group_get_residuals": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
+    "embra_group_get_forces": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
+    "embra_world_get_reactions": (c_int32, [c_void_p, POINTER(Reaction), c_int32, POINTER(c_int32)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
     "embra_default_solve_def": (SolveDef, []),
     "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),
@@ -599,6 +611,8 @@ PROTOTYPES = {
     "embra_world_get_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
     "embra_world_set_positions": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_set_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
+    "embra_world_set_loads": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
+    "embra_world_get_loads": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
     "embra_body_get_triangles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
     "embra_default_panel_mesh_def": (PanelMeshDef, []),
     "embra_panel_mesh_create": (c_int32, [c_void_p, POINTER(PanelMeshDef), POINTER(BodyId), POINTER(c_int32)]),

@@ -372,6 +372,57 @@ namespace Embra.Tests
         }
     }
 
+    [TestFixture]
+    public class StaticsTests
+    {
+        /// <summary>A load hung from two pins by two hard bars at 45 degrees: each bar carries the load
+        /// over 2 sin 45 (N, tension), and the reactions sum to minus every weight and point load.</summary>
+        [Test]
+        public void TwoBarTrussForcesAndReactions()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 20;
+            solver.Damping = 5.0;
+            solver.Tethers = 0;
+            solver.RealignPasses = 2;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { -1, 0, 0, 1, 0, 0, 0, 0, -1 }, masses: new[] { 1.0, 1.5, 2.0 }, def: def);
+                w.AddConstraints(ConstraintKind.Distance, new[] { 0, 2, 1, 2 });
+                var p0 = w.CreatePin(0, new double[] { -1, 0, 0 });
+                var p1 = w.CreatePin(1, new double[] { 1, 0, 0 });
+                w.SetLoads(new double[] { 0, 0, -10 }, 2);
+                Assert.AreEqual(new double[] { 0, 0, 0, 0, 0, 0, 0, 0, -10 }, w.GetLoads());
+                w.Step(200);
+                double down = 2 * 9.81 + 10;
+                foreach (double t in w.ConstraintForces(w.DefaultGroup, ConstraintKind.Distance))
+                    Assert.AreEqual(down / Math.Sqrt(2.0), t, 1e-9 * down);
+                var r = w.Reactions();
+                Assert.AreEqual(2, r.Length);
+                Assert.AreEqual(p0, r[0].Pin);
+                Assert.AreEqual(p1, r[1].Pin);
+                double[] total = new double[3];
+                unsafe
+                {
+                    for (int i = 0; i < 2; ++i)
+                    {
+                        Reaction ri = r[i];
+                        for (int k = 0; k < 3; ++k) total[k] += ri.Force[k];
+                    }
+                }
+                Assert.AreEqual(0.0, total[0], 1e-9 * down);
+                Assert.AreEqual(0.0, total[1], 1e-9 * down);
+                Assert.AreEqual(4.5 * 9.81 + 10, total[2], 1e-9 * down);
+                Assert.Throws<EmbraArgumentException>(() => w.ConstraintForces(w.DefaultGroup, ConstraintKind.Weld));
+                Assert.Throws<EmbraArgumentException>(() => w.SetLoads(new double[] { 0, double.NaN, 0 }, 0));
+                Assert.AreEqual(new double[] { 0, 0, 0 }, w.GetLoads(0, 1));
+            }
+        }
+    }
+
     public class ErrorTests
     {
         static World Square()

@@ -206,6 +206,13 @@ struct GroupConflict {
   int64_t particles = 0;  // particles where their forces point more than 120 degrees apart
 };
 
+/// The force a pin exerts on its particle after the last step (World::reactions).
+struct Reaction {
+  Id pin;
+  int32_t particle = 0;
+  Vec3 force = Vec3::Zero();  // N
+};
+
 struct StepReport {
   int64_t frame = 0;            // frames stepped since creation
   double time = 0.0;            // simulated seconds
@@ -523,6 +530,10 @@ class World {
   void set_clock(int64_t frame, double time);
   void set_positions(int32_t first, std::span<const double> xyz);
   void set_velocities(int32_t first, std::span<const double> xyz);
+  /// Point loads (N, xyz per particle) on particles [first, first + size / 3): forces applied every
+  /// substep beside gravity until changed; 0 by default. Each coordinate finite, |c| <= 1e300.
+  void set_loads(int32_t first, std::span<const double> xyz);
+  const std::vector<Vec3>& loads() const { return load_; }
 
   // --- fields (fields.hpp) -------------------------------------------------------------------
   Id create_field(const FieldDesc& desc);
@@ -545,6 +556,15 @@ class World {
   std::vector<GroupConflict> group_conflicts() const;
   /// The residual of every constraint of `kind` in `group`, in the group's ConstraintArray order.
   std::vector<double> constraint_residuals(Id group, Kind kind) const;
+  // Statics of the last step (solver/statics.cpp): forces from the last substep's multipliers.
+  /// The force of every constraint of `kind` in `group`, -lambda / h^2 of the last substep, in the
+  /// group's ConstraintArray order: for a distance or tether its tension (N, positive pulling the
+  /// ends together). Refused for a weld (three multipliers: its force is a vector).
+  std::vector<double> constraint_forces(Id group, Kind kind) const;
+  /// The force every live pin exerts on its particle (N), pins in slot order. A soft pin: its
+  /// multiplier over h^2. A hard pin: minus the sum of the particle's weight, its point load and
+  /// the forces of every constraint, automatic tether and soft pin on it (the pin holds the rest).
+  std::vector<Reaction> reactions() const;
   const Warning& warning() const { return warning_; }
 
  private:
@@ -614,6 +634,7 @@ class World {
   std::vector<double> w_;         // solver: inverse mass with hard pins as 0
   std::vector<double> radius_;    // contact offset (half the body's thickness)
   std::vector<double> damping_;   // per-particle damping rate (1/s)
+  std::vector<Vec3> load_;        // per-particle point load (N)
   std::vector<double> mu_s_, mu_k_;
   std::vector<int32_t> body_of_;
   std::vector<int32_t> hard_pin_of_;  // pin slot or -1
