@@ -41,6 +41,9 @@ namespace Embra
     /// <summary>EMBRA_CONSTRAINT_*.</summary>
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8 }
 
+    /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2 }
+
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
 
@@ -217,6 +220,21 @@ namespace Embra
         public int Version;
         public int Particle;
         public fixed double Target[3];
+        public double Compliance;
+        public GroupId Group;
+    }
+
+    /// <summary>embra_support_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct SupportDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Particle;
+        public int Support;
+        public int Reserved0;
+        public fixed double Target[3];
+        public fixed double Axis[3];
         public double Compliance;
         public GroupId Group;
     }
@@ -543,6 +561,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraints_add(IntPtr world, ref ConstraintBatchDef def);
         [DllImport(Library, CallingConvention = C)] public static extern PinDef embra_default_pin_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_create(IntPtr world, ref PinDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern SupportDef embra_default_support_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);

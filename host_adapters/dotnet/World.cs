@@ -601,6 +601,28 @@ namespace Embra
 
         // --- pins -------------------------------------------------------------------------------
         /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
+        /// <summary>A frictionless sliding support (embra_support_create): `particle` held on the plane
+        /// through `target` (m) normal to `axis` (PinSupport.Plane) or on the line through it along `axis`
+        /// (PinSupport.Line); axis null = {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
+        public PinId CreateSupport(int particle, double[] target, PinSupport support = PinSupport.Plane, double[] axis = null,
+                                   double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Three(target, "target");
+            if (axis != null) Three(axis, "axis");
+            var def = Native.embra_default_support_def();  // filled while on the stack (fixed buffers), then captured
+            def.Particle = particle;
+            def.Support = (int)support;
+            for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            if (axis != null)
+                for (int i = 0; i < 3; ++i) def.Axis[i] = axis[i];
+            def.Compliance = compliance;
+            def.Group = group;
+            var d = def;
+            var pin = new PinId();
+            Call(w => Native.embra_support_create(w, ref d, out pin));
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");

@@ -454,6 +454,10 @@ static void test_null_world(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_pin_get_particle(NULL, p, &i0));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_collider_get_transform(NULL, k, xyz, q));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_set_loads(NULL, xyz, 0, 1));
+  {
+    const embra_support_def su = embra_default_support_def();
+    REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_support_create(NULL, &su, &po));
+  }
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_loads(NULL, xyz, 3, 0, 1));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_reactions(NULL, NULL, 0, &i0));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w,
@@ -1175,6 +1179,70 @@ static void test_pins(void) {
   GOOD_PIN();
   d.compliance = -1e-3;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_pin_create(W, &d, &out));
+  /* Supports: a known kind, a finite nonzero axis (a plane needs its normal, a line its direction). */
+  {
+    scene s;
+    embra_support_def sd = embra_default_support_def();
+    CHECK(sd.version == EMBRA_SUPPORT_DEF_VERSION && sd.support == EMBRA_PIN_SUPPORT_PLANE);
+    CHECK(sd.axis[0] == 0.0 && sd.axis[1] == 0.0 && sd.axis[2] == 1.0 && sd.compliance == 0.0);
+    CHECK(scene_build(&s));
+    sd.particle = g_ref.cloth; /* a hard support beside the particle's hard pin is fine */
+    CHECK_OK(embra_support_create(s.w, &sd, &out));
+    sd.support = EMBRA_PIN_SUPPORT_LINE;
+    sd.axis[0] = 3.0;
+    sd.particle = g_ref.point;
+    CHECK_OK(embra_support_create(s.w, &sd, &out));
+    CHECK_OK(embra_world_step(s.w));
+    embra_world_destroy(s.w);
+  }
+  {
+    embra_support_def sd;
+#define GOOD_SUPPORT()                \
+  do {                                \
+    sd = embra_default_support_def(); \
+    sd.particle = g_ref.point;        \
+  } while (0)
+    GOOD_SUPPORT();
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_support_create(W, NULL, &out));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", embra_support_create(W, &sd, NULL));
+    sd.version = 2;
+    REFUSED(EMBRA_ERROR_VERSION, "version", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.particle = g_ref.n;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.support = 3;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
+    sd.support = -1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.compliance = -1.0;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.group = g_ref.g_dead;
+    REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_support_create(W, &sd, &out));
+    for (k = EMBRA_PIN_SUPPORT_PLANE; k <= EMBRA_PIN_SUPPORT_LINE; ++k) {
+      GOOD_SUPPORT();
+      sd.support = k;
+      sd.axis[2] = 0.0;
+      CAPI_CONTEXT("support %d, axis 0", k);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis is zero", embra_support_create(W, &sd, &out));
+      sd.axis[1] = 1e-320; /* denormal: its length does not normalise */
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis is zero", embra_support_create(W, &sd, &out));
+      for (i = 0; i < 3; ++i) {
+        GOOD_SUPPORT();
+        sd.support = k;
+        sd.axis[i % 3] = bad_value(i);
+        CAPI_CONTEXT("support %d, axis = %s", k, bad_name(i));
+        REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis", embra_support_create(W, &sd, &out));
+        GOOD_SUPPORT();
+        sd.target[i % 3] = bad_value(i);
+        REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "target", embra_support_create(W, &sd, &out));
+      }
+    }
+#undef GOOD_SUPPORT
+  }
+  CAPI_CONTEXT("pins");
   GOOD_PIN();
   d.compliance = 1e-3;
   d.group = g_ref.g_dead;

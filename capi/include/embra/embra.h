@@ -464,6 +464,37 @@ typedef struct embra_pin_def {
 EMBRA_API embra_pin_def embra_default_pin_def(void);
 /* A particle takes at most one hard pin. */
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
+/* Sliding supports: a pin that holds its particle on a plane or a line through the target, and
+ * lets it slide along it, frictionless. A per-axis anchor (a roller) is one of them: one
+ * coordinate held is a plane with that axis as its normal ({0, 0, 1}: z held, x and y free), two
+ * held a line along the third. A support is a pin (an embra_pin_id: embra_pin_destroy,
+ * embra_pin_set_target, embra_world_get_pins and the scene's "pins" take it), projected in its
+ * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
+ * the plane or across the line. */
+enum {
+  EMBRA_PIN_SUPPORT_POINT = 0, /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1, /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2   /* on the line through the target, along `axis` */
+};
+
+#define EMBRA_SUPPORT_DEF_VERSION 1
+typedef struct embra_support_def {
+  int32_t version;  /* EMBRA_SUPPORT_DEF_VERSION */
+  int32_t particle; /* world particle index */
+  int32_t support;  /* EMBRA_PIN_SUPPORT_*; default EMBRA_PIN_SUPPORT_PLANE */
+  int32_t reserved0;
+  double target[3];     /* m: a point of the plane or line */
+  double axis[3];       /* the plane's normal or the line's direction: finite, of any nonzero length
+                           (kept as a unit vector); default {0, 0, 1} */
+  double compliance;    /* 0 (default) = hard (projected with compliance 0); > 0: m/N */
+  embra_group_id group; /* its group; {0,0} = default group */
+} embra_support_def;
+
+EMBRA_API embra_support_def embra_default_support_def(void);
+/* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
+ * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
+ * (or one too short to normalise), a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The
@@ -660,8 +691,9 @@ typedef struct embra_reaction {
   embra_pin_id pin;
   int32_t particle; /* the pinned particle */
   int32_t reserved0;
-  double force[3]; /* N: the force the pin exerts on its particle. A soft pin: its multiplier over
-                      h^2. A hard pin: minus the particle's weight (gravity / inverse mass; none
+  double force[3]; /* N: the force the pin exerts on its particle. A soft pin or a sliding support
+                      (normal to its plane, across its line): its multiplier over
+                      h^2. A hard point pin: minus the particle's weight (gravity / inverse mass; none
                       for an immovable particle), its point load and the forces on it of every
                       constraint and soft pin (and automatic tether, when realign_passes >= 1:
                       without realignment they keep no multiplier). Fields (wind, pressure, surface

@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <new>
@@ -478,6 +479,10 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"friction_static", &PanelMeshDesc::friction_static},
                                     Row{"friction_dynamic", &PanelMeshDesc::friction_dynamic},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
+
+/// The pin supports' names in the scene format, by PinSupport.
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line"};
+static_assert(std::size(kPinSupportNames) == kPinSupportCount);
 
 /// The panel pins' names in the scene format, by PanelPins.
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
@@ -1185,6 +1190,10 @@ class Builder {
       d.particle = particles[i];
       d.target = w.positions()[particles[i]];
       read_rows(kPinRows, p, d);
+      if (p.contains("support"))  // the schema has checked it is one of kPinSupportNames
+        for (int k = 0; k < kPinSupportCount; ++k)
+          if (p["support"] == kPinSupportNames[k]) d.support = static_cast<PinSupport>(k);
+      if (p.contains("axis")) d.axis = vec3(p["axis"]);
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1473,7 +1482,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   // (creation order, which a reused slot breaks): a loaded scene lists them in that order again.
   std::vector<uint32_t> pin_order;
   for (uint32_t i = 0; i < w.pins().size(); ++i)
-    if (w.pins()[i].alive && w.pins()[i].compliance == 0.0) pin_order.push_back(i);
+    if (w.pins()[i].alive && w.pins()[i].kinematic()) pin_order.push_back(i);
   for (uint32_t slot : slots)
     for (int32_t i : w.groups()[slot].soft_pins) pin_order.push_back(static_cast<uint32_t>(i));
   for (uint32_t i : pin_order) {
@@ -1481,7 +1490,11 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     pin_name[i] = name_for(meta.pin_names, i, "pin", used_pins);
     json j = {{"name", pin_name[i]}, {"particle", p.particle}};
     write_rows(kPinRows, PinDesc{p.particle, p.target, p.compliance, p.group}, j);
-    if (p.compliance > 0.0) j["group"] = group_name(p.group);
+    if (!p.kinematic()) j["group"] = group_name(p.group);
+    if (p.support != PinSupport::point) {
+      j["support"] = kPinSupportNames[static_cast<int>(p.support)];
+      j["axis"] = vec_json(p.axis);
+    }
     pins.push_back(j);
   }
   doc["pins"] = pins;

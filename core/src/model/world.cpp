@@ -1115,8 +1115,19 @@ Id World::create_pin(const PinDesc& desc) {
   check_particle(desc.particle, "pin particle");
   for (int k = 0; k < 3; ++k) check_finite(desc.target[k], "pin target");
   check_non_negative(desc.compliance, "pin compliance");
+  const int32_t support = static_cast<int32_t>(desc.support);
+  if (support < 0 || support >= kPinSupportCount)
+    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1) or line (2)");
+  for (int k = 0; k < 3; ++k) check_finite(desc.axis[k], "pin axis");
+  const double axis_length = desc.axis.norm();
+  if (desc.support != PinSupport::point &&
+      !(axis_length > 0.0 && std::isfinite(axis_length) && (desc.axis / axis_length).allFinite()))
+    invalid(std::string("pin axis is zero (or too short to normalise): a ") +
+            (desc.support == PinSupport::plane ? "plane" : "line") + " support needs a direction (its " +
+            (desc.support == PinSupport::plane ? "normal" : "line") + ")");
+  const bool kinematic = desc.compliance == 0.0 && desc.support == PinSupport::point;
   Id gid;
-  if (desc.compliance == 0.0) {
+  if (kinematic) {
     if (hard_pin_of_[desc.particle] >= 0)
       invalid("particle " + std::to_string(desc.particle) + " already has a hard pin");
   } else {
@@ -1127,9 +1138,11 @@ Id World::create_pin(const PinDesc& desc) {
   p.target = desc.target;
   p.compliance = desc.compliance;
   p.group = gid;
+  p.support = desc.support;
+  if (desc.support != PinSupport::point) p.axis = desc.axis / axis_length;
   const Id id = slots::create(pins_, p);
   const int32_t slot = static_cast<int32_t>(id.index);
-  if (desc.compliance == 0.0) {
+  if (kinematic) {
     hard_pin_of_[desc.particle] = slot;
     w_[desc.particle] = 0.0;
     solver_dirty_ = true;  // automatic tethers attach to hard pins
@@ -1147,7 +1160,7 @@ const Pin& World::pin(Id id) const {
 
 void World::destroy_pin(Id id) {
   const Pin& p = pin(id);
-  if (p.compliance == 0.0) {
+  if (p.kinematic()) {
     hard_pin_of_[p.particle] = -1;
     w_[p.particle] = inv_mass_[p.particle];
     solver_dirty_ = true;

@@ -75,8 +75,8 @@ std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
       c.group = gid;
       c.pin = Id{static_cast<uint32_t>(pi), p.generation};
       c.particles[0] = p.particle;
-      c.residual = (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm();
-      c.violation = (x_[p.particle] - p.target).norm();
+      c.residual = (p.held(x_[p.particle] - p.target) + p.compliance * inv_h2 * p.lambda).norm();
+      c.violation = p.held(x_[p.particle] - p.target).norm();
       c.force = p.lambda.norm() * inv_h2;
       all.push_back(c);
     }

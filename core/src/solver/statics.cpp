@@ -36,7 +36,7 @@ std::vector<Reaction> World::reactions() const {
   const double inv_h2 = 1.0 / (h * h);
   std::vector<Vec3> f(x_.size(), Vec3::Zero());
   bool any_hard = false;
-  for (const Pin& p : pins_) any_hard = any_hard || (p.alive && p.compliance == 0.0);
+  for (const Pin& p : pins_) any_hard = any_hard || (p.alive && p.kinematic());
   // Every constraint's force on every particle (only a hard-pinned particle's sum is read).
   if (any_hard)
     for (int32_t slot : order_) {
@@ -57,7 +57,7 @@ std::vector<Reaction> World::reactions() const {
     Reaction r;
     r.pin = Id{static_cast<uint32_t>(i), p.generation};
     r.particle = p.particle;
-    if (p.compliance > 0.0) {
+    if (!p.kinematic()) {
       r.force = inv_h2 * p.lambda;
     } else {
       const double inv_mass = inv_mass_[p.particle];

@@ -28,6 +28,7 @@ const SHAPES = capi.COLLIDER_NAMES;
 const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
+const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
 const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
 const SOLVE_UNTIL = capi.SOLVE_UNTIL_NAMES;
 const SOLVE_OUTCOMES = Object.freeze(Object.fromEntries(Object.entries(capi.SOLVE_NAMES).map(([k, v]) => [v, k])));
@@ -670,6 +671,27 @@ class World {
     if (o.size) throw new TypeError(`createPin: unknown option '${o.keys().next().value}'`);
     const pin = {};
     this.#call('embra_pin_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
+  /**
+   * A frictionless sliding support (embra_support_create): `particle` held on the plane through
+   * `target` (m) normal to `axis` (support 'plane', the default) or on the line through it along
+   * `axis` ('line'). Options: support, axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
+   * Returns its PinId.
+   */
+  createSupport(particle, target, opts) {
+    const o = options(opts, 'createSupport options');
+    const d = lib.embra_default_support_def();
+    d.particle = buf.int32(particle, 'particle');
+    d.target = buf.fixed(target, 3, 'target');
+    if (o.has('support')) d.support = enumValue(take(o, 'support'), PIN_SUPPORTS, 'support');
+    if (o.has('axis')) d.axis = buf.fixed(take(o, 'axis'), 3, 'axis');
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createSupport: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_support_create', d, pin);
     return new PinId(pin.index, pin.generation);
   }
 

@@ -23,6 +23,7 @@ BODY_DEF_VERSION = 1
 CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
+SUPPORT_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
 SOLVE_DEF_VERSION = 1
 PANEL_MESH_DEF_VERSION = 1
@@ -62,6 +63,11 @@ CONSTRAINT_TETHER = 5
 CONSTRAINT_PLANARITY = 6
 CONSTRAINT_PLANE_OFFSET = 7
 CONSTRAINT_EQUAL_LENGTH = 8
+
+# --- EMBRA_PIN_SUPPORT_* ---
+PIN_SUPPORT_POINT = 0
+PIN_SUPPORT_PLANE = 1
+PIN_SUPPORT_LINE = 2
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -104,6 +110,7 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
@@ -272,6 +279,20 @@ class PinDef(_Struct):
         ("version", c_int32),
         ("particle", c_int32),
         ("target", c_double * 3),
+        ("compliance", c_double),
+        ("group", GroupId),
+    ]
+
+
+class SupportDef(_Struct):
+    """embra_support_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("particle", c_int32),
+        ("support", c_int32),
+        ("reserved0", c_int32),
+        ("target", c_double * 3),
+        ("axis", c_double * 3),
         ("compliance", c_double),
         ("group", GroupId),
     ]
@@ -583,6 +604,8 @@ PROTOTYPES = {
     "embra_constraints_add": (c_int32, [c_void_p, POINTER(ConstraintBatchDef)]),
     "embra_default_pin_def": (PinDef, []),
     "embra_pin_create": (c_int32, [c_void_p, POINTER(PinDef), POINTER(PinId)]),
+    "embra_default_support_def": (SupportDef, []),
+    "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),

@@ -27,6 +27,7 @@ SHAPES = dict(_capi.COLLIDER_NAMES)
 KINDS = dict(_capi.CONSTRAINT_NAMES)
 GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
+PIN_SUPPORTS = dict(_capi.PIN_SUPPORT_NAMES)
 PANEL_METRICS = dict(_capi.PANEL_METRIC_NAMES)
 CUTS_FORMATS = dict(_capi.CUTS_NAMES)
 SOLVE_UNTIL = dict(_capi.SOLVE_UNTIL_NAMES)
@@ -560,6 +561,21 @@ class World:
         d.group = _id(group, GroupId, "group")
         pin = PinId()
         self._call("embra_pin_create", byref(d), byref(pin))
+        return pin
+
+    def create_support(self, particle, target, support="plane", axis=(0.0, 0.0, 1.0), compliance=0.0, group=None):
+        """A frictionless sliding support (embra_support_create): `particle` held on the plane through
+        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line");
+        compliance 0 = hard, > 0 m/N; projected in `group`. Returns its PinId."""
+        d = lib.embra_default_support_def()
+        d.particle = buf.int32(particle, "particle")
+        d.support = _enum(support, PIN_SUPPORTS, "support")
+        d.target = buf.d3(target, "target")
+        d.axis = buf.d3(axis, "axis")
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        pin = PinId()
+        self._call("embra_support_create", byref(d), byref(pin))
         return pin
 
     def destroy_pin(self, pin):

@@ -421,6 +421,42 @@ namespace Embra.Tests
                 Assert.AreEqual(new double[] { 0, 0, 0 }, w.GetLoads(0, 1));
             }
         }
+
+        /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
+        /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
+        [Test]
+        public void PlaneSupportSlidesAtGSinTheta()
+        {
+            double th = Math.PI / 6;
+            var n = new[] { -Math.Sin(th), 0.0, Math.Cos(th) };
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0, 0 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Plane, new[] { 2 * n[0], 2 * n[1], 2 * n[2] });
+                w.Step(30);
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                double along = -(p[0] * Math.Cos(th) + p[2] * Math.Sin(th));
+                double exact = 9.81 * Math.Sin(th) * h * h * steps * (steps + 1) / 2;
+                Assert.AreEqual(exact, along, 1e-12 * exact);
+                var r = w.Reactions();
+                Assert.AreEqual(pin, r[0].Pin);
+                Reaction r0 = r[0];
+                unsafe
+                {
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(2 * 9.81 * Math.Cos(th) * n[k], r0.Force[k], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Line, new double[] { 0, 0, 0 }));
+            }
+        }
     }
 
     public class ErrorTests

@@ -128,6 +128,27 @@ test('statics: two hard bars at 45 degrees carry a load, the pins react with eve
   w.close();
 });
 
+test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
+  const th = Math.PI / 6;
+  const n = [-Math.sin(th), 0, Math.cos(th)];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0, 0, 0]], { generate: 0, masses: [2] });
+  const pin = w.createSupport(0, [0, 0, 0], { support: 'plane', axis: n.map((c) => 2 * c) });
+  w.step(30);
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  const along = -(p[0] * Math.cos(th) + p[2] * Math.sin(th));
+  const exact = 9.81 * Math.sin(th) * h * h * steps * (steps + 1) / 2;
+  assert.ok(Math.abs(along - exact) < 1e-12 * exact);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  for (let k = 0; k < 3; k++) assert.ok(Math.abs(r[0].force[k] - 2 * 9.81 * Math.cos(th) * n[k]) < 1e-9 * 9.81);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'line', axis: [0, 0, 0] }), embra.EmbraError);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'curve' }));
+  w.close();
+});
+
 test('bulk rest and compliance arrays', () => {
   const w = new embra.World({ gravity: [0, 0, 0], iterations: 50 });
   w.createBody([[0, 0, 0], [1, 0, 0], [2, 0, 0]], { generate: 0, mass: 3.0 });

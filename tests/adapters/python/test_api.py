@@ -117,6 +117,31 @@ def test_statics_two_bar_truss_forces_and_reactions():
         assert list(flat(w.loads()))[:3] == [0.0, 0.0, 0.0]
 
 
+def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
+    """A particle on a frictionless plane inclined at 30 degrees: s_n = g sin(theta) h^2 n (n + 1) / 2
+    down the slope after n substeps (symplectic Euler, the plane projected exactly), and the
+    support's reaction is m g cos(theta) along the normal."""
+    th = math.pi / 6
+    n = (-math.sin(th), 0.0, math.cos(th))
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.0, 0.0, 0.0)], generate=0, masses=[2.0])
+        pin = w.create_support(0, (0.0, 0.0, 0.0), "plane", axis=[2 * c for c in n])
+        w.step(30)
+        steps, h = 300, (1.0 / 60.0) / 10
+        p = list(flat(w.positions()))
+        along = -(p[0] * math.cos(th) + p[2] * math.sin(th))
+        exact = 9.81 * math.sin(th) * h * h * steps * (steps + 1) / 2
+        assert abs(along - exact) < 1e-12 * exact
+        r = w.reactions()
+        assert r[0]["pin"] == pin
+        for k in range(3):
+            assert abs(r[0]["force"][k] - 2.0 * 9.81 * math.cos(th) * n[k]) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "line", axis=(0.0, 0.0, 0.0))
+        with pytest.raises(ValueError):
+            w.create_support(0, (0.0, 0.0, 0.0), "curve")
+
+
 def test_groups_bulk_constraints_and_reports():
     """A chain of 5 links added in bulk, hard, hanging from a pin: every link at its rest length."""
     xyz = [(0.1 * i, 0.0, 0.0) for i in range(6)]
@@ -321,7 +346,8 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics,
                "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
-               "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction}
+               "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
+               "embra_support_def": _capi.SupportDef}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
     assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",
