@@ -44,6 +44,7 @@ SCHEMA_ENUMS: List[Tuple[Tuple[str, ...], str]] = [
     (("definitions", "panel_mesh", "then", "properties", "pins", "enum"), "PANEL_PINS"),
     (("definitions", "constraint_batch", "properties", "kind", "enum"), "CONSTRAINT"),
     (("definitions", "collider", "properties", "shape", "enum"), "COLLIDER"),
+    (("definitions", "pin", "properties", "support", "enum"), "PIN_SUPPORT"),
 ]
 
 # The C enums the C ABI casts to a core enum: group prefix -> (core enum, core count constant or
@@ -53,6 +54,7 @@ CORE_ENUMS: Dict[str, Tuple[str, Optional[str]]] = {
     "CONSTRAINT": ("embra::Kind", "embra::kKindCount"),
     "COLLIDER": ("embra::ColliderShape", "embra::kColliderShapeCount"),
     "PANEL_PINS": ("embra::PanelPins", None),
+    "PIN_SUPPORT": ("embra::PinSupport", "embra::kPinSupportCount"),
     "PANEL_METRIC": ("embra::PanelMetric", "embra::kPanelMetricCount"),
     "SOLVE_UNTIL": ("embra::SolveUntil", None),
     "SOLVE": ("embra::SolveOutcome", None),

@@ -33,6 +33,11 @@ static_assert(static_cast<int>(embra::PanelPins::none) == 0, "embra::PanelPins::
 static_assert(static_cast<int>(embra::PanelPins::top_corners) == 1, "embra::PanelPins::top_corners is EMBRA_PANEL_PINS_TOP_CORNERS = 1");
 static_assert(static_cast<int>(embra::PanelPins::top_and_bottom_corners) == 2, "embra::PanelPins::top_and_bottom_corners is EMBRA_PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2");
 
+static_assert(static_cast<int>(embra::PinSupport::point) == 0, "embra::PinSupport::point is EMBRA_PIN_SUPPORT_POINT = 0");
+static_assert(static_cast<int>(embra::PinSupport::plane) == 1, "embra::PinSupport::plane is EMBRA_PIN_SUPPORT_PLANE = 1");
+static_assert(static_cast<int>(embra::PinSupport::line) == 2, "embra::PinSupport::line is EMBRA_PIN_SUPPORT_LINE = 2");
+static_assert(embra::kPinSupportCount == 3, "embra::PinSupport and the 3 EMBRA_PIN_SUPPORT_* values differ");
+
 static_assert(static_cast<int>(embra::PanelMetric::planarity) == 0, "embra::PanelMetric::planarity is EMBRA_PANEL_METRIC_PLANARITY = 0");
 static_assert(static_cast<int>(embra::PanelMetric::thickness) == 1, "embra::PanelMetric::thickness is EMBRA_PANEL_METRIC_THICKNESS = 1");
 static_assert(static_cast<int>(embra::PanelMetric::miter) == 2, "embra::PanelMetric::miter is EMBRA_PANEL_METRIC_MITER = 2");

@@ -1,4 +1,5 @@
-// Pins: hard or soft attachments of a particle to a target.
+// Pins: hard or soft attachments of a particle to a target, and sliding supports (a pin that holds
+// its particle on a plane or a line through the target).
 #include "copy.hpp"
 #include "guard.hpp"
 
@@ -8,6 +9,10 @@ namespace {
 constexpr std::tuple kPinCopies{Copy{&embra_pin_def::particle, &embra::PinDesc::particle},
                                 Copy{&embra_pin_def::target, &embra::PinDesc::target},
                                 Copy{&embra_pin_def::compliance, &embra::PinDesc::compliance}};
+constexpr std::tuple kSupportCopies{Copy{&embra_support_def::particle, &embra::PinDesc::particle},
+                                    Copy{&embra_support_def::target, &embra::PinDesc::target},
+                                    Copy{&embra_support_def::axis, &embra::PinDesc::axis},
+                                    Copy{&embra_support_def::compliance, &embra::PinDesc::compliance}};
 }  // namespace
 
 extern "C" {
@@ -27,6 +32,31 @@ embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embr
     need_version(def->version, EMBRA_PIN_DEF_VERSION, "embra_pin_def");
     embra::PinDesc d;
     to_core(kPinCopies, *def, d);
+    d.group = to_id(def->group);
+    *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
+  });
+}
+
+embra_support_def embra_default_support_def(void) {
+  embra_support_def d{};
+  d.version = EMBRA_SUPPORT_DEF_VERSION;
+  embra::PinDesc core;
+  core.support = embra::PinSupport::plane;
+  to_c(kSupportCopies, core, d);
+  d.support = static_cast<int32_t>(core.support);
+  return d;
+}
+
+embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin) {
+  return guard("embra_support_create", world, [&] {
+    need(def, "def");
+    need(out_pin, "out_pin");
+    need_version(def->version, EMBRA_SUPPORT_DEF_VERSION, "embra_support_def");
+    if (def->support < 0 || def->support >= embra::kPinSupportCount)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "support " + num(def->support) + " is not an EMBRA_PIN_SUPPORT_* value");
+    embra::PinDesc d;
+    to_core(kSupportCopies, *def, d);
+    d.support = static_cast<embra::PinSupport>(def->support);
     d.group = to_id(def->group);
     *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
   });

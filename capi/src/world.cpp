@@ -320,6 +320,42 @@ embra_status embra_group_get_residuals(const embra_world* world, embra_group_id 
   });
 }
 
+embra_status embra_group_get_forces(const embra_world* world, embra_group_id group, int32_t kind, double* out,
+                                    int64_t capacity, int64_t* out_count) {
+  return guard("embra_group_get_forces", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    if (!embra::is_kind(kind))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "kind " + num(kind) + " is not an embra_constraint_kind");
+    const std::vector<double> f = world->world.constraint_forces(to_id(group), static_cast<embra::Kind>(kind));
+    const int64_t n = static_cast<int64_t>(f.size());
+    if (!fits(out, capacity, n, "doubles")) {
+      *out_count = n;
+      return;
+    }
+    std::copy(f.begin(), f.end(), out);
+    *out_count = n;
+  });
+}
+
+embra_status embra_world_get_reactions(const embra_world* world, embra_reaction* out, int32_t capacity,
+                                       int32_t* out_count) {
+  return guard("embra_world_get_reactions", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::Reaction> r = world->world.reactions();
+    const int32_t n = static_cast<int32_t>(r.size());
+    if (!fits(out, capacity, n, "reactions")) {
+      *out_count = n;
+      return;
+    }
+    for (int32_t i = 0; i < n; ++i)
+      out[i] = embra_reaction{
+          from_id<embra_pin_id>(r[i].pin), r[i].particle, 0, {r[i].force.x(), r[i].force.y(), r[i].force.z()}};
+    *out_count = n;
+  });
+}
+
 embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
   return guard("embra_world_get_warning", world, [&] {
     need(out_warning, "out_warning");
@@ -352,6 +388,19 @@ embra_status embra_world_set_velocities(embra_world* world, const double* xyz, i
     need_count(count, "count");
     world->world.set_velocities(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
   });
+}
+
+embra_status embra_world_set_loads(embra_world* world, const double* xyz, int32_t first, int32_t count) {
+  return guard("embra_world_set_loads", world, [&] {
+    need_count(count, "count");
+    world->world.set_loads(first, view(xyz, 3 * static_cast<int64_t>(count), "xyz"));
+  });
+}
+
+embra_status embra_world_get_loads(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                   int32_t count) {
+  return guard("embra_world_get_loads", world,
+               [&] { read_particles(world->world, world->world.loads(), capacity, first, count, out_xyz); });
 }
 
 }  // extern "C"

@@ -9,11 +9,11 @@
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
- * on), DIR/metrics.jsonl (one JSON object per frame) and DIR/frame_NNNNN.obj every K frames; with
- * panel meshes also their cut lists and, beside each OBJ, the per-vertex error fields
- * (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
- * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses. A DIR
- * that holds anything is refused (exit 1) unless --force, which writes into it.
+ * on), DIR/forces.json (reactions at the pins and member forces, N: write_forces), DIR/metrics.jsonl (one JSON object
+ * per frame) and DIR/frame_NNNNN.obj every K frames; with panel meshes also their cut lists and, beside each OBJ, the
+ * per-vertex error fields (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
+ * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses. A DIR that holds anything
+ * is refused (exit 1) unless --force, which writes into it.
  * --threads T steps on T threads (0: one per core; default: the scene's solver.threads): the same
  * bits at any T, and final.json keeps the scene's own setting. --until settled|tolerance steps with
  * embra_world_solve (N frames at most, 1000 by default) and prints why it stopped; it writes the
@@ -75,7 +75,8 @@ static int help(void) {
       "\n"
       "validate  loads SCENE.json (schemas/scene.schema.json) and builds its world; exit 0 if valid.\n"
       "run       steps the scene N frames (default: its own \"frames\"; 0: load and save only) and writes\n"
-      "          DIR/final.json, DIR/metrics.jsonl, DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
+      "          DIR/final.json, DIR/forces.json (pin reactions and member forces, N), DIR/metrics.jsonl,\n"
+      "          DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
       "          --threads T steps on T threads (0: one per core; default: the scene's solver.threads);\n"
       "          the results are the same bits at any T, and final.json keeps the scene's own setting.\n"
       "          --until settled|tolerance steps until the world is at rest (and, with tolerance, every\n"
@@ -610,6 +611,63 @@ static void run_index_frame(run_index* x, embra_world* world, long frame, const 
   fputs("]}", x->frames);
 }
 
+/* Writes DIR/forces.json: the last step's statics (embra_world_get_reactions, embra_group_get_forces):
+ * {"format": "embra-forces", "version": 1, "units": {"force": "N"},
+ *  "reactions": [{"pin": [index, generation], "particle": p, "force": [x, y, z]}, ...],
+ *  "reaction_sum": [x, y, z],
+ *  "groups": [{"group": [index, generation], "distance": [tension, ...], "tether": [...],
+ *              "equal_length": [...]}, ...]}
+ * a group's kinds listed when it holds any, each constraint's tension (N, positive pulling its ends
+ * together) in the order the constraints were added. */
+static int write_forces(const char* path, const embra_world* world) {
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    return -1;
+  }
+  int rc = 0;
+  fputs("{\"format\":\"embra-forces\",\"version\":1,\"units\":{\"force\":\"N\"},\"reactions\":[", f);
+  int32_t n = 0;
+  double sum[3] = {0.0, 0.0, 0.0};
+  if (embra_world_get_reactions(world, NULL, 0, &n) != EMBRA_OK) rc = -1;
+  if (rc == 0 && n > 0) {
+    embra_reaction* r = malloc(sizeof *r * (size_t)n);
+    if (!r || embra_world_get_reactions(world, r, n, &n) != EMBRA_OK) rc = -1;
+    for (int32_t i = 0; rc == 0 && i < n; ++i) {
+      fprintf(f, "%s{\"pin\":[%u,%u],\"particle\":%d,\"force\":[%.17g,%.17g,%.17g]}", i ? "," : "", r[i].pin.index,
+              r[i].pin.generation, r[i].particle, r[i].force[0], r[i].force[1], r[i].force[2]);
+      for (int k = 0; k < 3; ++k) sum[k] += r[i].force[k];
+    }
+    free(r);
+  }
+  fprintf(f, "],\"reaction_sum\":[%.17g,%.17g,%.17g],\"groups\":[", sum[0], sum[1], sum[2]);
+  int32_t groups = 0;
+  if (rc == 0 && embra_world_get_groups(world, NULL, 0, &groups) != EMBRA_OK) rc = -1;
+  embra_group_id* ids = groups > 0 ? malloc(sizeof *ids * (size_t)groups) : NULL;
+  if (rc == 0 && groups > 0 && (!ids || embra_world_get_groups(world, ids, groups, &groups) != EMBRA_OK)) rc = -1;
+  static const int32_t kinds[] = {EMBRA_CONSTRAINT_DISTANCE, EMBRA_CONSTRAINT_TETHER, EMBRA_CONSTRAINT_EQUAL_LENGTH};
+  for (int32_t g = 0; rc == 0 && g < groups; ++g) {
+    fprintf(f, "%s{\"group\":[%u,%u]", g ? "," : "", ids[g].index, ids[g].generation);
+    for (size_t k = 0; rc == 0 && k < sizeof kinds / sizeof kinds[0]; ++k) {
+      int64_t count = 0;
+      if (embra_group_get_forces(world, ids[g], kinds[k], NULL, 0, &count) != EMBRA_OK) rc = -1;
+      if (rc != 0 || count == 0) continue;
+      double* v = malloc(sizeof *v * (size_t)count);
+      if (!v || embra_group_get_forces(world, ids[g], kinds[k], v, count, &count) != EMBRA_OK) rc = -1;
+      fprintf(f, ",\"%s\":[", embra_residual_name(kinds[k]));
+      for (int64_t i = 0; rc == 0 && i < count; ++i) fprintf(f, "%s%.17g", i ? "," : "", v[i]);
+      fputc(']', f);
+      free(v);
+    }
+    fputc('}', f);
+  }
+  free(ids);
+  fputs("]}\n", f);
+  if (fclose(f) != 0) rc = -1;
+  if (rc != 0) fprintf(stderr, "embra: cannot write %s: %s\n", path, embra_last_error_message());
+  return rc;
+}
+
 /* Writes DIR/index.json and frees the index. */
 static int run_index_write(run_index* x, const char* dir) {
   fclose(x->files);
@@ -917,7 +975,10 @@ static int cmd_run(int argc, char** argv) {
   snprintf(path, sizeof path, "%s/final.errors.json", out);
   if (panel_count > 0 && write_error_fields(path, world, panel_bodies, panel_count, (long)r.frame) != 0 && rc == 0)
     rc = EXIT_INVALID;
+  snprintf(path, sizeof path, "%s/forces.json", out);
+  if (write_forces(path, world) != 0 && rc == 0) rc = EXIT_INVALID;
   run_index_file(&index, "final.json");
+  run_index_file(&index, "forces.json");
   run_index_file(&index, "metrics.jsonl");
   run_index_file(&index, "final.obj");
   if (panel_count > 0) run_index_file(&index, "final.errors.json");
@@ -948,7 +1009,7 @@ static int cmd_run(int argc, char** argv) {
     print_solve_outcome(&solved, world);
     if (solved.outcome != EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE) rc = EXIT_UNSETTLED;
   }
-  printf("%-18s %s/final.json, %s/metrics.jsonl\n", "wrote", out, out);
+  printf("%-18s %s/final.json, %s/forces.json, %s/metrics.jsonl\n", "wrote", out, out, out);
   if (panel_count > 0) {
     if (write_cuts(world, panel_bodies, panel_count, out) != 0 && rc == 0) rc = EXIT_INVALID;
     if (panel_count == 1)

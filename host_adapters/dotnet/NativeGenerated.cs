@@ -41,6 +41,9 @@ namespace Embra
     /// <summary>EMBRA_CONSTRAINT_*.</summary>
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8 }
 
+    /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2 }
+
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
 
@@ -221,6 +224,21 @@ namespace Embra
         public GroupId Group;
     }
 
+    /// <summary>embra_support_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct SupportDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Particle;
+        public int Support;
+        public int Reserved0;
+        public fixed double Target[3];
+        public fixed double Axis[3];
+        public double Compliance;
+        public GroupId Group;
+    }
+
     /// <summary>embra_collider_def.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct ColliderDef
@@ -291,6 +309,16 @@ namespace Embra
         public GroupId B;
         public double Force;
         public long Particles;
+    }
+
+    /// <summary>embra_reaction.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct Reaction
+    {
+        public PinId Pin;
+        public int Particle;
+        public int Reserved0;
+        public fixed double Force[3];
     }
 
     /// <summary>embra_group_report.</summary>
@@ -543,6 +571,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_remove(IntPtr world, GroupId group, int kind, int index);
         [DllImport(Library, CallingConvention = C)] public static extern PinDef embra_default_pin_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_create(IntPtr world, ref PinDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern SupportDef embra_default_support_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);
@@ -561,6 +591,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_worst_constraints(IntPtr world, [Out] ConstraintResidual[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_group_conflicts(IntPtr world, [Out] GroupConflict[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_residuals(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_forces(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_reactions(IntPtr world, [Out] Reaction[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);
@@ -569,6 +601,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_velocities(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_positions(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_velocities(IntPtr world, double[] xyz, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_loads(IntPtr world, double[] xyz, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_loads(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_export_obj(IntPtr world, [Out] byte[] buffer, long capacity, out long length);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_write_obj(IntPtr world, byte[] path);

@@ -676,6 +676,28 @@ namespace Embra
 
         // --- pins -------------------------------------------------------------------------------
         /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
+        /// <summary>A frictionless sliding support (embra_support_create): `particle` held on the plane
+        /// through `target` (m) normal to `axis` (PinSupport.Plane) or on the line through it along `axis`
+        /// (PinSupport.Line); axis null = {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
+        public PinId CreateSupport(int particle, double[] target, PinSupport support = PinSupport.Plane, double[] axis = null,
+                                   double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Three(target, "target");
+            if (axis != null) Three(axis, "axis");
+            var def = Native.embra_default_support_def();  // filled while on the stack (fixed buffers), then captured
+            def.Particle = particle;
+            def.Support = (int)support;
+            for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            if (axis != null)
+                for (int i = 0; i < 3; ++i) def.Axis[i] = axis[i];
+            def.Compliance = compliance;
+            def.Group = group;
+            var d = def;
+            var pin = new PinId();
+            Call(w => Native.embra_support_create(w, ref d, out pin));
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");
@@ -888,6 +910,23 @@ namespace Embra
             return res;
         }
 
+        /// <summary>The force of every constraint of `kind` in `group` after the last step, in the order
+        /// they were added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or
+        /// tether its tension in N (positive pulling its ends together).</summary>
+        public double[] ConstraintForces(GroupId group, ConstraintKind kind)
+        {
+            long n = 0;
+            Call(w => Native.embra_group_get_forces(w, group, (int)kind, null, 0, out n));
+            var res = new double[n];
+            Call(w => Native.embra_group_get_forces(w, group, (int)kind, res, res.Length, out n));
+            return res;
+        }
+
+        /// <summary>The force (N) every live pin exerts on its particle after the last step
+        /// (embra_world_get_reactions), pins in creation-slot order: at a static rest they sum to minus
+        /// the weights and point loads.</summary>
+        public Reaction[] Reactions() { return Ids<Reaction>(Native.embra_world_get_reactions); }
+
         public StepReport Report
         {
             get { var r = new StepReport(); Call(w => Native.embra_world_get_report(w, out r)); return r; }
@@ -931,6 +970,20 @@ namespace Embra
         {
             Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
             Call(w => Native.embra_world_set_velocities(w, xyz, first, xyz.Length / 3));
+        }
+
+        /// <summary>Point loads (N) of particles [first, first + count), as GetPositions.</summary>
+        public double[] GetLoads(int first = 0, int count = -1, double[] into = null)
+        {
+            return Read(Native.embra_world_get_loads, first, count, into);
+        }
+
+        /// <summary>Sets point loads (N, xyz per particle) on particles [first, first + xyz.Length / 3):
+        /// forces applied every substep beside gravity until set again.</summary>
+        public void SetLoads(double[] xyz, int first = 0)
+        {
+            Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
+            Call(w => Native.embra_world_set_loads(w, xyz, first, xyz.Length / 3));
         }
 
         // --- JSON scenes ------------------------------------------------------------------------

@@ -242,7 +242,7 @@ typedef struct snapshot {
   embra_group_report groups[4];
   double pin_targets[2][3];
   int32_t body_first[5], body_count[5];
-  double x[3 * MAX_PARTICLES], v[3 * MAX_PARTICLES];
+  double x[3 * MAX_PARTICLES], v[3 * MAX_PARTICLES], loads[3 * MAX_PARTICLES];
   int ok;
 } snapshot;
 
@@ -262,6 +262,7 @@ static void snapshot_take(const scene* s, snapshot* out) {
     ok &= embra_body_get_particles(s->w, bodies[i], &out->body_first[i], &out->body_count[i]) == EMBRA_OK;
   ok &= embra_world_get_positions(s->w, out->x, 3 * MAX_PARTICLES, 0, out->counts.particles) == EMBRA_OK;
   ok &= embra_world_get_velocities(s->w, out->v, 3 * MAX_PARTICLES, 0, out->counts.particles) == EMBRA_OK;
+  ok &= embra_world_get_loads(s->w, out->loads, 3 * MAX_PARTICLES, 0, out->counts.particles) == EMBRA_OK;
   out->ok = ok;
 }
 
@@ -452,6 +453,15 @@ static void test_null_world(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_colliders(NULL, NULL, 0, &i0));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_pin_get_particle(NULL, p, &i0));
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_collider_get_transform(NULL, k, xyz, q));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_set_loads(NULL, xyz, 0, 1));
+  {
+    const embra_support_def su = embra_default_support_def();
+    REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_support_create(NULL, &su, &po));
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_loads(NULL, xyz, 3, 0, 1));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w, embra_world_get_reactions(NULL, NULL, 0, &i0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, w,
+                   embra_group_get_forces(NULL, g, EMBRA_CONSTRAINT_DISTANCE, NULL, 0, &counts.constraints));
 }
 
 /* embra_world_create: every refusal leaves *out_world NULL. */
@@ -1169,6 +1179,70 @@ static void test_pins(void) {
   GOOD_PIN();
   d.compliance = -1e-3;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_pin_create(W, &d, &out));
+  /* Supports: a known kind, a finite nonzero axis (a plane needs its normal, a line its direction). */
+  {
+    scene s;
+    embra_support_def sd = embra_default_support_def();
+    CHECK(sd.version == EMBRA_SUPPORT_DEF_VERSION && sd.support == EMBRA_PIN_SUPPORT_PLANE);
+    CHECK(sd.axis[0] == 0.0 && sd.axis[1] == 0.0 && sd.axis[2] == 1.0 && sd.compliance == 0.0);
+    CHECK(scene_build(&s));
+    sd.particle = g_ref.cloth; /* a hard support beside the particle's hard pin is fine */
+    CHECK_OK(embra_support_create(s.w, &sd, &out));
+    sd.support = EMBRA_PIN_SUPPORT_LINE;
+    sd.axis[0] = 3.0;
+    sd.particle = g_ref.point;
+    CHECK_OK(embra_support_create(s.w, &sd, &out));
+    CHECK_OK(embra_world_step(s.w));
+    embra_world_destroy(s.w);
+  }
+  {
+    embra_support_def sd;
+#define GOOD_SUPPORT()                \
+  do {                                \
+    sd = embra_default_support_def(); \
+    sd.particle = g_ref.point;        \
+  } while (0)
+    GOOD_SUPPORT();
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_support_create(W, NULL, &out));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", embra_support_create(W, &sd, NULL));
+    sd.version = 2;
+    REFUSED(EMBRA_ERROR_VERSION, "version", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.particle = g_ref.n;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.support = 3;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
+    sd.support = -1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.compliance = -1.0;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_support_create(W, &sd, &out));
+    GOOD_SUPPORT();
+    sd.group = g_ref.g_dead;
+    REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_support_create(W, &sd, &out));
+    for (k = EMBRA_PIN_SUPPORT_PLANE; k <= EMBRA_PIN_SUPPORT_LINE; ++k) {
+      GOOD_SUPPORT();
+      sd.support = k;
+      sd.axis[2] = 0.0;
+      CAPI_CONTEXT("support %d, axis 0", k);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis is zero", embra_support_create(W, &sd, &out));
+      sd.axis[1] = 1e-320; /* denormal: its length does not normalise */
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis is zero", embra_support_create(W, &sd, &out));
+      for (i = 0; i < 3; ++i) {
+        GOOD_SUPPORT();
+        sd.support = k;
+        sd.axis[i % 3] = bad_value(i);
+        CAPI_CONTEXT("support %d, axis = %s", k, bad_name(i));
+        REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "axis", embra_support_create(W, &sd, &out));
+        GOOD_SUPPORT();
+        sd.target[i % 3] = bad_value(i);
+        REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "target", embra_support_create(W, &sd, &out));
+      }
+    }
+#undef GOOD_SUPPORT
+  }
+  CAPI_CONTEXT("pins");
   GOOD_PIN();
   d.compliance = 1e-3;
   d.group = g_ref.g_dead;
@@ -1531,6 +1605,76 @@ static void test_particles(void) {
     }
 }
 
+/* Point loads, member forces and reactions: every argument checked, a refusal changes nothing. */
+static void test_statics(void) {
+  const double xyz[6] = {1, 2, 3, 4, 5, 6};
+  double buf[64];
+  embra_reaction r[8];
+  int32_t n32 = -7;
+  int64_t n64 = -7;
+  int i, k;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "xyz", embra_world_set_loads(W, NULL, 0, 2));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_world_set_loads(W, xyz, 0, -1));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "range", embra_world_set_loads(W, xyz, -1, 2));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "range", embra_world_set_loads(W, xyz, S->n - 1, 2));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "range", embra_world_set_loads(W, xyz, INT32_MAX, 2));
+  for (i = 0; i < 3; ++i)
+    for (k = 0; k < 6; ++k) {
+      double v[6] = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+      CAPI_CONTEXT("xyz[%d] = %s", k, bad_name(i));
+      v[k] = bad_value(i); /* all or nothing: the first particle's load is not set either */
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_world_set_loads(W, v, S->cloth + 3, 2));
+    }
+  CAPI_CONTEXT("statics");
+  {
+    double big[3] = {0.0, 2e300, 0.0};
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "1e300", embra_world_set_loads(W, big, 0, 1));
+  }
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_xyz", embra_world_get_loads(W, NULL, 3, 0, 1));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "range", embra_world_get_loads(W, buf, 64, S->n - 1, 2));
+  REFUSED(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer", embra_world_get_loads(W, buf, 5, 0, 2));
+
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", embra_world_get_reactions(W, r, 8, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", embra_world_get_reactions(W, r, -1, &n32));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out", embra_world_get_reactions(W, NULL, 8, &n32));
+  REFUSED(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer", embra_world_get_reactions(W, r, 1, &n32));
+
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count",
+          embra_group_get_forces(W, S->g_default, EMBRA_CONSTRAINT_DISTANCE, buf, 64, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity",
+          embra_group_get_forces(W, S->g_default, EMBRA_CONSTRAINT_DISTANCE, buf, -1, &n64));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_group_get_forces(W, S->g_default, 42, buf, 64, &n64));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "kind", embra_group_get_forces(W, S->g_default, -1, buf, 64, &n64));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "3 multipliers",
+          embra_group_get_forces(W, S->g_default, EMBRA_CONSTRAINT_WELD, buf, 64, &n64));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group",
+          embra_group_get_forces(W, S->g_dead, EMBRA_CONSTRAINT_DISTANCE, buf, 64, &n64));
+
+  /* The two-call pattern: the counts, then the values; the hard pin's reaction holds its particle's
+   * share of the cloth, the soft pin's is its multiplier. */
+  {
+    scene s;
+    embra_pin_id pins[8];
+    int32_t np = 0, count = 0;
+    int64_t nf = 0;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_world_step(s.w));
+    CHECK_OK(embra_world_get_pins(s.w, pins, 8, &np));
+    CHECK_OK(embra_world_get_reactions(s.w, NULL, 0, &count));
+    CHECK(count == np && count > 0 && count <= 8);
+    CHECK_OK(embra_world_get_reactions(s.w, r, 8, &count));
+    for (i = 0; i < count; ++i) {
+      CHECK(r[i].pin.index == pins[i].index && r[i].pin.generation == pins[i].generation);
+      CHECK(isfinite(r[i].force[0]) && isfinite(r[i].force[1]) && isfinite(r[i].force[2]));
+    }
+    CHECK_OK(embra_group_get_forces(s.w, s.g_custom, EMBRA_CONSTRAINT_DISTANCE, NULL, 0, &nf));
+    CHECK(nf > 0 && nf <= 64);
+    CHECK_OK(embra_group_get_forces(s.w, s.g_custom, EMBRA_CONSTRAINT_DISTANCE, buf, 64, &nf));
+    for (i = 0; i < (int)nf; ++i) CHECK(isfinite(buf[i]));
+    embra_world_destroy(s.w);
+  }
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -1555,6 +1699,7 @@ int main(void) {
   RUN(test_colliders);
   RUN(test_id_lists);
   RUN(test_particles);
+  RUN(test_statics);
   RUN(test_step);
   return capi_test_finish();
 }

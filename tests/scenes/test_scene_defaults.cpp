@@ -223,6 +223,11 @@ std::map<std::string, std::vector<json>> code_defaults() {
   const embra_pin_def pin = embra_default_pin_def();
   c[d + "pin/properties/compliance"] = {pin.compliance, saved["pins"][0]["compliance"]};
   c[d + "pin/properties/group"] = {group_name(pin.group)};
+  // A scene's pin is embra_pin_create's point pin unless it names a support; then its axis defaults
+  // to embra_support_def's.
+  const embra_support_def support = embra_default_support_def();
+  c[d + "pin/properties/support"] = {json("point")};
+  c[d + "pin/properties/axis"] = {json::array({support.axis[0], support.axis[1], support.axis[2]})};
 
   const embra_collider_def col = embra_default_collider_def();
   const json& capsule = saved["colliders"][0];

@@ -3,8 +3,8 @@
  * For every scene file given on the command line (CMake passes every JSON file of examples/ and of
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
- * orders and weights, hard and soft pins, a plane and a sphere, non-default solver settings, a rest
- * scale, initial velocities, and a destroyed group, pin and collider whose slots are reused):
+ * orders and weights, hard and soft pins, plane and line supports, a plane and a sphere, non-default solver settings, a
+ * rest scale, initial velocities, point loads, and a destroyed group, pin and collider whose slots are reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -412,6 +412,20 @@ static embra_world* build_api_world(void) {
   pd.target[0] -= 0.2;
   pd.compliance = 5e-3;
   CHECK_OK(embra_pin_create(w, &pd, &pin));
+  /* Sliding supports: a hard one on a tilted plane, a soft one on a line (axes of any length). */
+  {
+    embra_support_def su = embra_default_support_def();
+    su.particle = c0 + 12;
+    memcpy(su.target, &cloth_xyz[3 * 12], sizeof su.target);
+    su.axis[0] = 0.1;
+    su.axis[2] = 0.7;
+    CHECK_OK(embra_support_create(w, &su, &pin));
+    su.particle = c0 + 13;
+    su.support = EMBRA_PIN_SUPPORT_LINE;
+    su.compliance = 1e-3;
+    su.group = g_stretch;
+    CHECK_OK(embra_support_create(w, &su, &pin));
+  }
 
   /* A tilted plane, a sphere, and a destroyed sphere. */
   kd = embra_default_collider_def();
@@ -441,6 +455,11 @@ static embra_world* build_api_world(void) {
     for (i = 0; i < 3 * BLOCK_N; ++i) v[i] = 0.01 * (i % 5) - 0.02;
     CHECK_OK(embra_world_set_velocities(w, v, b0, BLOCK_N));
   }
+  {
+    /* Point loads on two particles (N), written to the scene's "loads" with every bit. */
+    const double loads[6] = {0.1, -0.2, -1.0 / 3.0, 0.0, 0.0, 0.7};
+    CHECK_OK(embra_world_set_loads(w, loads, b0, 2));
+  }
   if (capi_test_failed != failed_before) {
     embra_world_destroy(w);
     return NULL;
@@ -456,7 +475,7 @@ static void api_world_round_trips(void) {
   if (w == NULL) return;
   CHECK_OK(embra_world_get_counts(w, &c));
   CHECK_INT(c.bodies, 2);
-  CHECK_INT(c.pins, 5);
+  CHECK_INT(c.pins, 7); /* five pins and two supports */
   CHECK_INT(c.colliders, 2);
   if (g_save_api_path != NULL) CHECK_OK(embra_world_save_file(w, g_save_api_path));
   check_round_trip("the C-ABI world", w, NULL);

@@ -512,6 +512,37 @@ typedef struct embra_pin_def {
 EMBRA_API embra_pin_def embra_default_pin_def(void);
 /* A particle takes at most one hard pin. */
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
+/* Sliding supports: a pin that holds its particle on a plane or a line through the target, and
+ * lets it slide along it, frictionless. A per-axis anchor (a roller) is one of them: one
+ * coordinate held is a plane with that axis as its normal ({0, 0, 1}: z held, x and y free), two
+ * held a line along the third. A support is a pin (an embra_pin_id: embra_pin_destroy,
+ * embra_pin_set_target, embra_world_get_pins and the scene's "pins" take it), projected in its
+ * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
+ * the plane or across the line. */
+enum {
+  EMBRA_PIN_SUPPORT_POINT = 0, /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1, /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2   /* on the line through the target, along `axis` */
+};
+
+#define EMBRA_SUPPORT_DEF_VERSION 1
+typedef struct embra_support_def {
+  int32_t version;  /* EMBRA_SUPPORT_DEF_VERSION */
+  int32_t particle; /* world particle index */
+  int32_t support;  /* EMBRA_PIN_SUPPORT_*; default EMBRA_PIN_SUPPORT_PLANE */
+  int32_t reserved0;
+  double target[3];     /* m: a point of the plane or line */
+  double axis[3];       /* the plane's normal or the line's direction: finite, of any nonzero length
+                           (kept as a unit vector); default {0, 0, 1} */
+  double compliance;    /* 0 (default) = hard (projected with compliance 0); > 0: m/N */
+  embra_group_id group; /* its group; {0,0} = default group */
+} embra_support_def;
+
+EMBRA_API embra_support_def embra_default_support_def(void);
+/* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
+ * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
+ * (or one too short to normalise), a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The
@@ -683,6 +714,46 @@ EMBRA_API embra_status embra_world_get_group_conflicts(const embra_world* world,
 EMBRA_API embra_status embra_group_get_residuals(const embra_world* world, embra_group_id group, int32_t kind,
                                                  double* out, int64_t capacity, int64_t* out_count);
 
+/* ---------------------------------------------------------------------------------------------
+ * Statics: member forces and support reactions after a step
+ *
+ * From the last substep's multipliers: a constraint's projection moves its particles as a force
+ * lambda / h^2 grad C would over a substep (h = dt / substeps). At a static rest (the world settled,
+ * every substep ending where it began) these forces balance each free particle's weight and point
+ * load: exactly (to rounding) with realign_passes >= 1, which evaluates them at the substep's end;
+ * textbook XPBD (realign_passes 0) leaves an imbalance of the order of h^2 g / member length of the
+ * forces. Read them after embra_world_step or embra_world_solve; constraints added since read 0.
+ * ------------------------------------------------------------------------------------------- */
+
+/* The force of every constraint of `kind` in `group`, -lambda / h^2 of the last substep, in the order
+ * they were added: a distance or tether's tension (N, positive when it pulls its ends together, negative
+ * in compression); an equal_length's tension added to its edge x0-x1 (N; the same compression added to
+ * x2-x3); for the other kinds the generalised force conjugate to the value (N m for an angle, N/m^2
+ * for a volume), positive when it pulls the value down. Refused for EMBRA_CONSTRAINT_WELD (three
+ * multipliers) and a number that is no kind. Two-call pattern (out NULL, capacity 0: *out_count
+ * only; a smaller capacity is EMBRA_ERROR_BUFFER_TOO_SMALL). */
+EMBRA_API embra_status embra_group_get_forces(const embra_world* world, embra_group_id group, int32_t kind, double* out,
+                                              int64_t capacity, int64_t* out_count);
+
+typedef struct embra_reaction {
+  embra_pin_id pin;
+  int32_t particle; /* the pinned particle */
+  int32_t reserved0;
+  double force[3]; /* N: the force the pin exerts on its particle. A soft pin or a sliding support
+                      (normal to its plane, across its line): its multiplier over
+                      h^2. A hard point pin: minus the particle's weight (gravity / inverse mass; none
+                      for an immovable particle), its point load and the forces on it of every
+                      constraint and soft pin (and automatic tether, when realign_passes >= 1:
+                      without realignment they keep no multiplier). Fields (wind, pressure, surface
+                      tension, vortex) and contacts on the pinned particle are not counted */
+} embra_reaction;
+
+/* The reaction at every live pin after the last step, pins in creation-slot order (as
+ * embra_world_get_pins). At a static rest the reactions sum to minus the total applied load (every
+ * particle's weight and point load). Two-call pattern (out NULL, capacity 0: *out_count only). */
+EMBRA_API embra_status embra_world_get_reactions(const embra_world* world, embra_reaction* out, int32_t capacity,
+                                                 int32_t* out_count);
+
 typedef struct embra_group_report {
   int64_t count;       /* constraints in the group (soft pins and contacts included) */
   double residual_max; /* as in embra_step_report, over this group */
@@ -774,6 +845,13 @@ EMBRA_API embra_status embra_world_get_velocities(const embra_world* world, doub
 EMBRA_API embra_status embra_world_set_positions(embra_world* world, const double* xyz, int32_t first, int32_t count);
 /* Sets `count` particles' velocities (m/s). */
 EMBRA_API embra_status embra_world_set_velocities(embra_world* world, const double* xyz, int32_t first, int32_t count);
+/* Sets `count` particles' point loads (N, xyz per particle, double[3 * count], each coordinate finite
+ * and within +-1e300) starting at `first`: forces applied every substep beside gravity, until set
+ * again (0 by default; a hard-pinned particle's load goes to its pin's reaction). */
+EMBRA_API embra_status embra_world_set_loads(embra_world* world, const double* xyz, int32_t first, int32_t count);
+/* Copies `count` particles' point loads (N) starting at `first` into out_xyz (capacity in doubles). */
+EMBRA_API embra_status embra_world_get_loads(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
+                                             int32_t count);
 
 /* ---------------------------------------------------------------------------------------------
  * Geometry queries

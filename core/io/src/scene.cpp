@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <new>
@@ -660,6 +661,10 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"friction_dynamic", &PanelMeshDesc::friction_dynamic},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
 
+/// The pin supports' names in the scene format, by PinSupport.
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line"};
+static_assert(std::size(kPinSupportNames) == kPinSupportCount);
+
 /// The panel pins' names in the scene format, by PanelPins.
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
 
@@ -1028,6 +1033,7 @@ class Builder {
     section("constraints", [&](const json& c, const std::string& at) { constraints(w, c, at); });
     if (doc_.contains("state")) state(w, doc_["state"]);
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
+    section("loads", [&](const json& l, const std::string& at) { load(w, l, at); });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
@@ -1329,7 +1335,8 @@ class Builder {
                   "pin");
   }
 
-  void pins(World& w, const json& p, const std::string& at) {
+  /// The particles of a pin or load: its "particle", or every vertex of its body's named "set".
+  std::vector<int32_t> particles_of(const World& w, const json& p, const std::string& at) {
     std::vector<int32_t> particles;
     if (p.contains("particle")) {
       if (p.contains("body") || p.contains("set")) fail(at, "give either \"particle\" or \"body\" and \"set\"");
@@ -1343,11 +1350,32 @@ class Builder {
         fail(at + "/set", "body '" + p["body"].get<std::string>() + "' has no vertex set '" + set + "'");
       for (int32_t v : it->second) particles.push_back(w.body(body).first_particle + v);
     }
+    return particles;
+  }
+
+  /// A point load on each of its particles, added to what earlier loads put there.
+  void load(World& w, const json& l, const std::string& at) {
+    const Vec3 force = vec3(l["force"]);
+    for (int32_t i : particles_of(w, l, at)) {
+      const Vec3 sum = w.loads()[i] + force;
+      guard(at + "/force", [&] {
+        w.set_loads(i, std::span<const double>(sum.data(), 3));
+        return 0;
+      });
+    }
+  }
+
+  void pins(World& w, const json& p, const std::string& at) {
+    const std::vector<int32_t> particles = particles_of(w, p, at);
     for (size_t i = 0; i < particles.size(); ++i) {
       PinDesc d;
       d.particle = particles[i];
       d.target = w.positions()[particles[i]];
       read_rows(kPinRows, p, d);
+      if (p.contains("support"))  // the schema has checked it is one of kPinSupportNames
+        for (int k = 0; k < kPinSupportCount; ++k)
+          if (p["support"] == kPinSupportNames[k]) d.support = static_cast<PinSupport>(k);
+      if (p.contains("axis")) d.axis = vec3(p["axis"]);
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1636,7 +1664,7 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   // (creation order, which a reused slot breaks): a loaded scene lists them in that order again.
   std::vector<uint32_t> pin_order;
   for (uint32_t i = 0; i < w.pins().size(); ++i)
-    if (w.pins()[i].alive && w.pins()[i].compliance == 0.0) pin_order.push_back(i);
+    if (w.pins()[i].alive && w.pins()[i].kinematic()) pin_order.push_back(i);
   for (uint32_t slot : slots)
     for (int32_t i : w.groups()[slot].soft_pins) pin_order.push_back(static_cast<uint32_t>(i));
   for (uint32_t i : pin_order) {
@@ -1644,10 +1672,19 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     pin_name[i] = name_for(meta.pin_names, i, "pin", used_pins);
     json j = {{"name", pin_name[i]}, {"particle", p.particle}};
     write_rows(kPinRows, PinDesc{p.particle, p.target, p.compliance, p.group}, j);
-    if (p.compliance > 0.0) j["group"] = group_name(p.group);
+    if (!p.kinematic()) j["group"] = group_name(p.group);
+    if (p.support != PinSupport::point) {
+      j["support"] = kPinSupportNames[static_cast<int>(p.support)];
+      j["axis"] = vec_json(p.axis);
+    }
     pins.push_back(j);
   }
   doc["pins"] = pins;
+
+  json loads = json::array();
+  for (int32_t i = 0; i < w.particle_count(); ++i)
+    if (!w.loads()[i].isZero()) loads.push_back({{"particle", i}, {"force", vec_json(w.loads()[i])}});
+  if (!loads.empty()) doc["loads"] = loads;
 
   json colliders = json::array();
   std::set<std::string> used_colliders = given_names(meta.collider_names);

@@ -595,6 +595,7 @@ Id World::create_body(const BodyDesc& d) {
     w_.push_back(inv_mass_.back());
     radius_.push_back(0.5 * d.material.thickness);
     damping_.push_back(d.material.damping);
+    load_.push_back(Vec3::Zero());
     mu_s_.push_back(d.material.friction_static);
     mu_k_.push_back(d.material.friction_dynamic);
     body_of_.push_back(body_index);
@@ -1262,8 +1263,19 @@ Id World::create_pin(const PinDesc& desc) {
   check_particle(desc.particle, "pin particle");
   for (int k = 0; k < 3; ++k) check_finite(desc.target[k], "pin target");
   check_non_negative(desc.compliance, "pin compliance");
+  const int32_t support = static_cast<int32_t>(desc.support);
+  if (support < 0 || support >= kPinSupportCount)
+    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1) or line (2)");
+  for (int k = 0; k < 3; ++k) check_finite(desc.axis[k], "pin axis");
+  const double axis_length = desc.axis.norm();
+  if (desc.support != PinSupport::point &&
+      !(axis_length > 0.0 && std::isfinite(axis_length) && (desc.axis / axis_length).allFinite()))
+    invalid(std::string("pin axis is zero (or too short to normalise): a ") +
+            (desc.support == PinSupport::plane ? "plane" : "line") + " support needs a direction (its " +
+            (desc.support == PinSupport::plane ? "normal" : "line") + ")");
+  const bool kinematic = desc.compliance == 0.0 && desc.support == PinSupport::point;
   Id gid;
-  if (desc.compliance == 0.0) {
+  if (kinematic) {
     if (hard_pin_of_[desc.particle] >= 0)
       invalid("particle " + std::to_string(desc.particle) + " already has a hard pin");
   } else {
@@ -1274,9 +1286,11 @@ Id World::create_pin(const PinDesc& desc) {
   p.target = desc.target;
   p.compliance = desc.compliance;
   p.group = gid;
+  p.support = desc.support;
+  if (desc.support != PinSupport::point) p.axis = desc.axis / axis_length;
   const Id id = slots::create(pins_, p);
   const int32_t slot = static_cast<int32_t>(id.index);
-  if (desc.compliance == 0.0) {
+  if (kinematic) {
     hard_pin_of_[desc.particle] = slot;
     w_[desc.particle] = 0.0;
     solver_dirty_ = true;  // automatic tethers attach to hard pins
@@ -1294,7 +1308,7 @@ const Pin& World::pin(Id id) const {
 
 void World::destroy_pin(Id id) {
   const Pin& p = pin(id);
-  if (p.compliance == 0.0) {
+  if (p.kinematic()) {
     hard_pin_of_[p.particle] = -1;
     w_[p.particle] = inv_mass_[p.particle];
     solver_dirty_ = true;
@@ -1382,6 +1396,14 @@ void World::set_velocities(int32_t first, std::span<const double> xyz) {
   if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
   for (double c : xyz) check_finite(c, "velocity coordinate");
   for (int64_t i = 0; i < n; ++i) v_[first + i] = at(xyz, i);
+}
+
+void World::set_loads(int32_t first, std::span<const double> xyz) {
+  if (xyz.size() % 3 != 0) invalid("load array length is not a multiple of 3");
+  const int64_t n = static_cast<int64_t>(xyz.size() / 3);
+  if (first < 0 || first + n > particle_count()) invalid("particle range is outside the world's particles");
+  for (double c : xyz) check_finite(c, "load coordinate");
+  for (int64_t i = 0; i < n; ++i) load_[first + i] = at(xyz, i);
 }
 
 }  // namespace embra

@@ -10,6 +10,7 @@
 // however hard it is stretched: the violation is what shows it fighting.)
 #include "embra/core/world.hpp"
 #include "model/kind_traits.hpp"
+#include "solver/forces.hpp"
 #include "solver/residuals.hpp"
 
 #include <algorithm>
@@ -74,8 +75,8 @@ std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
       c.group = gid;
       c.pin = Id{static_cast<uint32_t>(pi), p.generation};
       c.particles[0] = p.particle;
-      c.residual = (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm();
-      c.violation = (x_[p.particle] - p.target).norm();
+      c.residual = (p.held(x_[p.particle] - p.target) + p.compliance * inv_h2 * p.lambda).norm();
+      c.violation = p.held(x_[p.particle] - p.target).norm();
       c.force = p.lambda.norm() * inv_h2;
       all.push_back(c);
     }
@@ -101,32 +102,7 @@ std::vector<GroupConflict> World::group_conflicts() const {
   for (int32_t slot : order_) {
     const Group& g = groups_[slot];
     std::vector<Vec3> f(x_.size(), Vec3::Zero());
-    bool any = false;
-    for (const KindInfo& info : kKinds)
-      visit_kind(info.kind, [&](auto k) {
-        const SolverArray& a = g.solve[static_cast<int>(info.kind)];
-        if constexpr (k == Kind::weld) {
-          for (size_t i = 0; i < a.size(); ++i) {
-            const Vec3 l = inv_h2 * Vec3(a.lambda[3 * i], a.lambda[3 * i + 1], a.lambda[3 * i + 2]);
-            f[a.ids[2 * i]] += l;
-            f[a.ids[2 * i + 1]] -= l;
-            any = any || !l.isZero();
-          }
-        } else {
-          constexpr int N = arity(k);
-          for (size_t i = 0; i < a.size(); ++i) {
-            if (a.lambda[i] == 0.0) continue;
-            const auto e = KindTraits<k>::evaluate(&a.ids[i * N], x_);
-            if (!e.valid) continue;
-            for (int m = 0; m < N; ++m) f[a.ids[i * N + m]] += (a.lambda[i] * inv_h2) * e.grad[m];
-            any = true;
-          }
-        }
-      });
-    for (int32_t pi : g.soft_pins) {
-      f[pins_[pi].particle] += inv_h2 * pins_[pi].lambda;
-      any = any || !pins_[pi].lambda.isZero();
-    }
+    const bool any = add_group_forces(g, pins_, x_, inv_h2, f);
     if (!any) continue;
     force.push_back(std::move(f));
     slots.push_back(slot);

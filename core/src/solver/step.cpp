@@ -3,7 +3,8 @@
 //   begin_frame                hard pins' start, control.before_frame, solver arrays brought up to date
 //   for each substep:
 //     move_colliders           collider poses along their path over the frame
-//     predict                  fields, x <- x + h v + h^2 g; hard-pinned particles follow their target
+//     predict                  fields, x <- x + h v + h^2 (g + w f) (f: point load); hard-pinned
+//                              particles follow their target
 //     find_contacts            particles against colliders (swept over the substep), cloth against
 //     find_self_contacts       itself (self_collision.cpp), panel faces against spheres
 //     find_face_contacts
@@ -118,11 +119,11 @@ void World::predict(double h, double alpha) {
     x_prev_[i] = x_[i];
     if (w_[i] == 0.0) return;
     v_[i] += dv;
+    if (!load_[i].isZero()) v_[i] += (h * w_[i]) * load_[i];  // point loads (N)
     x_[i] += h * v_[i];
   });
   for (const Pin& p : pins_)
-    if (p.alive && p.compliance == 0.0)
-      x_[p.particle] = (1.0 - alpha) * p.target_prev + alpha * p.target;  // exact at 1
+    if (p.alive && p.kinematic()) x_[p.particle] = (1.0 - alpha) * p.target_prev + alpha * p.target;  // exact at 1
 }
 
 void World::move_colliders(double alpha) {
@@ -199,7 +200,9 @@ void World::project_group(Group& g, double h, bool first) {
     const double w = w_[p.particle];
     const double alpha = p.compliance * inv_h2;
     if (w + alpha <= 0.0) continue;
-    const Vec3 dl = (-(x_[p.particle] - p.target) - alpha * p.lambda) / (w + alpha);
+    // The held part only (all of it for a point): a support's multiplier stays along its normal
+    // (plane) or across its line, so the particle slides freely the other ways.
+    const Vec3 dl = (-p.held(x_[p.particle] - p.target) - alpha * p.lambda) / (w + alpha);
     p.lambda += dl;
     x_[p.particle] += w * dl;
   }
@@ -338,7 +341,7 @@ void World::measure() {
     }
     for (int32_t pi : g.soft_pins) {
       const Pin& p = pins_[pi];
-      add(kResidualPins, (x_[p.particle] - p.target + p.compliance * inv_h2 * p.lambda).norm(), max, sq);
+      add(kResidualPins, (p.held(x_[p.particle] - p.target) + p.compliance * inv_h2 * p.lambda).norm(), max, sq);
       ++n;
     }
     for (const Contact& ct : g.contacts) {
@@ -367,7 +370,7 @@ void World::measure() {
   }
   // Hard pins hold exactly; their residual is the distance left to the target.
   for (const Pin& p : pins_)
-    if (p.alive && p.compliance == 0.0) {
+    if (p.alive && p.kinematic()) {
       const double r = (x_[p.particle] - p.target).norm();
       all_max = std::max(all_max, r);
       kind_max[kResidualPins] = std::max(kind_max[kResidualPins], r);
@@ -475,7 +478,7 @@ void World::begin_frame(const StepControl& control) {
   // set_positions put it, or the pin's last target) to the target: derived from the state, so a
   // saved and reloaded world steps the same.
   for (Pin& p : pins_)
-    if (p.alive && p.compliance == 0.0) p.target_prev = x_[p.particle];
+    if (p.alive && p.kinematic()) p.target_prev = x_[p.particle];
   if (control.before_frame) control.before_frame(*this);
   if (solver_dirty_)
     rebuild_solver();

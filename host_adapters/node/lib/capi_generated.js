@@ -21,6 +21,7 @@ const BODY_DEF_VERSION = 1;
 const CONSTRAINT_DEF_VERSION = 1;
 const CONSTRAINT_BATCH_DEF_VERSION = 1;
 const PIN_DEF_VERSION = 1;
+const SUPPORT_DEF_VERSION = 1;
 const COLLIDER_DEF_VERSION = 2;
 const SOLVE_DEF_VERSION = 1;
 const PANEL_MESH_DEF_VERSION = 1;
@@ -60,6 +61,11 @@ const CONSTRAINT_TETHER = 5;
 const CONSTRAINT_PLANARITY = 6;
 const CONSTRAINT_PLANE_OFFSET = 7;
 const CONSTRAINT_EQUAL_LENGTH = 8;
+
+// --- EMBRA_PIN_SUPPORT_* ---
+const PIN_SUPPORT_POINT = 0;
+const PIN_SUPPORT_PLANE = 1;
+const PIN_SUPPORT_LINE = 2;
 
 // --- embra_collider_shape ---
 const COLLIDER_PLANE = 0;
@@ -102,6 +108,7 @@ const CUTS_CSV = 1;
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8 });
+const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
@@ -220,6 +227,16 @@ const PinDef = koffi.struct('embra_pin_def', {
   compliance: 'double',
   group: GroupIdType,
 });
+const SupportDef = koffi.struct('embra_support_def', {
+  version: 'int32_t',
+  particle: 'int32_t',
+  support: 'int32_t',
+  reserved0: 'int32_t',
+  target: koffi.array('double', 3, 'Array'),
+  axis: koffi.array('double', 3, 'Array'),
+  compliance: 'double',
+  group: GroupIdType,
+});
 const ColliderDef = koffi.struct('embra_collider_def', {
   version: 'int32_t',
   shape: 'embra_collider_shape',
@@ -270,6 +287,12 @@ const GroupConflict = koffi.struct('embra_group_conflict', {
   b: GroupIdType,
   force: 'double',
   particles: 'int64_t',
+});
+const Reaction = koffi.struct('embra_reaction', {
+  pin: PinIdType,
+  particle: 'int32_t',
+  reserved0: 'int32_t',
+  force: koffi.array('double', 3, 'Array'),
 });
 const GroupReport = koffi.struct('embra_group_report', {
   count: 'int64_t',
@@ -416,11 +439,13 @@ const STRUCTS = {
   embra_constraint_def: ConstraintDef,
   embra_constraint_batch_def: ConstraintBatchDef,
   embra_pin_def: PinDef,
+  embra_support_def: SupportDef,
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
   embra_kind_residual: KindResidual,
   embra_constraint_residual: ConstraintResidual,
   embra_group_conflict: GroupConflict,
+  embra_reaction: Reaction,
   embra_group_report: GroupReport,
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
@@ -487,6 +512,8 @@ const PROTOTYPES = {
   embra_constraint_remove: 'embra_status embra_constraint_remove(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index)',
   embra_default_pin_def: 'embra_pin_def embra_default_pin_def(void)',
   embra_pin_create: 'embra_status embra_pin_create(embra_world *world, const embra_pin_def *def, _Out_ embra_pin_id *out_pin)',
+  embra_default_support_def: 'embra_support_def embra_default_support_def(void)',
+  embra_support_create: 'embra_status embra_support_create(embra_world *world, const embra_support_def *def, _Out_ embra_pin_id *out_pin)',
   embra_pin_destroy: 'embra_status embra_pin_destroy(embra_world *world, embra_pin_id pin)',
   embra_pin_set_target: 'embra_status embra_pin_set_target(embra_world *world, embra_pin_id pin, const double *target)',
   embra_pin_get_target: 'embra_status embra_pin_get_target(const embra_world *world, embra_pin_id pin, double *out_target)',
@@ -505,6 +532,8 @@ const PROTOTYPES = {
   embra_world_get_worst_constraints: 'embra_status embra_world_get_worst_constraints(const embra_world *world, embra_constraint_residual *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_world_get_group_conflicts: 'embra_status embra_world_get_group_conflicts(const embra_world *world, embra_group_conflict *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_residuals: 'embra_status embra_group_get_residuals(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
+  embra_group_get_forces: 'embra_status embra_group_get_forces(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
+  embra_world_get_reactions: 'embra_status embra_world_get_reactions(const embra_world *world, embra_reaction *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
   embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
   embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
@@ -513,6 +542,8 @@ const PROTOTYPES = {
   embra_world_get_velocities: 'embra_status embra_world_get_velocities(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
   embra_world_set_positions: 'embra_status embra_world_set_positions(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_set_velocities: 'embra_status embra_world_set_velocities(embra_world *world, const double *xyz, int32_t first, int32_t count)',
+  embra_world_set_loads: 'embra_status embra_world_set_loads(embra_world *world, const double *xyz, int32_t first, int32_t count)',
+  embra_world_get_loads: 'embra_status embra_world_get_loads(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
   embra_body_get_triangles: 'embra_status embra_body_get_triangles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_world_export_obj: 'embra_status embra_world_export_obj(const embra_world *world, char *out, int64_t capacity, _Out_ int64_t *out_length)',
   embra_world_write_obj: 'embra_status embra_world_write_obj(const embra_world *world, const char *path)',
@@ -557,22 +588,23 @@ module.exports = {
   koffi, STRUCTS, PROTOTYPES,
   ABI_VERSION, MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS,
   MAX_PASSES_PER_STEP, MAX_OBJ_BYTES, MAX_THREADS, SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION,
-  CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, COLLIDER_DEF_VERSION,
-  SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION,
-  WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK,
-  ERROR_INVALID_ARGUMENT, ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED,
-  ERROR_NUMERICAL, ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND,
-  GENERATE_VOLUME, CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME,
-  CONSTRAINT_WELD, CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH,
+  CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, SUPPORT_DEF_VERSION,
+  COLLIDER_DEF_VERSION, SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION,
+  LOAD_OPTIONS_VERSION, WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION,
+  VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT, ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA,
+  ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL, ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH,
+  GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE,
+  CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER, CONSTRAINT_PLANARITY,
+  CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE, PIN_SUPPORT_LINE,
   COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH,
   RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE,
   SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING,
   PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
   PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
-  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
-  PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
-  SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, ColliderDef,
-  StepReport, KindResidual, ConstraintResidual, GroupConflict, GroupReport, SolveDef, SolveResult, Warning,
-  PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef,
-  PressureDef, SurfaceTensionDef, VortexDef,
+  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
+  SOLVE_UNTIL_NAMES, SOLVE_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType,
+  PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef,
+  ConstraintBatchDef, PinDef, SupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual,
+  GroupConflict, Reaction, GroupReport, SolveDef, SolveResult, Warning, PanelMeshDef, Tolerance, Tolerances,
+  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -28,6 +28,7 @@ const SHAPES = capi.COLLIDER_NAMES;
 const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
+const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
 const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
 const SOLVE_UNTIL = capi.SOLVE_UNTIL_NAMES;
 const SOLVE_OUTCOMES = Object.freeze(Object.fromEntries(Object.entries(capi.SOLVE_NAMES).map(([k, v]) => [v, k])));
@@ -755,6 +756,27 @@ class World {
     return new PinId(pin.index, pin.generation);
   }
 
+  /**
+   * A frictionless sliding support (embra_support_create): `particle` held on the plane through
+   * `target` (m) normal to `axis` (support 'plane', the default) or on the line through it along
+   * `axis` ('line'). Options: support, axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
+   * Returns its PinId.
+   */
+  createSupport(particle, target, opts) {
+    const o = options(opts, 'createSupport options');
+    const d = lib.embra_default_support_def();
+    d.particle = buf.int32(particle, 'particle');
+    d.target = buf.fixed(target, 3, 'target');
+    if (o.has('support')) d.support = enumValue(take(o, 'support'), PIN_SUPPORTS, 'support');
+    if (o.has('axis')) d.axis = buf.fixed(take(o, 'axis'), 3, 'axis');
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createSupport: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_support_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
   destroyPin(pin) {
     this.#call('embra_pin_destroy', toId(pin, PinId, 'pin'));
   }
@@ -1110,6 +1132,41 @@ class World {
     return out;
   }
 
+  /**
+   * The force of every constraint of `kind` in `group` after the last step, in the order they were
+   * added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or tether its
+   * tension in N (positive pulling its ends together). A Float64Array.
+   */
+  constraintForces(group, kind) {
+    if (!(group instanceof GroupId)) throw new TypeError(`group: expected a GroupId, got ${buf.describe(group)}`);
+    const k = enumValue(kind, KINDS, 'kind');
+    const n = [0];
+    this.#call('embra_group_get_forces', group, k, null, 0, n);
+    const out = new Float64Array(Number(n[0]));
+    this.#call('embra_group_get_forces', group, k, out, out.length, n);
+    return out;
+  }
+
+  /**
+   * The force (N) every live pin exerts on its particle after the last step
+   * (embra_world_get_reactions): [{pin (PinId), particle, force ([x, y, z])}], pins in creation-slot
+   * order. At a static rest they sum to minus the weights and point loads.
+   */
+  reactions() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_reactions', null, 0, n);
+    const size = koffi.sizeof(capi.Reaction);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_reactions', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const r = koffi.decode(out, k * size, capi.Reaction);
+      result.push({ pin: new PinId(r.pin.index, r.pin.generation), particle: r.particle, force: Array.from(r.force) });
+    }
+    return result;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);
@@ -1161,6 +1218,19 @@ class World {
   /** Sets particles' velocities (m/s), as setPositions. */
   setVelocities(xyz, first = 0) {
     this.#write('embra_world_set_velocities', xyz, first);
+  }
+
+  /** Point loads (N) of particles [first, first + count), as positions(). */
+  loads(first = 0, count = null, out = null) {
+    return this.#read('embra_world_get_loads', first, count, out);
+  }
+
+  /**
+   * Sets point loads (N, flat xyz per particle) on particles [first, first + xyz.length / 3): forces
+   * applied every substep beside gravity until set again.
+   */
+  setLoads(xyz, first = 0) {
+    this.#write('embra_world_set_loads', xyz, first);
   }
 
   // --- JSON scenes --------------------------------------------------------------------------------

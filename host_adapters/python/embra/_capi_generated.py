@@ -23,6 +23,7 @@ BODY_DEF_VERSION = 1
 CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
+SUPPORT_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
 SOLVE_DEF_VERSION = 1
 PANEL_MESH_DEF_VERSION = 1
@@ -62,6 +63,11 @@ CONSTRAINT_TETHER = 5
 CONSTRAINT_PLANARITY = 6
 CONSTRAINT_PLANE_OFFSET = 7
 CONSTRAINT_EQUAL_LENGTH = 8
+
+# --- EMBRA_PIN_SUPPORT_* ---
+PIN_SUPPORT_POINT = 0
+PIN_SUPPORT_PLANE = 1
+PIN_SUPPORT_LINE = 2
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -104,6 +110,7 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
@@ -277,6 +284,20 @@ class PinDef(_Struct):
     ]
 
 
+class SupportDef(_Struct):
+    """embra_support_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("particle", c_int32),
+        ("support", c_int32),
+        ("reserved0", c_int32),
+        ("target", c_double * 3),
+        ("axis", c_double * 3),
+        ("compliance", c_double),
+        ("group", GroupId),
+    ]
+
+
 class ColliderDef(_Struct):
     """embra_collider_def."""
     _fields_ = [
@@ -345,6 +366,16 @@ class GroupConflict(_Struct):
         ("b", GroupId),
         ("force", c_double),
         ("particles", c_int64),
+    ]
+
+
+class Reaction(_Struct):
+    """embra_reaction."""
+    _fields_ = [
+        ("pin", PinId),
+        ("particle", c_int32),
+        ("reserved0", c_int32),
+        ("force", c_double * 3),
     ]
 
 
@@ -583,6 +614,8 @@ PROTOTYPES = {
     "embra_constraint_remove": (c_int32, [c_void_p, GroupId, c_int32, c_int32]),
     "embra_default_pin_def": (PinDef, []),
     "embra_pin_create": (c_int32, [c_void_p, POINTER(PinDef), POINTER(PinId)]),
+    "embra_default_support_def": (SupportDef, []),
+    "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
@@ -601,6 +634,8 @@ PROTOTYPES = {
     "embra_world_get_worst_constraints": (c_int32, [c_void_p, POINTER(ConstraintResidual), c_int32, POINTER(c_int32)]),
     "embra_world_get_group_conflicts": (c_int32, [c_void_p, POINTER(GroupConflict), c_int32, POINTER(c_int32)]),
     "embra_group_get_residuals": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
+    "embra_group_get_forces": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
+    "embra_world_get_reactions": (c_int32, [c_void_p, POINTER(Reaction), c_int32, POINTER(c_int32)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
     "embra_default_solve_def": (SolveDef, []),
     "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),
@@ -609,6 +644,8 @@ PROTOTYPES = {
     "embra_world_get_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
     "embra_world_set_positions": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_set_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
+    "embra_world_set_loads": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
+    "embra_world_get_loads": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
     "embra_body_get_triangles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
     "embra_world_export_obj": (c_int32, [c_void_p, POINTER(c_char), c_int64, POINTER(c_int64)]),
     "embra_world_write_obj": (c_int32, [c_void_p, c_char_p]),

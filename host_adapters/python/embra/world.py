@@ -17,7 +17,7 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, SolveResult, SolverDef,
+                    ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, Reaction, SolveResult, SolverDef,
                     StepReport, PressureDef, SurfaceTensionDef, VortexDef, WindDef,
                     Tolerances, Warning, WorldCounts, lib)
 from .errors import EmbraError, check, error_for
@@ -27,6 +27,7 @@ SHAPES = dict(_capi.COLLIDER_NAMES)
 KINDS = dict(_capi.CONSTRAINT_NAMES)
 GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
+PIN_SUPPORTS = dict(_capi.PIN_SUPPORT_NAMES)
 PANEL_METRICS = dict(_capi.PANEL_METRIC_NAMES)
 CUTS_FORMATS = dict(_capi.CUTS_NAMES)
 SOLVE_UNTIL = dict(_capi.SOLVE_UNTIL_NAMES)
@@ -628,6 +629,21 @@ class World:
         self._call("embra_pin_create", byref(d), byref(pin))
         return pin
 
+    def create_support(self, particle, target, support="plane", axis=(0.0, 0.0, 1.0), compliance=0.0, group=None):
+        """A frictionless sliding support (embra_support_create): `particle` held on the plane through
+        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line");
+        compliance 0 = hard, > 0 m/N; projected in `group`. Returns its PinId."""
+        d = lib.embra_default_support_def()
+        d.particle = buf.int32(particle, "particle")
+        d.support = _enum(support, PIN_SUPPORTS, "support")
+        d.target = buf.d3(target, "target")
+        d.axis = buf.d3(axis, "axis")
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        pin = PinId()
+        self._call("embra_support_create", byref(d), byref(pin))
+        return pin
+
     def destroy_pin(self, pin):
         self._call("embra_pin_destroy", _id(pin, PinId, "pin"))
 
@@ -839,6 +855,28 @@ class World:
         self._call("embra_group_get_residuals", g, k, out, n.value, byref(n))
         return list(out[:n.value])
 
+    def constraint_forces(self, group, kind):
+        """The force of every constraint of `kind` in `group` after the last step, in the order they
+        were added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or
+        tether its tension in N (positive pulling its ends together). A list of floats."""
+        g, k = _id(group, GroupId, "group"), _enum(kind, KINDS, "kind")
+        n = c_int64()
+        self._call("embra_group_get_forces", g, k, None, 0, byref(n))
+        out = (c_double * max(n.value, 1))()
+        self._call("embra_group_get_forces", g, k, out, n.value, byref(n))
+        return list(out[:n.value])
+
+    def reactions(self):
+        """The force (N) every live pin exerts on its particle after the last step
+        (embra_world_get_reactions): a list of dicts {pin (PinId), particle, force ([x, y, z])}, pins in
+        creation-slot order. At a static rest they sum to minus the weights and point loads."""
+        n = c_int32()
+        self._call("embra_world_get_reactions", None, 0, byref(n))
+        out = (Reaction * max(n.value, 1))()
+        self._call("embra_world_get_reactions", out, n.value, byref(n))
+        return [{"pin": PinId(r.pin.index, r.pin.generation), "particle": r.particle, "force": list(r.force)}
+                for r in out[:n.value]]
+
     def report(self):
         r = StepReport()
         self._call("embra_world_get_report", byref(r))
@@ -882,6 +920,15 @@ class World:
 
     def set_velocities(self, xyz, first=0):
         self._write("embra_world_set_velocities", xyz, first)
+
+    def loads(self, first=0, count=None, out=None):
+        """Point loads (N) of particles [first, first + count), as positions()."""
+        return self._read("embra_world_get_loads", first, count, out)
+
+    def set_loads(self, xyz, first=0):
+        """Sets point loads (N, one xyz row per particle) on particles [first, first + len): forces
+        applied every substep beside gravity until set again."""
+        self._write("embra_world_set_loads", xyz, first)
 
     # --- JSON scenes ---------------------------------------------------------------------------
     def save_json(self):

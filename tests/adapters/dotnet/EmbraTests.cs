@@ -410,6 +410,93 @@ namespace Embra.Tests
         }
     }
 
+    [TestFixture]
+    public class StaticsTests
+    {
+        /// <summary>A load hung from two pins by two hard bars at 45 degrees: each bar carries the load
+        /// over 2 sin 45 (N, tension), and the reactions sum to minus every weight and point load.</summary>
+        [Test]
+        public void TwoBarTrussForcesAndReactions()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 20;
+            solver.Damping = 5.0;
+            solver.Tethers = 0;
+            solver.RealignPasses = 2;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { -1, 0, 0, 1, 0, 0, 0, 0, -1 }, masses: new[] { 1.0, 1.5, 2.0 }, def: def);
+                w.AddConstraints(ConstraintKind.Distance, new[] { 0, 2, 1, 2 });
+                var p0 = w.CreatePin(0, new double[] { -1, 0, 0 });
+                var p1 = w.CreatePin(1, new double[] { 1, 0, 0 });
+                w.SetLoads(new double[] { 0, 0, -10 }, 2);
+                Assert.AreEqual(new double[] { 0, 0, 0, 0, 0, 0, 0, 0, -10 }, w.GetLoads());
+                w.Step(200);
+                double down = 2 * 9.81 + 10;
+                foreach (double t in w.ConstraintForces(w.DefaultGroup, ConstraintKind.Distance))
+                    Assert.AreEqual(down / Math.Sqrt(2.0), t, 1e-9 * down);
+                var r = w.Reactions();
+                Assert.AreEqual(2, r.Length);
+                Assert.AreEqual(p0, r[0].Pin);
+                Assert.AreEqual(p1, r[1].Pin);
+                double[] total = new double[3];
+                unsafe
+                {
+                    for (int i = 0; i < 2; ++i)
+                    {
+                        Reaction ri = r[i];
+                        for (int k = 0; k < 3; ++k) total[k] += ri.Force[k];
+                    }
+                }
+                Assert.AreEqual(0.0, total[0], 1e-9 * down);
+                Assert.AreEqual(0.0, total[1], 1e-9 * down);
+                Assert.AreEqual(4.5 * 9.81 + 10, total[2], 1e-9 * down);
+                Assert.Throws<EmbraArgumentException>(() => w.ConstraintForces(w.DefaultGroup, ConstraintKind.Weld));
+                Assert.Throws<EmbraArgumentException>(() => w.SetLoads(new double[] { 0, double.NaN, 0 }, 0));
+                Assert.AreEqual(new double[] { 0, 0, 0 }, w.GetLoads(0, 1));
+            }
+        }
+
+        /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
+        /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
+        [Test]
+        public void PlaneSupportSlidesAtGSinTheta()
+        {
+            double th = Math.PI / 6;
+            var n = new[] { -Math.Sin(th), 0.0, Math.Cos(th) };
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0, 0 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Plane, new[] { 2 * n[0], 2 * n[1], 2 * n[2] });
+                w.Step(30);
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                double along = -(p[0] * Math.Cos(th) + p[2] * Math.Sin(th));
+                double exact = 9.81 * Math.Sin(th) * h * h * steps * (steps + 1) / 2;
+                Assert.AreEqual(exact, along, 1e-12 * exact);
+                var r = w.Reactions();
+                Assert.AreEqual(pin, r[0].Pin);
+                Reaction r0 = r[0];
+                unsafe
+                {
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(2 * 9.81 * Math.Cos(th) * n[k], r0.Force[k], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Line, new double[] { 0, 0, 0 }));
+            }
+        }
+    }
+
     public class ErrorTests
     {
         static World Square()

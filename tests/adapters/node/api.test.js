@@ -104,6 +104,51 @@ test('equal length: four links between fixed ends, neighbours held equal, end a 
   w.close();
 });
 
+test('statics: two hard bars at 45 degrees carry a load, the pins react with every weight and load', () => {
+  const xyz = [[-1, 0, 0], [1, 0, 0], [0, 0, -1]];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 20, damping: 5, tethers: 0,
+    realign_passes: 2 });
+  w.createBody(xyz, { generate: 0, masses: [1, 1.5, 2] });
+  w.addConstraints('distance', [[0, 2], [1, 2]]);
+  const pins = [w.createPin(0, xyz[0]), w.createPin(1, xyz[1])];
+  w.setLoads([0, 0, -10], 2);
+  assert.deepEqual(Array.from(w.loads()), [0, 0, 0, 0, 0, 0, 0, 0, -10]);
+  w.step(200);
+  const down = 2 * 9.81 + 10;
+  for (const t of w.constraintForces(w.defaultGroup(), 'distance')) assert.ok(Math.abs(t - down / Math.SQRT2) < 1e-9 * down);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pins[0]) && r[1].pin.equals(pins[1]));
+  assert.deepEqual(r.map((x) => x.particle), [0, 1]);
+  const total = [0, 1, 2].map((k) => r[0].force[k] + r[1].force[k]);
+  assert.ok(Math.abs(total[0]) < 1e-9 * down && Math.abs(total[1]) < 1e-9 * down);
+  assert.ok(Math.abs(total[2] - (4.5 * 9.81 + 10)) < 1e-9 * down);
+  assert.throws(() => w.constraintForces(w.defaultGroup(), 'weld'), embra.EmbraError);
+  assert.throws(() => w.setLoads([0, NaN, 0], 0));
+  assert.deepEqual(Array.from(w.loads(0, 1)), [0, 0, 0]);
+  w.close();
+});
+
+test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
+  const th = Math.PI / 6;
+  const n = [-Math.sin(th), 0, Math.cos(th)];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0, 0, 0]], { generate: 0, masses: [2] });
+  const pin = w.createSupport(0, [0, 0, 0], { support: 'plane', axis: n.map((c) => 2 * c) });
+  w.step(30);
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  const along = -(p[0] * Math.cos(th) + p[2] * Math.sin(th));
+  const exact = 9.81 * Math.sin(th) * h * h * steps * (steps + 1) / 2;
+  assert.ok(Math.abs(along - exact) < 1e-12 * exact);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  for (let k = 0; k < 3; k++) assert.ok(Math.abs(r[0].force[k] - 2 * 9.81 * Math.cos(th) * n[k]) < 1e-9 * 9.81);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'line', axis: [0, 0, 0] }), embra.EmbraError);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'curve' }));
+  w.close();
+});
+
 test('bulk rest and compliance arrays', () => {
   const w = new embra.World({ gravity: [0, 0, 0], iterations: 50 });
   w.createBody([[0, 0, 0], [1, 0, 0], [2, 0, 0]], { generate: 0, mass: 3.0 });

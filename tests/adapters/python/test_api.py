@@ -90,6 +90,58 @@ def test_equal_length_splits_a_pinned_line_evenly():
             assert abs(math.dist(p[3 * i:3 * i + 3], p[3 * i + 3:3 * i + 6]) - 0.25) < 1e-9
 
 
+def test_statics_two_bar_truss_forces_and_reactions():
+    """A load hung from two pins by two hard bars at 45 degrees: each bar carries the load over
+    2 sin 45 (tension, N), and the pins' reactions sum to minus every weight and point load."""
+    xyz = [(-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0)]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=4, iterations=20, damping=5.0, tethers=0,
+                     realign_passes=2) as w:
+        w.create_body(xyz, generate=0, masses=[1.0, 1.5, 2.0])
+        w.add_constraints("distance", [(0, 2), (1, 2)])
+        pins = [w.create_pin(0, xyz[0]), w.create_pin(1, xyz[1])]
+        w.set_loads([(0.0, 0.0, -10.0)], first=2)
+        assert list(flat(w.loads())) == [0.0] * 6 + [0.0, 0.0, -10.0]
+        w.step(200)
+        down = 2.0 * 9.81 + 10.0
+        for t in w.constraint_forces(w.default_group(), "distance"):
+            assert abs(t - down / math.sqrt(2.0)) < 1e-9 * down
+        r = w.reactions()
+        assert [x["pin"] for x in r] == pins and [x["particle"] for x in r] == [0, 1]
+        total = [sum(x["force"][k] for x in r) for k in range(3)]
+        assert abs(total[0]) < 1e-9 * down and abs(total[1]) < 1e-9 * down
+        assert abs(total[2] - (4.5 * 9.81 + 10.0)) < 1e-9 * down
+        with pytest.raises(embra.EmbraError):
+            w.constraint_forces(w.default_group(), "weld")
+        with pytest.raises((ValueError, embra.EmbraError)):
+            w.set_loads([(0.0, float("nan"), 0.0)], first=0)
+        assert list(flat(w.loads()))[:3] == [0.0, 0.0, 0.0]
+
+
+def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
+    """A particle on a frictionless plane inclined at 30 degrees: s_n = g sin(theta) h^2 n (n + 1) / 2
+    down the slope after n substeps (symplectic Euler, the plane projected exactly), and the
+    support's reaction is m g cos(theta) along the normal."""
+    th = math.pi / 6
+    n = (-math.sin(th), 0.0, math.cos(th))
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.0, 0.0, 0.0)], generate=0, masses=[2.0])
+        pin = w.create_support(0, (0.0, 0.0, 0.0), "plane", axis=[2 * c for c in n])
+        w.step(30)
+        steps, h = 300, (1.0 / 60.0) / 10
+        p = list(flat(w.positions()))
+        along = -(p[0] * math.cos(th) + p[2] * math.sin(th))
+        exact = 9.81 * math.sin(th) * h * h * steps * (steps + 1) / 2
+        assert abs(along - exact) < 1e-12 * exact
+        r = w.reactions()
+        assert r[0]["pin"] == pin
+        for k in range(3):
+            assert abs(r[0]["force"][k] - 2.0 * 9.81 * math.cos(th) * n[k]) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "line", axis=(0.0, 0.0, 0.0))
+        with pytest.raises(ValueError):
+            w.create_support(0, (0.0, 0.0, 0.0), "curve")
+
+
 def test_groups_bulk_constraints_and_reports():
     """A chain of 5 links added in bulk, hard, hanging from a pin: every link at its rest length."""
     xyz = [(0.1 * i, 0.0, 0.0) for i in range(6)]
@@ -294,7 +346,8 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_metric_summary": _capi.MetricSummary, "embra_panel_metrics": _capi.PanelMetrics,
                "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
-               "embra_load_options": _capi.LoadOptions}
+               "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
+               "embra_support_def": _capi.SupportDef}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
     assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",

@@ -112,11 +112,20 @@ struct ConstraintInfo {
   int32_t body = -1;  // the body that generated it (it follows the body's material), or -1: added
 };
 
+/// What a pin holds (the numbering is part of the C ABI: embra_pin_support). A plane or line
+/// support lets its particle slide, frictionless, on the plane through the target normal to `axis`
+/// or on the line through it along `axis`; a per-axis anchor (a roller) is a plane (one coordinate
+/// held: its axis the normal) or a line (two held: the third the line).
+enum class PinSupport : int32_t { point = 0, plane = 1, line = 2 };
+constexpr int kPinSupportCount = 3;
+
 struct PinDesc {
   int32_t particle = 0;
   Vec3 target = Vec3::Zero();
   double compliance = 0.0;  // 0 = hard (the particle follows the target exactly), else m/N
-  Id group;                 // group of a soft pin; null = the default group
+  Id group;                 // group of a soft pin or a support; null = the default group
+  PinSupport support = PinSupport::point;
+  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // plane: its normal; line: its direction (any length > 0)
 };
 
 /// The numbering is part of the C ABI (embra_collider_shape).
@@ -215,6 +224,13 @@ struct GroupConflict {
   double force = 0.0;     // N: over their shared particles, the smaller of the two groups' forces on
                           // each times how far they point against each other (-cos, where negative)
   int64_t particles = 0;  // particles where their forces point more than 120 degrees apart
+};
+
+/// The force a pin exerts on its particle after the last step (World::reactions).
+struct Reaction {
+  Id pin;
+  int32_t particle = 0;
+  Vec3 force = Vec3::Zero();  // N
 };
 
 struct StepReport {
@@ -388,9 +404,27 @@ struct Pin {
   Vec3 target_prev = Vec3::Zero();  // hard pin: its particle's position at the start of the frame
   double compliance = 0.0;
   Id group;
+  PinSupport support = PinSupport::point;
+  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // unit
   Vec3 lambda = Vec3::Zero();
   uint32_t generation = 0;
   bool alive = false;
+  /// A hard point pin: its particle is kinematic (inverse mass 0), carried to the target. Every
+  /// other pin (soft, or a support of any compliance) is projected in its group.
+  bool kinematic() const { return compliance == 0.0 && support == PinSupport::point; }
+  /// The part of d (the particle's offset from the target) the pin holds: all of it for a point,
+  /// its part along the normal for a plane, its part across the line for a line.
+  Vec3 held(const Vec3& d) const {
+    switch (support) {
+      case PinSupport::plane:
+        return axis.dot(d) * axis;
+      case PinSupport::line:
+        return d - axis.dot(d) * axis;
+      case PinSupport::point:
+        break;
+    }
+    return d;
+  }
 };
 
 /// A collider's pose moves along a straight path from where it was at the start of the frame to
@@ -558,6 +592,10 @@ class World {
   void set_clock(int64_t frame, double time);
   void set_positions(int32_t first, std::span<const double> xyz);
   void set_velocities(int32_t first, std::span<const double> xyz);
+  /// Point loads (N, xyz per particle) on particles [first, first + size / 3): forces applied every
+  /// substep beside gravity until changed; 0 by default. Each coordinate finite, |c| <= 1e300.
+  void set_loads(int32_t first, std::span<const double> xyz);
+  const std::vector<Vec3>& loads() const { return load_; }
 
   // --- fields (fields.hpp) -------------------------------------------------------------------
   Id create_field(const FieldDesc& desc);
@@ -583,6 +621,15 @@ class World {
   std::vector<GroupConflict> group_conflicts() const;
   /// The residual of every constraint of `kind` in `group`, in the group's ConstraintArray order.
   std::vector<double> constraint_residuals(Id group, Kind kind) const;
+  // Statics of the last step (solver/statics.cpp): forces from the last substep's multipliers.
+  /// The force of every constraint of `kind` in `group`, -lambda / h^2 of the last substep, in the
+  /// group's ConstraintArray order: for a distance or tether its tension (N, positive pulling the
+  /// ends together). Refused for a weld (three multipliers: its force is a vector).
+  std::vector<double> constraint_forces(Id group, Kind kind) const;
+  /// The force every live pin exerts on its particle (N), pins in slot order. A soft pin or a
+  /// sliding support: its multiplier over h^2. A hard point pin: minus the sum of the particle's weight, its point load
+  /// and the forces of every constraint, automatic tether and soft pin on it (the pin holds the rest).
+  std::vector<Reaction> reactions() const;
   const Warning& warning() const { return warning_; }
 
  private:
@@ -658,6 +705,7 @@ class World {
   std::vector<double> w_;         // solver: inverse mass with hard pins as 0
   std::vector<double> radius_;    // contact offset (half the body's thickness)
   std::vector<double> damping_;   // per-particle damping rate (1/s)
+  std::vector<Vec3> load_;        // per-particle point load (N)
   std::vector<double> mu_s_, mu_k_;
   std::vector<int32_t> body_of_;
   std::vector<int32_t> hard_pin_of_;  // pin slot or -1
