@@ -134,7 +134,8 @@ function positiveInteger(value, what) {
  * Starts a live server. options: {scene (path), host ('127.0.0.1'), port (0 = any free one),
  * web (folder of the built page), saveDir (the output folder), allowOrigins (extra origins a page
  * may come from, e.g. ['http://192.168.1.5:8710']), log (a function taking a line; default
- * stderr), and the bounds of DEFAULTS}. Resolves to {url, port, session, limits, connections() (the
+ * stderr), waitForPage (default true: no frame is stepped before the first page connects), and
+ * the bounds of DEFAULTS}. Resolves to {url, port, session, limits, connections() (the
  * WebSocket connections open), close()}.
  */
 function startServer(options) {
@@ -167,6 +168,8 @@ function startServer(options) {
   let timer = null;
   let closed = false;
   let next = 0;
+  // Paused until a page connects: a page opened a while after launch sees the scene from frame 0.
+  let waiting = options.waitForPage !== false;
 
   const send = (ws, message) => {
     if (ws.readyState !== ws.OPEN) return;
@@ -208,7 +211,7 @@ function startServer(options) {
     timer = null;
     if (closed) return;
     const now = performance.now();
-    if (!session.paused) {
+    if (!session.paused && !waiting) {
       try {
         stepAndSend();
       } catch (e) {
@@ -256,6 +259,10 @@ function startServer(options) {
 
   wss.on('connection', (ws, req) => {
     clients.add(ws);
+    if (waiting) {
+      waiting = false;
+      next = performance.now();
+    }
     log(`page connected from ${req.socket.remoteAddress}`);
     const bucket = new Bucket(limits.messagesPerSecond, limits.messageBurst);
     // Messages over the rate are dropped unread; the page hears of them in one `error` a second at
@@ -338,6 +345,8 @@ function startServer(options) {
         session,
         limits,
         connections: () => sockets,
+        /** True until the first page connects (the clock does not step before). */
+        waiting: () => waiting,
         close: () => new Promise((done) => {
           closed = true;
           if (timer) clearTimeout(timer);

@@ -11,7 +11,18 @@ const { World, EmbraError, NumericalError } = require('../lib');
 const { fieldColors, toGltf, to3dm } = require('../lib/export');
 
 const FIELDS = ['planarity', 'thickness', 'miter'];
-const DRAG_COMPLIANCE = 1e-6; // m/N: a soft pin firm enough to lead, soft enough not to tear
+/**
+ * A drag is a soft pin in the default group, whose soft pins are projected before its welds and
+ * panel constraints in every pass, so the panels correct last. Its compliance and its reach (the
+ * drag pin's target is kept within DRAG_REACH times the scene's diagonal of the particle, however far
+ * the cursor goes) bound its pull: on the POQ drape (docs/live-protocol.md) the panels stay within
+ * their tolerances' max during a 150 px drag.
+ */
+const DRAG_COMPLIANCE = 2e-5; // m/N
+const DRAG_REACH = 0.1; // of the scene's diagonal at load
+const DRAG_BACK_OFF = 0.3; // of a tolerance's max: above it the drags' reach halves each frame
+const DRAG_EASE = 0.2; // of a tolerance's max: below it the drags' reach grows back
+const DRAG_GAIN_START = 0.05; // a new drag's reach, of DRAG_REACH: it grows from there
 const MAGIC = 0x464d4245; // 'EBMF' little-endian
 /**
  * A page's coordinates (drag targets, collider positions) are places in the scene: within its
@@ -86,6 +97,7 @@ class Session {
     this.pinsOn = true;
     this.drags = new Map(); // page -> {pin, particle}: each page holds at most one drag
     this.lastMs = 0;
+    this.dragGain = 1; // the drags' reach, as a fraction of dragReach (#adaptDrag)
     const saved = JSON.parse(world.saveJson());
     this.name = saved.name || path.basename(this.scenePath, '.json');
     this.description = saved.description || '';
@@ -152,7 +164,9 @@ class Session {
       lo.fill(0);
       hi.fill(0);
     }
-    const reach = WORKSPACE_REACH * Math.max(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]), 1);
+    const diagonal = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    this.dragReach = DRAG_REACH * Math.max(diagonal, 1e-9);
+    const reach = WORKSPACE_REACH * Math.max(diagonal, 1);
     return { min: lo.map((v) => v - reach), max: hi.map((v) => v + reach) };
   }
 
@@ -194,9 +208,34 @@ class Session {
     this.record = record;
   }
 
+  /** Moves a drag pin's target toward the cursor, at most dragReach from its particle. */
+  #leadDrag(drag) {
+    const at = this.positions.subarray(3 * drag.particle, 3 * drag.particle + 3);
+    const d = drag.target.map((v, k) => v - at[k]);
+    const length = Math.hypot(...d);
+    const reach = this.dragReach * this.dragGain;
+    const f = length > reach ? reach / length : 1;
+    this.world.setPinTarget(drag.pin, d.map((v, k) => at[k] + f * v));
+  }
+
+  /**
+   * The drags' reach shrinks while a panel metric nears its tolerance's max (above DRAG_BACK_OFF of
+   * it: halved each frame) and grows back (by a quarter a frame, up to DRAG_REACH) below DRAG_EASE.
+   */
+  #adaptDrag() {
+    const r = this.record;
+    if (r.planarity_max === undefined) return;
+    const t = this.tolerances;
+    const worst = Math.max(r.planarity_max / t.planarity.max, r.thickness_error_max / t.thickness.max,
+                           r.miter_error_max / t.miter.max);
+    if (worst > DRAG_BACK_OFF) this.dragGain *= 0.5;
+    else if (worst < DRAG_EASE) this.dragGain = Math.min(1, this.dragGain * 1.25);
+  }
+
   /** Advances one frame. A numerical failure (the world restored to before the step) pauses. */
   step() {
     const t0 = process.hrtime.bigint();
+    for (const drag of this.drags.values()) this.#leadDrag(drag);
     try {
       this.world.step();
     } catch (e) {
@@ -207,6 +246,7 @@ class Session {
     }
     this.lastMs = Number(process.hrtime.bigint() - t0) / 1e6;
     this.#measure();
+    this.#adaptDrag();
     return null;
   }
 
@@ -279,19 +319,39 @@ class Session {
         const target = this.#point(msg.target, 'target');
         const pin = w.createPin(msg.particle, target, { compliance: DRAG_COMPLIANCE });
         this.releaseDrag(page);
-        this.drags.set(page, { pin, particle: msg.particle });
+        this.drags.set(page, { pin, particle: msg.particle, target: [...target] });
+        this.dragGain = Math.min(this.dragGain, DRAG_GAIN_START);
         return {};
       }
       case 'drag': {
         const target = this.#point(msg.target, 'target');
         const drag = this.drags.get(page);
         if (!drag) refuse('drag without drag_start');
-        w.setPinTarget(drag.pin, target);
+        drag.target = [...target]; // the pin's target follows it at the next step (#leadDrag)
         return {};
       }
-      case 'drag_end':
+      case 'drag_end': {
+        const pinHere = msg.pin === undefined ? false : bool(msg.pin, 'pin');
+        const drag = this.drags.get(page);
+        if (!pinHere || !drag) {
+          this.releaseDrag(page);
+          return {};
+        }
+        // "Pin here": the drag's soft pin becomes a hard pin of the scene at the release point.
+        const { target } = drag;
         this.releaseDrag(page);
-        return {};
+        if (!this.pinsOn) refuse('the scene\'s pins are off: turn them on to pin here');
+        const index = this.pins.length;
+        const id = w.createPin(drag.particle, target);
+        this.pins.push({ id, index, name: `pin_here_${index}`, particle: drag.particle, compliance: 0, group: undefined });
+        return { scene: true };
+      }
+      case 'pin_target': {
+        if (!this.pinsOn) refuse('the scene\'s pins are off');
+        const p = indexIn(msg.index, this.pins, 'pin');
+        w.setPinTarget(p.id, this.#point(msg.target, 'target'));
+        return {}; // the dot follows its particle in the frames; the next scene message has the target
+      }
       case 'collider_pose': {
         const c = indexIn(msg.index, this.colliders, 'collider');
         const position = this.#point(msg.position, 'position');
@@ -430,13 +490,13 @@ class Session {
   /** The scene JSON of the current state without the pages' drag pins (a design, not a gesture). */
   #saveWithoutDrags() {
     const w = this.world;
-    const held = [...this.drags.entries()].map(([page, d]) => [page, d.particle, w.pinTarget(d.pin)]);
+    const held = [...this.drags.entries()].map(([page, d]) => [page, d, w.pinTarget(d.pin)]);
     for (const [page] of held) this.releaseDrag(page);
     try {
       return w.saveJson();
     } finally {
-      for (const [page, particle, target] of held)
-        this.drags.set(page, { pin: w.createPin(particle, target, { compliance: DRAG_COMPLIANCE }), particle });
+      for (const [page, d, at] of held)
+        this.drags.set(page, { ...d, pin: w.createPin(d.particle, at, { compliance: DRAG_COMPLIANCE }) });
     }
   }
 
@@ -461,4 +521,4 @@ class Session {
   }
 }
 
-module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, WORKSPACE_REACH, KEEP_FILES, outputStem };
+module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, WORKSPACE_REACH, KEEP_FILES, outputStem };

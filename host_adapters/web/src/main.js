@@ -14,6 +14,7 @@ import { base64Blob, basename, download, droppedFiles } from './files.js';
 
 const PLAIN = [0.86, 0.84, 0.8]; // metric "none": the geometry alone
 const $ = (id) => document.getElementById(id);
+const ROWS_KEPT = 600; // frame rows kept for embraView.rows
 
 const state = {
   mode: 'starting',
@@ -21,6 +22,8 @@ const state = {
   scene: null,
   frame: null,
   framesReceived: 0,
+  firstFrame: null, // the number of the first frame received from the server
+  rows: [], // the last ROWS_KEPT frame rows received (the server's metrics of each frame)
   fps: 0,
   positions: null,
   fields: {},
@@ -104,7 +107,7 @@ function applyScene(scene) {
       send({ type: 'drag_end' });
       view.showDrag(null, null);
     }
-    else view.heldCollider = -1;
+    else if (pointer.drag.kind === 'collider') view.heldCollider = -1;
     pointer.drag = null;
     view.controls.enabled = true;
   }
@@ -176,6 +179,9 @@ function startLive() {
     frame(row, geometry) {
       if (!state.scene || geometry.particles !== state.scene.particles) return;
       state.framesReceived += 1;
+      if (state.firstFrame === null) state.firstFrame = geometry.frame;
+      state.rows.push(row);
+      if (state.rows.length > ROWS_KEPT) state.rows.shift();
       const now = performance.now();
       receivedAt.push(now);
       while (receivedAt.length && receivedAt[0] < now - 1000) receivedAt.shift();
@@ -299,6 +305,9 @@ function onPointerDown(e) {
       offset: position.sub(hit.point), pending: null, pointerId: e.pointerId,
     };
     view.heldCollider = hit.index;
+  } else if (view.pickPin(e.clientX, e.clientY)) {
+    const hit = view.pickPin(e.clientX, e.clientY);
+    pointer.drag = { kind: 'pin', index: hit.index, plane: view.cameraPlane(hit.point), pending: null, pointerId: e.pointerId };
   } else {
     const hit = view.pickParticle(e.clientX, e.clientY);
     if (!hit) return;
@@ -324,13 +333,16 @@ function onPointerMove(e) {
   if (e.buttons === 0) pointer.hover = { x: e.clientX, y: e.clientY };
 }
 
-function onPointerUp() {
+function onPointerUp(e) {
   const drag = pointer.drag;
   if (!drag) return;
   flushDrag();
   if (drag.kind === 'particle') {
-    send({ type: 'drag_end' });
+    const pin = $('pin-here').checked || e.altKey;
+    send(pin ? { type: 'drag_end', pin: true } : { type: 'drag_end' });
     view.showDrag(null, null);
+  } else if (drag.kind === 'pin') {
+    // the dot follows its particle, which the hard pin carries to the target
   } else {
     view.heldCollider = -1;
   }
@@ -348,6 +360,8 @@ function flushDrag() {
   if (drag.kind === 'particle') {
     send({ type: 'drag', target: [point.x, point.y, point.z] });
     view.showDrag(drag.particle, point);
+  } else if (drag.kind === 'pin') {
+    send({ type: 'pin_target', index: drag.index, target: [point.x, point.y, point.z] });
   } else {
     const position = point.clone().add(drag.offset);
     view.moveCollider(drag.index, position);
@@ -564,6 +578,9 @@ window.embraView = {
   get connected() { return state.connected; },
   get frame() { return state.frame; },
   get framesReceived() { return state.framesReceived; },
+  get firstFrame() { return state.firstFrame; },
+  /** The last frame rows received (up to 600), oldest first. */
+  get rows() { return state.rows; },
   get fps() { return state.fps; },
   get positions() { return state.positions; },
   get plotPoints() { return plot.points; },
@@ -571,6 +588,8 @@ window.embraView = {
   get lastError() { return state.lastError; },
   /** The particle a mouse drag holds (null when none). */
   get dragParticle() { return pointer.drag?.kind === 'particle' ? pointer.drag.particle : null; },
+  /** The scene pin whose dot a mouse drag holds (null when none). */
+  get dragPin() { return pointer.drag?.kind === 'pin' ? pointer.drag.index : null; },
   get metric() { return state.metric; },
   get fields() { return state.fields; },
   /** The colour attribute's array (3 floats per particle, errorColor's values). */

@@ -381,6 +381,14 @@ export class View {
   }
 
   /** The collider under the cursor: its index and the hit point, or null. */
+  /** The scene pin whose dot is under the cursor ({index, point}), or null. */
+  pickPin(clientX, clientY) {
+    if (!this.pinGroup.visible) return null;
+    this.ray(clientX, clientY);
+    const hit = this.raycaster.intersectObjects(this.pins, false)[0];
+    return hit ? { index: this.pins.indexOf(hit.object), point: hit.object.position.clone() } : null;
+  }
+
   pickCollider(clientX, clientY) {
     this.ray(clientX, clientY);
     const hit = this.raycaster.intersectObjects(this.colliders, false)[0];
