@@ -145,3 +145,64 @@ test('a pin dot dragged moves its pin, and its particle follows', async () => {
   assert.ok(off < 1e-3, `${off} m from the moved target`);
   assert.deepEqual(pageErrors, []);
 });
+
+test('at 1280 x 720 the help line is whole and inside the view; numbers carry units', async () => {
+  const box = await view(() => {
+    const help = document.getElementById('help-live');
+    const side = document.getElementById('side').getBoundingClientRect();
+    const r = help.getBoundingClientRect();
+    return { x: r.x, y: r.y, right: r.right, bottom: r.bottom, w: innerWidth, h: innerHeight,
+             sideTop: side.top, sideBottom: side.bottom, clipped: help.scrollHeight > help.clientHeight || help.scrollWidth > help.clientWidth,
+             text: help.textContent, hud: document.getElementById('hud').textContent,
+             legend: document.getElementById('legend').textContent };
+  });
+  const shot = process.env.EMBRA_SCREENSHOT_DIR ? path.join(process.env.EMBRA_SCREENSHOT_DIR, 'live_1280x720.png') : path.join(tmp, 'live_1280x720.png');
+  await page.screenshot({ path: shot });
+  console.log(`help line at ${JSON.stringify(box)}; screenshot ${shot}`);
+  assert.equal(box.w, 1280);
+  assert.equal(box.h, 720);
+  assert.ok(box.x >= 0 && box.right <= box.w && box.y >= box.sideTop && box.bottom <= Math.min(box.h, box.sideBottom), JSON.stringify(box));
+  assert.equal(box.clipped, false);
+  assert.match(box.text, /pin here/);
+  assert.match(box.hud, /mrad/); // planarity (fold angle) and miter
+  assert.match(box.hud, /\d mm/); // thickness
+  assert.doesNotMatch(box.hud, /mm\/m/);
+  assert.match(box.legend, /target [\d.e+-]+ mrad/);
+});
+
+test('what fights: a cable pulled by two soft pins in two groups lists them first and colours the particle', async () => {
+  const { startServer } = require(path.join(source, 'host_adapters', 'node', 'live', 'server.js'));
+  const tug = await startServer({
+    scene: path.join(source, 'tests', 'web', 'scenes', 'tug.json'), host: '127.0.0.1', port: 0,
+    web: path.join(web, 'dist'), saveDir: tmp, log: () => {},
+  });
+  const other = await context.newPage();
+  try {
+    other.on('pageerror', (err) => pageErrors.push(err.message));
+    await other.goto(tug.url);
+    await other.waitForFunction(() => embraView.fights && embraView.fights.frame >= 120, null, { timeout: 60000 });
+    const f = await other.evaluate(() => embraView.fights);
+    const listed = await other.$$eval('#fights-list li', (els) => els.map((e) => e.textContent));
+    const pairs = await other.$$eval('#fights-conflicts li', (els) => els.map((e) => e.textContent));
+    console.log(`fights at frame ${f.frame}: ${listed.slice(0, 2).join(' | ')}; ${pairs[0]}`);
+    assert.deepEqual(f.worst.slice(0, 2).map((c) => c.pin).sort(), ['pull_left', 'pull_right']);
+    for (const c of f.worst.slice(0, 2)) {
+      assert.deepEqual(c.particles, [0]);
+      assert.equal(c.unit, 'm');
+      assert.ok(Math.abs(c.violation - 0.5) < 0.05, `${c.pin} off ${c.violation} m`);
+      assert.ok(Math.abs(c.force - 500) < 50, `${c.pin} ${c.force} N`);
+    }
+    assert.match(listed[0], /^pin pull_(left|right) · (left|right) · particles 0 · off 0\.5\d* m, 5\d\d N$/);
+    assert.deepEqual([f.conflicts[0].a, f.conflicts[0].b], ['left', 'right']);
+    assert.match(pairs[0], /^left against right: \d+ N on 1 particle$/);
+    await other.selectOption('#metric', 'fights');
+    const colors = await other.evaluate(() => Array.from(embraView.colors));
+    assert.ok(colors[1] < 0.2 && colors[0] > 0.6, `particle 0 full magenta: ${colors.slice(0, 3)}`);
+    // The free end's link stretches by micrometres at tens of newtons: 6 decades below, the lightest.
+    assert.ok(colors[3 * 10 + 1] > 0.7, `the free end light: ${colors.slice(30, 33)}`);
+  } finally {
+    await other.close();
+    await tug.close();
+  }
+  assert.deepEqual(pageErrors, []);
+});

@@ -30,7 +30,8 @@ const FRAME_SKIP_BYTES = 4 * 1024 * 1024; // a page further behind than this ski
 const CLOSE_BEHIND_BYTES = 64 * 1024 * 1024; // a page this far behind (not reading its replies) is closed
 const HTTP_EXTRA_SOCKETS = 16; // sockets beyond maxConnections for page loads (server.maxConnections)
 const REQUEST_TIMEOUT_MS = 10000; // an http request (or a WebSocket handshake) must arrive within this
-const HEAVY = new Set(['save', 'export', 'reset']);
+const FIGHTS_EVERY = 10; // frames between `fights` messages
+const HEAVY = new Set(['save', 'export', 'export_all', 'reset']);
 const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8',
                 '.css': 'text/css; charset=utf-8', '.json': 'application/json', '.png': 'image/png',
                 '.map': 'application/json', '.svg': 'image/svg+xml' };
@@ -194,6 +195,11 @@ function startServer(options) {
     const record = JSON.stringify(session.frameMessage());
     const geometry = Buffer.from(session.geometryMessage());
     for (const ws of clients) sendFrame(ws, record, geometry);
+    // What fights, every FIGHTS_EVERY frames and at every frame stepped while paused.
+    if (session.paused || session.record.frame % FIGHTS_EVERY === 0) {
+      const fights = JSON.stringify(session.fightsMessage());
+      for (const ws of clients) if (ws.bufferedAmount <= FRAME_SKIP_BYTES) send(ws, fights);
+    }
   };
   const stepAndSend = () => {
     const problem = session.step();

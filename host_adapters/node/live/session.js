@@ -32,6 +32,8 @@ const MAGIC = 0x464d4245; // 'EBMF' little-endian
  * next step fail and one pulled to 1e30 flings the mesh beyond what a frame's float32 can carry.
  */
 const WORKSPACE_REACH = 1000;
+const FIGHTS_LISTED = 10; // constraints listed in a `fights` message
+const FIGHTS_COLOURED = 64; // constraints whose particles a `fights` message colours
 /** Output files kept per scene in the output folder (the oldest deleted beyond it), by default. */
 const KEEP_FILES = 100;
 const OUTPUT_KINDS = ['json', 'gltf', '3dm'];
@@ -279,6 +281,40 @@ class Session {
     return this.record;
   }
 
+  /**
+   * What fights in the last step (docs/live-protocol.md, `fights`): the FIGHTS_LISTED worst
+   * constraints and soft pins (embra_world_get_worst_constraints: ranked by violation x force) with
+   * their group's and pin's names, the pairs of groups pulling against each other
+   * (embra_world_get_group_conflicts), and per particle the largest energy (violation x force, J)
+   * of the FIGHTS_COLOURED worst constraints it is in, as [particle, energy] pairs.
+   */
+  fightsMessage() {
+    const w = this.world;
+    const same = (a, b) => a && b && a.index === b.index && a.generation === b.generation;
+    const groupName = (id) => (this.groups.find((g) => same(g.id, id)) || { name: `group ${id.index}` }).name;
+    const pinName = (id) => {
+      if (!id) return null;
+      const scene = this.pins.find((p) => this.pinsOn && same(p.id, id));
+      if (scene) return scene.name;
+      return [...this.drags.values()].some((d) => same(d.pin, id)) ? 'drag' : `pin ${id.index}`;
+    };
+    const all = w.worstConstraints(FIGHTS_COLOURED);
+    const energy = new Map();
+    for (const c of all) {
+      const e = Math.abs(c.violation * c.force);
+      for (const p of c.particles) energy.set(p, Math.max(energy.get(p) || 0, e));
+    }
+    return {
+      type: 'fights', frame: this.record.frame,
+      worst: all.slice(0, FIGHTS_LISTED).map((c) => ({
+        kind: c.kind, group: groupName(c.group), index: c.index, pin: pinName(c.pin), particles: c.particles,
+        residual: c.residual, violation: c.violation, unit: c.unit, force: c.force,
+      })),
+      conflicts: w.groupConflicts().map((c) => ({ a: groupName(c.a), b: groupName(c.b), force: c.force, particles: c.particles })),
+      energy: [...energy.entries()],
+    };
+  }
+
   statusMessage() {
     return { type: 'status', paused: this.paused, gravity_on: this.gravityOn, pins_on: this.pinsOn };
   }
@@ -410,7 +446,7 @@ class Session {
       case 'save': {
         const json = this.#saveWithoutDrags();
         const file = this.writeOutput('json', json, this.record.frame);
-        return { replies: [{ type: 'saved', path: file, json }] };
+        return { replies: [{ type: 'saved', frame: this.record.frame, path: file, json }] };
       }
       case 'export': {
         if (msg.format !== 'gltf' && msg.format !== '3dm') refuse('format must be "gltf" or "3dm"');
@@ -419,7 +455,24 @@ class Session {
         const frame = this.record.frame;
         return this.exportBytes(msg.format, metric).then((bytes) => {
           const file = this.writeOutput(msg.format, bytes, frame);
-          return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
+          return { replies: [{ type: 'exported', format: msg.format, metric, frame, path: file, base64: bytes.toString('base64') }] };
+        });
+      }
+      case 'export_all': {
+        // The scene JSON, the glTF and the .3dm of one frame: each snapshot is taken here, before
+        // the server's clock can step again.
+        const metric = msg.metric ?? 'planarity';
+        if (!FIELDS.includes(metric)) refuse(`metric must be one of ${FIELDS.join(', ')}`);
+        const frame = this.record.frame;
+        const json = this.#saveWithoutDrags();
+        const gltf = this.exportBytes('gltf', metric);
+        const rhino = this.exportBytes('3dm', metric);
+        return Promise.all([gltf, rhino]).then(([g, r]) => {
+          const saved = { type: 'saved', frame, path: this.writeOutput('json', json, frame), json };
+          const files = [['gltf', g], ['3dm', r]].map(([format, bytes]) => ({
+            type: 'exported', format, metric, frame, path: this.writeOutput(format, bytes, frame), base64: bytes.toString('base64'),
+          }));
+          return { replies: [saved, ...files] };
         });
       }
       default:
@@ -521,4 +574,4 @@ class Session {
   }
 }
 
-module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, WORKSPACE_REACH, KEEP_FILES, outputStem };
+module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, FIGHTS_LISTED, WORKSPACE_REACH, KEEP_FILES, outputStem };

@@ -3,10 +3,10 @@
 // docs/live-protocol.md is the contract with the server; window.embraView is the tests' view.
 
 import './style.css';
-import { errorColor } from '../../node/lib/colors.js';
+import { errorColor, GREY } from '../../node/lib/colors.js';
 import { View } from './view.js';
 import { Plot } from './plot.js';
-import { Hud, mm, sci } from './hud.js';
+import { Hud, inUnits } from './hud.js';
 import { renderLegend } from './legend.js';
 import { LiveClient, liveUrl } from './live.js';
 import { folderFromFiles, folderFromUrl, openReplay } from './replay.js';
@@ -23,6 +23,7 @@ const state = {
   frame: null,
   framesReceived: 0,
   firstFrame: null, // the number of the first frame received from the server
+  fights: null, // the last `fights` message, with energyOf (a Map) and maxEnergy
   rows: [], // the last ROWS_KEPT frame rows received (the server's metrics of each frame)
   fps: 0,
   positions: null,
@@ -59,7 +60,21 @@ function showError(message) {
 
 // --- colours and numbers ---------------------------------------------------------------------
 
+/**
+ * Metric "fights": a particle in one of the worst constraints of the last `fights` message shaded
+ * from light to full magenta on a log scale of its energy (violation x force) over 6 decades below
+ * the largest; every other particle grey.
+ */
+function fightColor(i) {
+  const f = state.fights;
+  const e = f?.energyOf.get(i);
+  if (!e || !(f.maxEnergy > 0)) return GREY;
+  const s = Math.min(1, Math.max(0, 1 + Math.log10(e / f.maxEnergy) / 6));
+  return [0.95 - 0.25 * s, 0.75 - 0.65 * s, 0.95 - 0.2 * s];
+}
+
 function colorOf(i) {
+  if (state.metric === 'fights') return fightColor(i);
   const values = state.fields[state.metric];
   if (state.metric === 'none' || !values) return PLAIN;
   return errorColor(state.metric, values[i], state.scene.tolerances[state.metric]);
@@ -122,8 +137,12 @@ function applyScene(scene) {
   $('scene-name').title = scene.description || '';
   document.title = `embra · ${scene.name}`;
   const select = $('metric');
-  for (const option of select.options) option.disabled = option.value !== 'none' && !scene.fields.includes(option.value);
-  const metric = scene.fields.includes(state.metric) ? state.metric : scene.fields[0] || 'none';
+  const fights = state.mode === 'live' || state.mode === 'connecting';
+  for (const option of select.options) {
+    option.disabled = option.value === 'fights' ? !fights : option.value !== 'none' && !scene.fields.includes(option.value);
+  }
+  const keep = scene.fields.includes(state.metric) || (state.metric === 'fights' && fights);
+  const metric = keep ? state.metric : scene.fields[0] || 'none';
   setMetric(metric);
   // An edit (pins, a weight) re-sends the same scene: the history stays; a reset shows in the plot
   // as a frame going back, which plot.push handles.
@@ -192,6 +211,7 @@ function startLive() {
       state.positions = geometry.positions;
     },
     status: setStatus,
+    fights: showFights,
     saved(msg) {
       download(basename(msg.path) || `${state.scene?.name || 'scene'}-${state.frame}.json`,
         new Blob([msg.json], { type: 'application/json' }));
@@ -207,6 +227,35 @@ function startLive() {
       showError(msg.message);
     },
   });
+}
+
+const fmt = (v) => (Math.abs(v) >= 0.01 && Math.abs(v) < 1e4 ? String(Number(v.toPrecision(3))) : v.toExponential(2));
+const FORCE_UNIT = { m: 'N', rad: 'N m', 'm^3': 'N/m^2' };
+
+/** The `fights` message: the worst constraints and the groups pulling against each other. */
+function showFights(msg) {
+  const energyOf = new Map(msg.energy);
+  let maxEnergy = 0;
+  for (const e of energyOf.values()) maxEnergy = Math.max(maxEnergy, e);
+  state.fights = { ...msg, energyOf, maxEnergy };
+  const list = $('fights-list');
+  list.textContent = '';
+  for (const c of msg.worst) {
+    const li = document.createElement('li');
+    const what = c.pin ? `pin ${c.pin}` : `${c.kind} #${c.index}`;
+    li.textContent = `${what} · ${c.group} · particles ${c.particles.join(', ')} · off ${fmt(c.violation)} ${c.unit}, ` +
+      `${fmt(c.force)} ${FORCE_UNIT[c.unit] || 'N'}`;
+    list.appendChild(li);
+  }
+  const pairs = $('fights-conflicts');
+  pairs.textContent = '';
+  for (const c of msg.conflicts.filter((x) => x.particles > 0)) {
+    const li = document.createElement('li');
+    li.textContent = `${c.a} against ${c.b}: ${fmt(c.force)} N on ${c.particles} particle${c.particles === 1 ? '' : 's'}`;
+    pairs.appendChild(li);
+  }
+  $('fights-panel').hidden = false;
+  if (state.metric === 'fights') recolor();
 }
 
 function setStatus(msg) {
@@ -285,9 +334,10 @@ function wireLiveControls() {
   $('gravity').addEventListener('change', (e) => send({ type: 'gravity', on: e.target.checked }));
   $('pins').addEventListener('change', (e) => send({ type: 'pins', on: e.target.checked }));
   $('save').addEventListener('click', () => send({ type: 'save' }));
-  const metricForExport = () => (state.metric === 'none' ? state.scene?.fields[0] || 'planarity' : state.metric);
+  const metricForExport = () => (state.metric === 'none' || state.metric === 'fights' ? state.scene?.fields[0] || 'planarity' : state.metric);
   $('export-gltf').addEventListener('click', () => send({ type: 'export', format: 'gltf', metric: metricForExport() }));
   $('export-3dm').addEventListener('click', () => send({ type: 'export', format: '3dm', metric: metricForExport() }));
+  $('export-all').addEventListener('click', () => send({ type: 'export_all', metric: metricForExport() }));
 }
 
 // --- mouse: drag a particle, shift-drag a collider, hover readout -----------------------------
@@ -389,8 +439,7 @@ function updateHover() {
       parts.push(`${name} –`);
       continue;
     }
-    const length = name !== 'planarity' ? ` (${mm(v * (tol.unit_scale ?? 1))} mm/m)` : '';
-    parts.push(`${name} ${sci(v)}${length}${tol[name] && v > tol[name].target ? ' ▲' : ''}`);
+    parts.push(`${name} ${inUnits(name, v, tol)}${tol[name] && v > tol[name].target ? ' ▲' : ''}`);
   }
   el.textContent = parts.join('  ·  ');
   el.hidden = false;
@@ -592,9 +641,13 @@ window.embraView = {
   get dragPin() { return pointer.drag?.kind === 'pin' ? pointer.drag.index : null; },
   get metric() { return state.metric; },
   get fields() { return state.fields; },
+  /** The last `fights` message (null before one arrives). */
+  get fights() { return state.fights; },
   /** The colour attribute's array (3 floats per particle, errorColor's values). */
   get colors() { return view.color ? view.color.array : null; },
   get vertexCount() { return view.position ? view.position.count : 0; },
+  /** Edges drawn as lines (edge-only bodies: `l` lines of a replay's OBJ). */
+  get edgeCount() { return view.edgeLines.reduce((n, l) => n + l.geometry.index.count / 2, 0); },
   get triangleCount() { return view.meshes.reduce((n, m) => n + m.geometry.index.count / 3, 0); },
   /** Replay: the frame numbers the slider steps through, and the shown one's index. */
   get replayFrames() { return state.replay ? state.replay.frames.map((f) => f.frame) : []; },

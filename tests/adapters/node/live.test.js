@@ -342,3 +342,38 @@ test('the embra-live command: usage errors exit 1, an invalid scene exits 2 nami
   const missing = run('/nonexistent/scene.json', '--port', '0');
   assert.equal(missing.status, 2, missing.stderr);
 });
+
+test('export_all while running: the scene JSON, the glTF and the .3dm of one frame', async () => {
+  send(page, { type: 'pause', paused: false });
+  await next(page, geometryFrom(live.session.record.frame + 5), 'frames while running');
+  const mark = page.inbox.length;
+  send(page, { type: 'export_all', metric: 'thickness' });
+  // The replies come in this order, at once: the scene JSON, the glTF, the .3dm.
+  const rhinoMsg = await next(page, (m) => m.type === 'exported' && m.format === '3dm', 'the .3dm', 30000);
+  const replies = page.inbox.slice(mark).filter((m) => m.type === 'saved' || m.type === 'exported');
+  assert.deepEqual(replies.map((m) => m.format || m.type), ['saved', 'gltf', '3dm']);
+  const [saved, gltfMsg] = replies;
+  const { frame } = saved;
+  await next(page, geometryFrom(frame + 1), 'the world stepping on');
+  await paused(page);
+  assert.equal(gltfMsg.frame, frame);
+  assert.equal(rhinoMsg.frame, frame);
+  for (const m of [saved, gltfMsg, rhinoMsg]) assert.match(path.basename(m.path), new RegExp(`-f${String(frame).padStart(5, '0')}\\.`));
+  // The three hold the same positions: the saved scene's, as floats in the glTF and the .3dm.
+  const again = embra.World.loadJson(saved.json, path.dirname(scene));
+  const positions = again.positions();
+  again.close();
+  const used = Array.from(new Set(live.session.bodies[0].triangles)).sort((a, b) => a - b);
+  const gltf = JSON.parse(Buffer.from(gltfMsg.base64, 'base64').toString());
+  const data = Buffer.from(gltf.buffers[0].uri.split(',')[1], 'base64');
+  const acc = gltf.accessors[gltf.meshes[0].primitives[0].attributes.POSITION];
+  const view = gltf.bufferViews[acc.bufferView];
+  const pos = new Float32Array(data.buffer.slice(data.byteOffset + view.byteOffset, data.byteOffset + view.byteOffset + view.byteLength));
+  const [mesh] = await read3dm(Buffer.from(rhinoMsg.base64, 'base64'));
+  used.forEach((p, i) => {
+    for (let k = 0; k < 3; ++k) {
+      assert.equal(pos[3 * i + k], Math.fround(positions[3 * p + k]), `glTF vertex ${i}`);
+      assert.equal(mesh.positions[3 * i + k], Math.fround(positions[3 * p + k]), `.3dm vertex ${i}`);
+    }
+  });
+});
