@@ -91,7 +91,9 @@ test('a mouse drag on a panel corner pulls it; the streamed positions and the er
   await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.05, [particle, start.z], { timeout: 30000 });
   // The world itself moved (the page drew what the server streamed), read while the drag still holds
   // it: once released the corner falls back, and on a loaded machine the server may be frames ahead.
-  assert.ok(live.session.positions[3 * particle + 2] > serverZ + 0.05);
+  const rose = () => live.session.positions[3 * particle + 2] > serverZ + 0.05;
+  for (let k = 0; k < 200 && !rose(); k++) await new Promise((resolve) => setTimeout(resolve, 50));
+  assert.ok(rose(), `the world's particle at ${live.session.positions[3 * particle + 2]}, from ${serverZ}`);
   await page.mouse.up();
   // The plot kept growing.
   await page.waitForFunction((n) => embraView.plotPoints > n + 10, start.plot, { timeout: 20000 });

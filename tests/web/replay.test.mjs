@@ -164,8 +164,8 @@ test('the slider moves the frame; the geometry is that frame\'s OBJ', async () =
     .find((r) => r.frame === 180);
   assert.equal(await page.textContent('.hud-frame .hud-number'), '180');
   assert.equal(await page.textContent('.hud-thickness .hud-number'), row.thickness_error_max.toExponential(2));
-  const mmPerM = Number(String(row.thickness_error_max * 1250).slice(0, 8)); // unit_scale 1250
-  assert.match(await page.textContent('.hud-thickness .hud-unit'), /^[0-9.]+ mm\/m$/);
+  const mmPerM = Number(String(row.thickness_error_max * 1250).slice(0, 8)); // unit_scale 1250: mm
+  assert.match(await page.textContent('.hud-thickness .hud-unit'), /^[0-9.]+ mm$/);
   assert.ok(Math.abs(parseFloat(await page.textContent('.hud-thickness .hud-unit')) - mmPerM) < 5e-3 * mmPerM);
   assert.equal(await page.textContent('.hud-within .hud-number'), row.within_tolerance ? 'yes' : 'no');
 });
