@@ -199,6 +199,9 @@ test('bad messages are refused with a reason and change nothing', async () => {
     { type: 'rest_scale', body: 0, scale: -1 }, { type: 'rest_scale', body: 3, scale: 1 },
     { type: 'pause', paused: 'no' }, { type: 'export', format: 'stl' },
     { type: 'export', format: 'gltf', metric: 'beauty' },
+    { type: 'export_all', metric: 'beauty' }, { type: 'drag_end', pin: 'yes' },
+    { type: 'pin_target', index: 4, target: [0, 0, 0] }, { type: 'pin_target', index: -1, target: [0, 0, 0] },
+    { type: 'pin_target', index: 0, target: [0, 0, 1e300] }, { type: 'pin_target', index: 0, target: [0, 0] },
   ];
   for (const msg of bad) {
     send(page, msg);
@@ -376,4 +379,39 @@ test('export_all while running: the scene JSON, the glTF and the .3dm of one fra
       assert.equal(mesh.positions[3 * i + k], Math.fround(positions[3 * p + k]), `.3dm vertex ${i}`);
     }
   });
+});
+
+test('pin here leaves a hard pin at the drag\'s target; pin_target moves a scene pin', async () => {
+  await paused(page);
+  const w = live.session.world;
+  const pins = live.session.pins.length;
+  const start = Array.from(w.positions(3, 1));
+  const target = [start[0], start[1], start[2] + 0.05];
+  send(page, { type: 'drag_start', particle: 3, target: start });
+  send(page, { type: 'drag', target });
+  send(page, { type: 'drag_end', pin: true });
+  const scene = await next(page, (m) => m.type === 'scene' && m.pins.length === pins + 1, 'a scene with the new pin');
+  const pin = scene.pins[pins];
+  assert.equal(pin.particle, 3);
+  assert.equal(pin.name, `pin_here_${pins}`);
+  assert.deepEqual(pin.target, target);
+  assert.equal(live.session.drags.size, 0, 'the drag pin is gone');
+  for (let k = 0; k < 3; k++) {
+    send(page, { type: 'step' });
+    await next(page, ofType('geometry'), 'a step');
+  }
+  // A hard pin: the particle is at its target after a step.
+  assert.deepEqual(Array.from(w.positions(3, 1)), target);
+  send(page, { type: 'pin_target', index: pins, target: start });
+  send(page, { type: 'step' });
+  await next(page, ofType('geometry'), 'a step');
+  assert.deepEqual(Array.from(w.positions(3, 1)), start);
+  // While the pins are off there is nothing to move or pin; back on, each holds its last target.
+  send(page, { type: 'pins', on: false });
+  await next(page, (m) => m.type === 'status' && m.pins_on === false, 'pins off');
+  send(page, { type: 'pin_target', index: 0, target: start });
+  assert.match((await next(page, ofType('error'), 'a refusal')).message, /pins are off/);
+  send(page, { type: 'pins', on: true });
+  const back = await next(page, (m) => m.type === 'scene' && m.pins_on, 'pins on');
+  assert.deepEqual(back.pins[pins].target, start);
 });
