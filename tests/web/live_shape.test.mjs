@@ -154,7 +154,9 @@ test('at 1280 x 720 the help line is whole and inside the view; numbers carry un
     return { x: r.x, y: r.y, right: r.right, bottom: r.bottom, w: innerWidth, h: innerHeight,
              sideTop: side.top, sideBottom: side.bottom, clipped: help.scrollHeight > help.clientHeight || help.scrollWidth > help.clientWidth,
              text: help.textContent, hud: document.getElementById('hud').textContent,
-             legend: document.getElementById('legend').textContent };
+             legend: document.getElementById('legend').textContent,
+             cut: [...document.querySelectorAll('#hud .hud-value, #hud .hud-sub, #hud .hud-label')]
+               .filter((e) => e.scrollWidth > e.clientWidth + 1).map((e) => e.textContent) };
   });
   const shot = process.env.EMBRA_SCREENSHOT_DIR ? path.join(process.env.EMBRA_SCREENSHOT_DIR, 'live_1280x720.png') : path.join(tmp, 'live_1280x720.png');
   await page.screenshot({ path: shot });
@@ -163,6 +165,7 @@ test('at 1280 x 720 the help line is whole and inside the view; numbers carry un
   assert.equal(box.h, 720);
   assert.ok(box.x >= 0 && box.right <= box.w && box.y >= box.sideTop && box.bottom <= Math.min(box.h, box.sideBottom), JSON.stringify(box));
   assert.equal(box.clipped, false);
+  assert.deepEqual(box.cut, [], 'no number, unit or tolerance of the HUD cut off');
   assert.match(box.text, /pin here/);
   assert.match(box.hud, /mrad/); // planarity (fold angle) and miter
   assert.match(box.hud, /\d mm/); // thickness

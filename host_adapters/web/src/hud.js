@@ -83,7 +83,7 @@ export class Hud {
       }
       measured = true;
       const over = value > tol.target;
-      const sub = `tolerance ${inUnits(m.field, tol.target, tolerances)} (max ${inUnits(m.field, tol.max, tolerances)})`;
+      const sub = `target ${inUnits(m.field, tol.target, tolerances).split(' ')[0]} · max ${inUnits(m.field, tol.max, tolerances)}`;
       this.set(m.field, sci(value), sub, over ? (m.field === 'miter' ? 'over-yellow' : 'over') : 'ok',
         inUnits(m.field, value, tolerances));
       if (row?.within_tolerance === undefined && over) within = false;
