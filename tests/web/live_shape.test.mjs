@@ -198,6 +198,7 @@ test('what fights: a cable pulled by two soft pins in two groups lists them firs
     assert.match(listed[0], /^pin pull_(left|right) · (left|right) · particles 0 · off 0\.5\d* m, 5\d\d N$/);
     assert.deepEqual([f.conflicts[0].a, f.conflicts[0].b], ['left', 'right']);
     assert.match(pairs[0], /^left against right: \d+ N on 1 particle$/);
+    assert.equal(await other.evaluate(() => embraView.edgeCount), 10, 'the cable drawn as its 10 links');
     await other.selectOption('#metric', 'fights');
     const colors = await other.evaluate(() => Array.from(embraView.colors));
     assert.ok(colors[1] < 0.2 && colors[0] > 0.6, `particle 0 full magenta: ${colors.slice(0, 3)}`);

@@ -120,8 +120,9 @@ class Session {
       }
       const entry = (saved.bodies || [])[i] || {};
       return { id, index: i, name: entry.name || `body_${i}`, first, count, triangles: world.bodyTriangles(id),
-               panels, restScale: [1, 1, 1] };
+               panels, restScale: [1, 1, 1], edges: [] };
     });
+    this.#edgesOf(saved);
     const groupIds = world.groups();
     const savedGroups = saved.groups || [];
     this.groups = groupIds.map((id, i) => {
@@ -149,6 +150,29 @@ class Session {
     this.fieldValues = FIELDS.map(() => new Float64Array(this.particles).fill(NaN));
     this.#measure();
     this.workspace = this.#workspace();
+  }
+
+  /**
+   * The edges a page draws of each body without triangles (a net, a cable): its mesh's `edges` and
+   * the scene's distance constraints between two of its particles, as world particle indices.
+   */
+  #edgesOf(saved) {
+    const byName = new Map(this.bodies.map((b) => [b.name, b]));
+    const world = (ref) => (Number.isInteger(ref) ? ref : (byName.get(ref?.body)?.first ?? NaN) + ref?.vertex);
+    (saved.bodies || []).forEach((entry, i) => {
+      const b = this.bodies[i];
+      if (!b || b.triangles.length > 0) return;
+      for (const [u, v] of entry.mesh?.edges || []) b.edges.push(b.first + u, b.first + v);
+    });
+    const inside = (b, p) => Number.isInteger(p) && p >= b.first && p < b.first + b.count;
+    for (const c of saved.constraints || []) {
+      if (c.kind !== 'distance') continue;
+      for (const pair of c.particles || []) {
+        const [u, v] = pair.map(world);
+        const b = this.bodies.find((x) => x.triangles.length === 0 && inside(x, u) && inside(x, v));
+        if (b) b.edges.push(u, v);
+      }
+    }
   }
 
   /** The box a page's coordinates must lie in (WORKSPACE_REACH): {min, max}, 3 numbers each. */
@@ -260,7 +284,7 @@ class Session {
       particles: this.particles, paused: this.paused, gravity: this.gravity, gravity_on: this.gravityOn,
       pins_on: this.pinsOn,
       bodies: this.bodies.map((b) => ({ index: b.index, name: b.name, first: b.first, count: b.count,
-                                         triangles: Array.from(b.triangles), panel_mesh: b.panels > 0,
+                                         triangles: Array.from(b.triangles), edges: b.edges, panel_mesh: b.panels > 0,
                                          panels: b.panels, rest_scale: b.restScale })),
       colliders: this.colliders.map((c) => {
         const pose = this.world.colliderTransform(c.id);
