@@ -87,10 +87,13 @@ test('a mouse drag on a panel corner pulls it; the streamed positions and the er
     await page.mouse.move(start.at.x, start.at.y - 10 * k);
     await page.waitForTimeout(30);
   }
-  await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.15, [particle, start.z], { timeout: 30000 });
+  // The drag lifts it as far as the panels stay within tolerance (tests/web/live_shape.test.mjs).
+  await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.05, [particle, start.z], { timeout: 30000 });
   // The world itself moved (the page drew what the server streamed), read while the drag still holds
   // it: once released the corner falls back, and on a loaded machine the server may be frames ahead.
-  assert.ok(live.session.positions[3 * particle + 2] > serverZ + 0.15);
+  const rose = () => live.session.positions[3 * particle + 2] > serverZ + 0.05;
+  for (let k = 0; k < 200 && !rose(); k++) await new Promise((resolve) => setTimeout(resolve, 50));
+  assert.ok(rose(), `the world's particle at ${live.session.positions[3 * particle + 2]}, from ${serverZ}`);
   await page.mouse.up();
   // The plot kept growing.
   await page.waitForFunction((n) => embraView.plotPoints > n + 10, start.plot, { timeout: 20000 });

@@ -50,6 +50,7 @@ function serve(mounts) {
 
 let tmp;
 let run;
+let net;
 let server;
 let context;
 let page;
@@ -67,7 +68,11 @@ before(async () => {
   // every file in the folder.
   const index = JSON.parse(fs.readFileSync(path.join(run, 'index.json'), 'utf8'));
   assert.deepEqual([...index.files].sort(), fs.readdirSync(run).sort());
-  server = await serve({ dist, run });
+  // An edge-only body (the hanging net): its OBJs carry `l` lines, which the page draws.
+  net = path.join(tmp, 'net');
+  execFileSync(cli, ['run', path.join(source, 'examples', 'hanging_net.json'), '--out', net, '--every', '30', '--frames', '60'],
+    { stdio: ['ignore', 'ignore', 'inherit'] });
+  server = await serve({ dist, run, net });
 
   context = await launchChromium(path.join(tmp, 'profile'));
   page = context.pages()[0] || await context.newPage();
@@ -159,8 +164,8 @@ test('the slider moves the frame; the geometry is that frame\'s OBJ', async () =
     .find((r) => r.frame === 180);
   assert.equal(await page.textContent('.hud-frame .hud-number'), '180');
   assert.equal(await page.textContent('.hud-thickness .hud-number'), row.thickness_error_max.toExponential(2));
-  const mmPerM = Number(String(row.thickness_error_max * 1250).slice(0, 8)); // unit_scale 1250
-  assert.match(await page.textContent('.hud-thickness .hud-unit'), /^[0-9.]+ mm\/m$/);
+  const mmPerM = Number(String(row.thickness_error_max * 1250).slice(0, 8)); // unit_scale 1250: mm
+  assert.match(await page.textContent('.hud-thickness .hud-unit'), /^[0-9.]+ mm$/);
   assert.ok(Math.abs(parseFloat(await page.textContent('.hud-thickness .hud-unit')) - mmPerM) < 5e-3 * mmPerM);
   assert.equal(await page.textContent('.hud-within .hud-number'), row.within_tolerance ? 'yes' : 'no');
 });
@@ -236,5 +241,20 @@ test('screenshot: the thickness map of frame 180 is drawn', async () => {
   assert.ok(stats.reddish > 100, `no red of the thickness errors in the view: ${JSON.stringify(stats)}`);
   fs.mkdirSync(path.dirname(screenshot), { recursive: true });
   await page.screenshot({ path: screenshot });
+  assert.deepEqual(pageErrors, []);
+});
+
+test('an edge-only net (OBJ `l` lines) renders as lines', async () => {
+  const text = fs.readFileSync(path.join(net, 'final.obj'), 'utf8').split('\n');
+  const vertices = text.filter((l) => l.startsWith('v ')).length;
+  const edges = text.filter((l) => l.startsWith('l ')).reduce((n, l) => n + l.trim().split(/\s+/).length - 2, 0);
+  assert.ok(edges > 0, 'the net\'s OBJ has l lines');
+  assert.equal(text.filter((l) => l.startsWith('f ')).length, 0, 'and no faces');
+  const { port } = server.address();
+  await page.goto(`http://127.0.0.1:${port}/dist/index.html?replay=/net/`);
+  await page.waitForFunction(() => window.embraView && window.embraView.frame !== null, null, { timeout: 60000 });
+  const v = await page.evaluate(() => ({ edges: embraView.edgeCount, vertices: embraView.vertexCount, triangles: embraView.triangleCount }));
+  console.log(`hanging net: ${v.edges} edges drawn over ${v.vertices} vertices`);
+  assert.deepEqual(v, { edges, vertices, triangles: 0 });
   assert.deepEqual(pageErrors, []);
 });

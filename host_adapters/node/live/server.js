@@ -30,7 +30,8 @@ const FRAME_SKIP_BYTES = 4 * 1024 * 1024; // a page further behind than this ski
 const CLOSE_BEHIND_BYTES = 64 * 1024 * 1024; // a page this far behind (not reading its replies) is closed
 const HTTP_EXTRA_SOCKETS = 16; // sockets beyond maxConnections for page loads (server.maxConnections)
 const REQUEST_TIMEOUT_MS = 10000; // an http request (or a WebSocket handshake) must arrive within this
-const HEAVY = new Set(['save', 'export', 'reset']);
+const FIGHTS_EVERY = 10; // frames between `fights` messages
+const HEAVY = new Set(['save', 'export', 'export_all', 'reset']);
 const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8',
                 '.css': 'text/css; charset=utf-8', '.json': 'application/json', '.png': 'image/png',
                 '.map': 'application/json', '.svg': 'image/svg+xml' };
@@ -134,7 +135,8 @@ function positiveInteger(value, what) {
  * Starts a live server. options: {scene (path), host ('127.0.0.1'), port (0 = any free one),
  * web (folder of the built page), saveDir (the output folder), allowOrigins (extra origins a page
  * may come from, e.g. ['http://192.168.1.5:8710']), log (a function taking a line; default
- * stderr), and the bounds of DEFAULTS}. Resolves to {url, port, session, limits, connections() (the
+ * stderr), waitForPage (default true: no frame is stepped before the first page connects), and
+ * the bounds of DEFAULTS}. Resolves to {url, port, session, limits, connections() (the
  * WebSocket connections open), close()}.
  */
 function startServer(options) {
@@ -167,6 +169,8 @@ function startServer(options) {
   let timer = null;
   let closed = false;
   let next = 0;
+  // Paused until a page connects: a page opened a while after launch sees the scene from frame 0.
+  let waiting = options.waitForPage !== false;
 
   const send = (ws, message) => {
     if (ws.readyState !== ws.OPEN) return;
@@ -191,6 +195,11 @@ function startServer(options) {
     const record = JSON.stringify(session.frameMessage());
     const geometry = Buffer.from(session.geometryMessage());
     for (const ws of clients) sendFrame(ws, record, geometry);
+    // What fights, every FIGHTS_EVERY frames and at every frame stepped while paused.
+    if (session.paused || session.record.frame % FIGHTS_EVERY === 0) {
+      const fights = JSON.stringify(session.fightsMessage());
+      for (const ws of clients) if (ws.bufferedAmount <= FRAME_SKIP_BYTES) send(ws, fights);
+    }
   };
   const stepAndSend = () => {
     const problem = session.step();
@@ -208,7 +217,7 @@ function startServer(options) {
     timer = null;
     if (closed) return;
     const now = performance.now();
-    if (!session.paused) {
+    if (!session.paused && !waiting) {
       try {
         stepAndSend();
       } catch (e) {
@@ -256,6 +265,10 @@ function startServer(options) {
 
   wss.on('connection', (ws, req) => {
     clients.add(ws);
+    if (waiting) {
+      waiting = false;
+      next = performance.now();
+    }
     log(`page connected from ${req.socket.remoteAddress}`);
     const bucket = new Bucket(limits.messagesPerSecond, limits.messageBurst);
     // Messages over the rate are dropped unread; the page hears of them in one `error` a second at
@@ -338,6 +351,8 @@ function startServer(options) {
         session,
         limits,
         connections: () => sockets,
+        /** True until the first page connects (the clock does not step before). */
+        waiting: () => waiting,
         close: () => new Promise((done) => {
           closed = true;
           if (timer) clearTimeout(timer);

@@ -11,7 +11,18 @@ const { World, EmbraError, NumericalError } = require('../lib');
 const { fieldColors, toGltf, to3dm } = require('../lib/export');
 
 const FIELDS = ['planarity', 'thickness', 'miter'];
-const DRAG_COMPLIANCE = 1e-6; // m/N: a soft pin firm enough to lead, soft enough not to tear
+/**
+ * A drag is a soft pin in the default group, whose soft pins are projected before its welds and
+ * panel constraints in every pass, so the panels correct last. Its compliance and its reach (the
+ * drag pin's target is kept within DRAG_REACH times the scene's diagonal of the particle, however far
+ * the cursor goes) bound its pull: on the POQ drape (docs/live-protocol.md) the panels stay within
+ * their tolerances' max during a 150 px drag.
+ */
+const DRAG_COMPLIANCE = 2e-5; // m/N
+const DRAG_REACH = 0.1; // of the scene's diagonal at load
+const DRAG_BACK_OFF = 0.3; // of a tolerance's max: above it the drags' reach halves each frame
+const DRAG_EASE = 0.2; // of a tolerance's max: below it the drags' reach grows back
+const DRAG_GAIN_START = 0.05; // a new drag's reach, of DRAG_REACH: it grows from there
 const MAGIC = 0x464d4245; // 'EBMF' little-endian
 /**
  * A page's coordinates (drag targets, collider positions) are places in the scene: within its
@@ -21,6 +32,8 @@ const MAGIC = 0x464d4245; // 'EBMF' little-endian
  * next step fail and one pulled to 1e30 flings the mesh beyond what a frame's float32 can carry.
  */
 const WORKSPACE_REACH = 1000;
+const FIGHTS_LISTED = 10; // constraints listed in a `fights` message
+const FIGHTS_COLOURED = 64; // constraints whose particles a `fights` message colours
 /** Output files kept per scene in the output folder (the oldest deleted beyond it), by default. */
 const KEEP_FILES = 100;
 const OUTPUT_KINDS = ['json', 'gltf', '3dm'];
@@ -86,6 +99,7 @@ class Session {
     this.pinsOn = true;
     this.drags = new Map(); // page -> {pin, particle}: each page holds at most one drag
     this.lastMs = 0;
+    this.dragGain = 1; // the drags' reach, as a fraction of dragReach (#adaptDrag)
     const saved = JSON.parse(world.saveJson());
     this.name = saved.name || path.basename(this.scenePath, '.json');
     this.description = saved.description || '';
@@ -106,8 +120,9 @@ class Session {
       }
       const entry = (saved.bodies || [])[i] || {};
       return { id, index: i, name: entry.name || `body_${i}`, first, count, triangles: world.bodyTriangles(id),
-               panels, restScale: [1, 1, 1] };
+               panels, restScale: [1, 1, 1], edges: [] };
     });
+    this.#edgesOf(saved);
     const groupIds = world.groups();
     const savedGroups = saved.groups || [];
     this.groups = groupIds.map((id, i) => {
@@ -137,6 +152,29 @@ class Session {
     this.workspace = this.#workspace();
   }
 
+  /**
+   * The edges a page draws of each body without triangles (a net, a cable): its mesh's `edges` and
+   * the scene's distance constraints between two of its particles, as world particle indices.
+   */
+  #edgesOf(saved) {
+    const byName = new Map(this.bodies.map((b) => [b.name, b]));
+    const world = (ref) => (Number.isInteger(ref) ? ref : (byName.get(ref?.body)?.first ?? NaN) + ref?.vertex);
+    (saved.bodies || []).forEach((entry, i) => {
+      const b = this.bodies[i];
+      if (!b || b.triangles.length > 0) return;
+      for (const [u, v] of entry.mesh?.edges || []) b.edges.push(b.first + u, b.first + v);
+    });
+    const inside = (b, p) => Number.isInteger(p) && p >= b.first && p < b.first + b.count;
+    for (const c of saved.constraints || []) {
+      if (c.kind !== 'distance') continue;
+      for (const pair of c.particles || []) {
+        const [u, v] = pair.map(world);
+        const b = this.bodies.find((x) => x.triangles.length === 0 && inside(x, u) && inside(x, v));
+        if (b) b.edges.push(u, v);
+      }
+    }
+  }
+
   /** The box a page's coordinates must lie in (WORKSPACE_REACH): {min, max}, 3 numbers each. */
   #workspace() {
     const lo = [Infinity, Infinity, Infinity];
@@ -152,7 +190,9 @@ class Session {
       lo.fill(0);
       hi.fill(0);
     }
-    const reach = WORKSPACE_REACH * Math.max(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]), 1);
+    const diagonal = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    this.dragReach = DRAG_REACH * Math.max(diagonal, 1e-9);
+    const reach = WORKSPACE_REACH * Math.max(diagonal, 1);
     return { min: lo.map((v) => v - reach), max: hi.map((v) => v + reach) };
   }
 
@@ -194,9 +234,34 @@ class Session {
     this.record = record;
   }
 
+  /** Moves a drag pin's target toward the cursor, at most dragReach from its particle. */
+  #leadDrag(drag) {
+    const at = this.positions.subarray(3 * drag.particle, 3 * drag.particle + 3);
+    const d = drag.target.map((v, k) => v - at[k]);
+    const length = Math.hypot(...d);
+    const reach = this.dragReach * this.dragGain;
+    const f = length > reach ? reach / length : 1;
+    this.world.setPinTarget(drag.pin, d.map((v, k) => at[k] + f * v));
+  }
+
+  /**
+   * The drags' reach shrinks while a panel metric nears its tolerance's max (above DRAG_BACK_OFF of
+   * it: halved each frame) and grows back (by a quarter a frame, up to DRAG_REACH) below DRAG_EASE.
+   */
+  #adaptDrag() {
+    const r = this.record;
+    if (r.planarity_max === undefined) return;
+    const t = this.tolerances;
+    const worst = Math.max(r.planarity_max / t.planarity.max, r.thickness_error_max / t.thickness.max,
+                           r.miter_error_max / t.miter.max);
+    if (worst > DRAG_BACK_OFF) this.dragGain *= 0.5;
+    else if (worst < DRAG_EASE) this.dragGain = Math.min(1, this.dragGain * 1.25);
+  }
+
   /** Advances one frame. A numerical failure (the world restored to before the step) pauses. */
   step() {
     const t0 = process.hrtime.bigint();
+    for (const drag of this.drags.values()) this.#leadDrag(drag);
     try {
       this.world.step();
     } catch (e) {
@@ -207,6 +272,7 @@ class Session {
     }
     this.lastMs = Number(process.hrtime.bigint() - t0) / 1e6;
     this.#measure();
+    this.#adaptDrag();
     return null;
   }
 
@@ -218,7 +284,7 @@ class Session {
       particles: this.particles, paused: this.paused, gravity: this.gravity, gravity_on: this.gravityOn,
       pins_on: this.pinsOn,
       bodies: this.bodies.map((b) => ({ index: b.index, name: b.name, first: b.first, count: b.count,
-                                         triangles: Array.from(b.triangles), panel_mesh: b.panels > 0,
+                                         triangles: Array.from(b.triangles), edges: b.edges, panel_mesh: b.panels > 0,
                                          panels: b.panels, rest_scale: b.restScale })),
       colliders: this.colliders.map((c) => {
         const pose = this.world.colliderTransform(c.id);
@@ -237,6 +303,40 @@ class Session {
 
   frameMessage() {
     return this.record;
+  }
+
+  /**
+   * What fights in the last step (docs/live-protocol.md, `fights`): the FIGHTS_LISTED worst
+   * constraints and soft pins (embra_world_get_worst_constraints: ranked by violation x force) with
+   * their group's and pin's names, the pairs of groups pulling against each other
+   * (embra_world_get_group_conflicts), and per particle the largest energy (violation x force, J)
+   * of the FIGHTS_COLOURED worst constraints it is in, as [particle, energy] pairs.
+   */
+  fightsMessage() {
+    const w = this.world;
+    const same = (a, b) => a && b && a.index === b.index && a.generation === b.generation;
+    const groupName = (id) => (this.groups.find((g) => same(g.id, id)) || { name: `group ${id.index}` }).name;
+    const pinName = (id) => {
+      if (!id) return null;
+      const scene = this.pins.find((p) => this.pinsOn && same(p.id, id));
+      if (scene) return scene.name;
+      return [...this.drags.values()].some((d) => same(d.pin, id)) ? 'drag' : `pin ${id.index}`;
+    };
+    const all = w.worstConstraints(FIGHTS_COLOURED);
+    const energy = new Map();
+    for (const c of all) {
+      const e = Math.abs(c.violation * c.force);
+      for (const p of c.particles) energy.set(p, Math.max(energy.get(p) || 0, e));
+    }
+    return {
+      type: 'fights', frame: this.record.frame,
+      worst: all.slice(0, FIGHTS_LISTED).map((c) => ({
+        kind: c.kind, group: groupName(c.group), index: c.index, pin: pinName(c.pin), particles: c.particles,
+        residual: c.residual, violation: c.violation, unit: c.unit, force: c.force,
+      })),
+      conflicts: w.groupConflicts().map((c) => ({ a: groupName(c.a), b: groupName(c.b), force: c.force, particles: c.particles })),
+      energy: [...energy.entries()],
+    };
   }
 
   statusMessage() {
@@ -279,19 +379,39 @@ class Session {
         const target = this.#point(msg.target, 'target');
         const pin = w.createPin(msg.particle, target, { compliance: DRAG_COMPLIANCE });
         this.releaseDrag(page);
-        this.drags.set(page, { pin, particle: msg.particle });
+        this.drags.set(page, { pin, particle: msg.particle, target: [...target] });
+        this.dragGain = Math.min(this.dragGain, DRAG_GAIN_START);
         return {};
       }
       case 'drag': {
         const target = this.#point(msg.target, 'target');
         const drag = this.drags.get(page);
         if (!drag) refuse('drag without drag_start');
-        w.setPinTarget(drag.pin, target);
+        drag.target = [...target]; // the pin's target follows it at the next step (#leadDrag)
         return {};
       }
-      case 'drag_end':
+      case 'drag_end': {
+        const pinHere = msg.pin === undefined ? false : bool(msg.pin, 'pin');
+        const drag = this.drags.get(page);
+        if (!pinHere || !drag) {
+          this.releaseDrag(page);
+          return {};
+        }
+        // "Pin here": the drag's soft pin becomes a hard pin of the scene at the release point.
+        const { target } = drag;
         this.releaseDrag(page);
-        return {};
+        if (!this.pinsOn) refuse('the scene\'s pins are off: turn them on to pin here');
+        const index = this.pins.length;
+        const id = w.createPin(drag.particle, target);
+        this.pins.push({ id, index, name: `pin_here_${index}`, particle: drag.particle, compliance: 0, group: undefined });
+        return { scene: true };
+      }
+      case 'pin_target': {
+        if (!this.pinsOn) refuse('the scene\'s pins are off');
+        const p = indexIn(msg.index, this.pins, 'pin');
+        w.setPinTarget(p.id, this.#point(msg.target, 'target'));
+        return {}; // the dot follows its particle in the frames; the next scene message has the target
+      }
       case 'collider_pose': {
         const c = indexIn(msg.index, this.colliders, 'collider');
         const position = this.#point(msg.position, 'position');
@@ -350,7 +470,7 @@ class Session {
       case 'save': {
         const json = this.#saveWithoutDrags();
         const file = this.writeOutput('json', json, this.record.frame);
-        return { replies: [{ type: 'saved', path: file, json }] };
+        return { replies: [{ type: 'saved', frame: this.record.frame, path: file, json }] };
       }
       case 'export': {
         if (msg.format !== 'gltf' && msg.format !== '3dm') refuse('format must be "gltf" or "3dm"');
@@ -359,7 +479,24 @@ class Session {
         const frame = this.record.frame;
         return this.exportBytes(msg.format, metric).then((bytes) => {
           const file = this.writeOutput(msg.format, bytes, frame);
-          return { replies: [{ type: 'exported', format: msg.format, metric, path: file, base64: bytes.toString('base64') }] };
+          return { replies: [{ type: 'exported', format: msg.format, metric, frame, path: file, base64: bytes.toString('base64') }] };
+        });
+      }
+      case 'export_all': {
+        // The scene JSON, the glTF and the .3dm of one frame: each snapshot is taken here, before
+        // the server's clock can step again.
+        const metric = msg.metric ?? 'planarity';
+        if (!FIELDS.includes(metric)) refuse(`metric must be one of ${FIELDS.join(', ')}`);
+        const frame = this.record.frame;
+        const json = this.#saveWithoutDrags();
+        const gltf = this.exportBytes('gltf', metric);
+        const rhino = this.exportBytes('3dm', metric);
+        return Promise.all([gltf, rhino]).then(([g, r]) => {
+          const saved = { type: 'saved', frame, path: this.writeOutput('json', json, frame), json };
+          const files = [['gltf', g], ['3dm', r]].map(([format, bytes]) => ({
+            type: 'exported', format, metric, frame, path: this.writeOutput(format, bytes, frame), base64: bytes.toString('base64'),
+          }));
+          return { replies: [saved, ...files] };
         });
       }
       default:
@@ -430,13 +567,13 @@ class Session {
   /** The scene JSON of the current state without the pages' drag pins (a design, not a gesture). */
   #saveWithoutDrags() {
     const w = this.world;
-    const held = [...this.drags.entries()].map(([page, d]) => [page, d.particle, w.pinTarget(d.pin)]);
+    const held = [...this.drags.entries()].map(([page, d]) => [page, d, w.pinTarget(d.pin)]);
     for (const [page] of held) this.releaseDrag(page);
     try {
       return w.saveJson();
     } finally {
-      for (const [page, particle, target] of held)
-        this.drags.set(page, { pin: w.createPin(particle, target, { compliance: DRAG_COMPLIANCE }), particle });
+      for (const [page, d, at] of held)
+        this.drags.set(page, { ...d, pin: w.createPin(d.particle, at, { compliance: DRAG_COMPLIANCE }) });
     }
   }
 
@@ -461,4 +598,4 @@ class Session {
   }
 }
 
-module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, WORKSPACE_REACH, KEEP_FILES, outputStem };
+module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, FIGHTS_LISTED, WORKSPACE_REACH, KEEP_FILES, outputStem };

@@ -1,10 +1,24 @@
 // The numbers at the bottom of the view, as in the paper's figures 12 and 13: the frame, each
-// metric's max against its tolerance (model units, and mm per metre through unit_scale for the
-// lengths), within tolerance yes / no, ms per frame and the frames received per second.
+// metric's max against its tolerance (the model's number and its value in units, inUnits), within
+// tolerance yes / no, ms per frame and the frames received per second.
 
 import { METRICS } from './plot.js';
 
-const LENGTHS = new Set(['thickness', 'miter']); // planarity is 1 - cos: no length
+/**
+ * A metric's value in the units a designer reads, from the model's units and the tolerances'
+ * unit_scale (mm per metre of panel per model unit: the model's lengths as mm on panels 1 m wide):
+ * planarity (1 - n1.n2 of a quad's two triangles) as the fold angle acos(1 - v) in mrad; thickness
+ * (model units) as mm at that scale; miter (a joint's twist, model units per panel) as mm per metre
+ * of joint, that is mrad.
+ */
+export function inUnits(field, v, tolerances) {
+  if (!Number.isFinite(v)) return '–';
+  const scale = tolerances?.unit_scale ?? 1;
+  if (field === 'planarity') return `${mm(1000 * Math.acos(Math.min(1, Math.max(-1, 1 - v))))} mrad`;
+  if (field === 'thickness') return `${mm(v * scale)} mm`;
+  if (field === 'miter') return `${mm(v * scale)} mrad`;
+  return sci(v);
+}
 
 export function sci(v) {
   if (v === null || v === undefined || !Number.isFinite(v)) return '–';
@@ -58,7 +72,6 @@ export class Hud {
    */
   update({ frame, row, maxima, tolerances, fps, fpsLabel }) {
     this.set('frame', frame === null || frame === undefined ? '–' : String(frame));
-    const scale = tolerances?.unit_scale ?? 1;
     let within = row?.within_tolerance;
     let measured = false;
     for (const m of METRICS) {
@@ -70,10 +83,9 @@ export class Hud {
       }
       measured = true;
       const over = value > tol.target;
-      const length = LENGTHS.has(m.field);
-      const sub = length ? `tolerance ${sci(tol.target)} · ${mm(tol.target * scale)} mm/m` : `tolerance ${sci(tol.target)}`;
-      const unit = length ? `${mm(value * scale)} mm/m` : '';
-      this.set(m.field, sci(value), sub, over ? (m.field === 'miter' ? 'over-yellow' : 'over') : 'ok', unit);
+      const sub = `target ${inUnits(m.field, tol.target, tolerances).split(' ')[0]} · max ${inUnits(m.field, tol.max, tolerances)}`;
+      this.set(m.field, sci(value), sub, over ? (m.field === 'miter' ? 'over-yellow' : 'over') : 'ok',
+        inUnits(m.field, value, tolerances));
       if (row?.within_tolerance === undefined && over) within = false;
     }
     if (within === undefined && measured) within = true;

@@ -1,10 +1,9 @@
 // The colour bar of the selected metric, drawn with the shared colour function itself.
 
 import { errorColor, GREY, UNMEASURED } from '../../node/lib/colors.js';
-import { mm, sci } from './hud.js';
+import { inUnits } from './hud.js';
 
 const css = (c) => `rgb(${c.map((v) => Math.round(v * 255)).join(', ')})`;
-const LENGTHS = new Set(['thickness', 'miter']);
 
 export function renderLegend(container, metric, tolerances) {
   container.textContent = '';
@@ -21,8 +20,7 @@ export function renderLegend(container, metric, tolerances) {
     const value = tol.target * (tol.max / tol.target) ** s * (1 + 1e-9);
     stops.push(`${css(errorColor(metric, value, tol))} ${(100 * s).toFixed(1)}%`);
   }
-  const scale = tolerances.unit_scale ?? 1;
-  const label = (v) => (LENGTHS.has(metric) ? `${sci(v)} · ${mm(v * scale)} mm/m` : sci(v));
+  const label = (v) => inUnits(metric, v, tolerances);
 
   const bar = document.createElement('div');
   bar.className = 'legend-bar';

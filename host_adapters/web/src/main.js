@@ -3,10 +3,10 @@
 // docs/live-protocol.md is the contract with the server; window.embraView is the tests' view.
 
 import './style.css';
-import { errorColor } from '../../node/lib/colors.js';
+import { errorColor, GREY } from '../../node/lib/colors.js';
 import { View } from './view.js';
 import { Plot } from './plot.js';
-import { Hud, mm, sci } from './hud.js';
+import { Hud, inUnits } from './hud.js';
 import { renderLegend } from './legend.js';
 import { LiveClient, liveUrl } from './live.js';
 import { folderFromFiles, folderFromUrl, openReplay } from './replay.js';
@@ -14,6 +14,7 @@ import { base64Blob, basename, download, droppedFiles } from './files.js';
 
 const PLAIN = [0.86, 0.84, 0.8]; // metric "none": the geometry alone
 const $ = (id) => document.getElementById(id);
+const ROWS_KEPT = 600; // frame rows kept for embraView.rows
 
 const state = {
   mode: 'starting',
@@ -21,6 +22,9 @@ const state = {
   scene: null,
   frame: null,
   framesReceived: 0,
+  firstFrame: null, // the number of the first frame received from the server
+  fights: null, // the last `fights` message, with energyOf (a Map) and maxEnergy
+  rows: [], // the last ROWS_KEPT frame rows received (the server's metrics of each frame)
   fps: 0,
   positions: null,
   fields: {},
@@ -56,7 +60,21 @@ function showError(message) {
 
 // --- colours and numbers ---------------------------------------------------------------------
 
+/**
+ * Metric "fights": a particle in one of the worst constraints of the last `fights` message shaded
+ * from light to full magenta on a log scale of its energy (violation x force) over 6 decades below
+ * the largest; every other particle grey.
+ */
+function fightColor(i) {
+  const f = state.fights;
+  const e = f?.energyOf.get(i);
+  if (!e || !(f.maxEnergy > 0)) return GREY;
+  const s = Math.min(1, Math.max(0, 1 + Math.log10(e / f.maxEnergy) / 6));
+  return [0.95 - 0.25 * s, 0.75 - 0.65 * s, 0.95 - 0.2 * s];
+}
+
 function colorOf(i) {
+  if (state.metric === 'fights') return fightColor(i);
   const values = state.fields[state.metric];
   if (state.metric === 'none' || !values) return PLAIN;
   return errorColor(state.metric, values[i], state.scene.tolerances[state.metric]);
@@ -104,7 +122,7 @@ function applyScene(scene) {
       send({ type: 'drag_end' });
       view.showDrag(null, null);
     }
-    else view.heldCollider = -1;
+    else if (pointer.drag.kind === 'collider') view.heldCollider = -1;
     pointer.drag = null;
     view.controls.enabled = true;
   }
@@ -119,8 +137,12 @@ function applyScene(scene) {
   $('scene-name').title = scene.description || '';
   document.title = `embra · ${scene.name}`;
   const select = $('metric');
-  for (const option of select.options) option.disabled = option.value !== 'none' && !scene.fields.includes(option.value);
-  const metric = scene.fields.includes(state.metric) ? state.metric : scene.fields[0] || 'none';
+  const fights = state.mode === 'live' || state.mode === 'connecting';
+  for (const option of select.options) {
+    option.disabled = option.value === 'fights' ? !fights : option.value !== 'none' && !scene.fields.includes(option.value);
+  }
+  const keep = scene.fields.includes(state.metric) || (state.metric === 'fights' && fights);
+  const metric = keep ? state.metric : scene.fields[0] || 'none';
   setMetric(metric);
   // An edit (pins, a weight) re-sends the same scene: the history stays; a reset shows in the plot
   // as a frame going back, which plot.push handles.
@@ -176,6 +198,9 @@ function startLive() {
     frame(row, geometry) {
       if (!state.scene || geometry.particles !== state.scene.particles) return;
       state.framesReceived += 1;
+      if (state.firstFrame === null) state.firstFrame = geometry.frame;
+      state.rows.push(row);
+      if (state.rows.length > ROWS_KEPT) state.rows.shift();
       const now = performance.now();
       receivedAt.push(now);
       while (receivedAt.length && receivedAt[0] < now - 1000) receivedAt.shift();
@@ -186,6 +211,7 @@ function startLive() {
       state.positions = geometry.positions;
     },
     status: setStatus,
+    fights: showFights,
     saved(msg) {
       download(basename(msg.path) || `${state.scene?.name || 'scene'}-${state.frame}.json`,
         new Blob([msg.json], { type: 'application/json' }));
@@ -201,6 +227,35 @@ function startLive() {
       showError(msg.message);
     },
   });
+}
+
+const fmt = (v) => (Math.abs(v) >= 0.01 && Math.abs(v) < 1e4 ? String(Number(v.toPrecision(3))) : v.toExponential(2));
+const FORCE_UNIT = { m: 'N', rad: 'N m', 'm^3': 'N/m^2' };
+
+/** The `fights` message: the worst constraints and the groups pulling against each other. */
+function showFights(msg) {
+  const energyOf = new Map(msg.energy);
+  let maxEnergy = 0;
+  for (const e of energyOf.values()) maxEnergy = Math.max(maxEnergy, e);
+  state.fights = { ...msg, energyOf, maxEnergy };
+  const list = $('fights-list');
+  list.textContent = '';
+  for (const c of msg.worst) {
+    const li = document.createElement('li');
+    const what = c.pin ? `pin ${c.pin}` : `${c.kind} #${c.index}`;
+    li.textContent = `${what} · ${c.group} · particles ${c.particles.join(', ')} · off ${fmt(c.violation)} ${c.unit}, ` +
+      `${fmt(c.force)} ${FORCE_UNIT[c.unit] || 'N'}`;
+    list.appendChild(li);
+  }
+  const pairs = $('fights-conflicts');
+  pairs.textContent = '';
+  for (const c of msg.conflicts.filter((x) => x.particles > 0)) {
+    const li = document.createElement('li');
+    li.textContent = `${c.a} against ${c.b}: ${fmt(c.force)} N on ${c.particles} particle${c.particles === 1 ? '' : 's'}`;
+    pairs.appendChild(li);
+  }
+  $('fights-panel').hidden = false;
+  if (state.metric === 'fights') recolor();
 }
 
 function setStatus(msg) {
@@ -279,9 +334,10 @@ function wireLiveControls() {
   $('gravity').addEventListener('change', (e) => send({ type: 'gravity', on: e.target.checked }));
   $('pins').addEventListener('change', (e) => send({ type: 'pins', on: e.target.checked }));
   $('save').addEventListener('click', () => send({ type: 'save' }));
-  const metricForExport = () => (state.metric === 'none' ? state.scene?.fields[0] || 'planarity' : state.metric);
+  const metricForExport = () => (state.metric === 'none' || state.metric === 'fights' ? state.scene?.fields[0] || 'planarity' : state.metric);
   $('export-gltf').addEventListener('click', () => send({ type: 'export', format: 'gltf', metric: metricForExport() }));
   $('export-3dm').addEventListener('click', () => send({ type: 'export', format: '3dm', metric: metricForExport() }));
+  $('export-all').addEventListener('click', () => send({ type: 'export_all', metric: metricForExport() }));
 }
 
 // --- mouse: drag a particle, shift-drag a collider, hover readout -----------------------------
@@ -299,6 +355,9 @@ function onPointerDown(e) {
       offset: position.sub(hit.point), pending: null, pointerId: e.pointerId,
     };
     view.heldCollider = hit.index;
+  } else if (view.pickPin(e.clientX, e.clientY)) {
+    const hit = view.pickPin(e.clientX, e.clientY);
+    pointer.drag = { kind: 'pin', index: hit.index, plane: view.cameraPlane(hit.point), pending: null, pointerId: e.pointerId };
   } else {
     const hit = view.pickParticle(e.clientX, e.clientY);
     if (!hit) return;
@@ -324,13 +383,16 @@ function onPointerMove(e) {
   if (e.buttons === 0) pointer.hover = { x: e.clientX, y: e.clientY };
 }
 
-function onPointerUp() {
+function onPointerUp(e) {
   const drag = pointer.drag;
   if (!drag) return;
   flushDrag();
   if (drag.kind === 'particle') {
-    send({ type: 'drag_end' });
+    const pin = $('pin-here').checked || e.altKey;
+    send(pin ? { type: 'drag_end', pin: true } : { type: 'drag_end' });
     view.showDrag(null, null);
+  } else if (drag.kind === 'pin') {
+    // the dot follows its particle, which the hard pin carries to the target
   } else {
     view.heldCollider = -1;
   }
@@ -348,6 +410,8 @@ function flushDrag() {
   if (drag.kind === 'particle') {
     send({ type: 'drag', target: [point.x, point.y, point.z] });
     view.showDrag(drag.particle, point);
+  } else if (drag.kind === 'pin') {
+    send({ type: 'pin_target', index: drag.index, target: [point.x, point.y, point.z] });
   } else {
     const position = point.clone().add(drag.offset);
     view.moveCollider(drag.index, position);
@@ -375,8 +439,7 @@ function updateHover() {
       parts.push(`${name} –`);
       continue;
     }
-    const length = name !== 'planarity' ? ` (${mm(v * (tol.unit_scale ?? 1))} mm/m)` : '';
-    parts.push(`${name} ${sci(v)}${length}${tol[name] && v > tol[name].target ? ' ▲' : ''}`);
+    parts.push(`${name} ${inUnits(name, v, tol)}${tol[name] && v > tol[name].target ? ' ▲' : ''}`);
   }
   el.textContent = parts.join('  ·  ');
   el.hidden = false;
@@ -564,6 +627,9 @@ window.embraView = {
   get connected() { return state.connected; },
   get frame() { return state.frame; },
   get framesReceived() { return state.framesReceived; },
+  get firstFrame() { return state.firstFrame; },
+  /** The last frame rows received (up to 600), oldest first. */
+  get rows() { return state.rows; },
   get fps() { return state.fps; },
   get positions() { return state.positions; },
   get plotPoints() { return plot.points; },
@@ -571,11 +637,17 @@ window.embraView = {
   get lastError() { return state.lastError; },
   /** The particle a mouse drag holds (null when none). */
   get dragParticle() { return pointer.drag?.kind === 'particle' ? pointer.drag.particle : null; },
+  /** The scene pin whose dot a mouse drag holds (null when none). */
+  get dragPin() { return pointer.drag?.kind === 'pin' ? pointer.drag.index : null; },
   get metric() { return state.metric; },
   get fields() { return state.fields; },
+  /** The last `fights` message (null before one arrives). */
+  get fights() { return state.fights; },
   /** The colour attribute's array (3 floats per particle, errorColor's values). */
   get colors() { return view.color ? view.color.array : null; },
   get vertexCount() { return view.position ? view.position.count : 0; },
+  /** Edges drawn as lines (edge-only bodies: `l` lines of a replay's OBJ). */
+  get edgeCount() { return view.edgeLines.reduce((n, l) => n + l.geometry.index.count / 2, 0); },
   get triangleCount() { return view.meshes.reduce((n, m) => n + m.geometry.index.count / 3, 0); },
   /** Replay: the frame numbers the slider steps through, and the shown one's index. */
   get replayFrames() { return state.replay ? state.replay.frames.map((f) => f.frame) : []; },

@@ -1,15 +1,28 @@
 // The OBJ files `embra run` writes: every particle as a `v` line in world order, each body's
-// triangles as `f` lines under `g body_<index>` (1-based, possibly v/vt/vn or negative indices).
+// triangles as `f` lines and the edges of an edge-only body (a net) as `l` lines under
+// `g body_<index>` (1-based, possibly v/vt/vn or negative indices).
 
-/** Positions (3N floats) and triangles per body index (world particle indices, 0-based). */
+/**
+ * Positions (3N floats), triangles per body index and edges per body index (world particle
+ * indices, 0-based; an `l` polyline of k points gives k - 1 edges, 2 indices each).
+ */
 export function parseObj(text) {
   const coords = [];
   const bodies = new Map();
+  const edges = new Map();
   let current = 0;
   let faces = null;
-  const facesOf = (index) => {
-    if (!bodies.has(index)) bodies.set(index, []);
-    return bodies.get(index);
+  const listOf = (map, index) => {
+    if (!map.has(index)) map.set(index, []);
+    return map.get(index);
+  };
+  const facesOf = (index) => listOf(bodies, index);
+  const ids = (line) => {
+    const count = coords.length / 3;
+    return line.split(/\s+/).slice(1).map((token) => {
+      const k = parseInt(token, 10);
+      return k < 0 ? count + k : k - 1;
+    });
   };
   for (const raw of text.split('\n')) {
     const line = raw.trim();
@@ -22,15 +35,15 @@ export function parseObj(text) {
       faces = null;
     } else if (line.startsWith('f ')) {
       faces = faces || facesOf(current);
-      const count = coords.length / 3;
-      const ids = line.split(/\s+/).slice(1).map((token) => {
-        const k = parseInt(token, 10);
-        return k < 0 ? count + k : k - 1;
-      });
-      for (let k = 1; k + 1 < ids.length; k++) faces.push(ids[0], ids[k], ids[k + 1]);
+      const f = ids(line);
+      for (let k = 1; k + 1 < f.length; k++) faces.push(f[0], f[k], f[k + 1]);
+    } else if (line.startsWith('l ')) {
+      const l = ids(line);
+      const list = listOf(edges, current);
+      for (let k = 0; k + 1 < l.length; k++) list.push(l[k], l[k + 1]);
     }
   }
-  return { positions: Float32Array.from(coords), bodies };
+  return { positions: Float32Array.from(coords), bodies, edges };
 }
 
 /** Only the positions (the topology of a replay folder's OBJs is the same in every frame). */

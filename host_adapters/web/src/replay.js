@@ -93,13 +93,14 @@ function sceneOf(final, obj, errors, metrics) {
     first += def.mesh?.vertices?.length || 0;
   }
   const bodies = [];
-  const indices = [...obj.bodies.keys()].sort((a, b) => a - b);
+  const indices = [...new Set([...obj.bodies.keys(), ...obj.edges.keys()])].sort((a, b) => a - b);
   for (const index of indices) {
-    const triangles = obj.bodies.get(index);
+    const triangles = obj.bodies.get(index) || [];
+    const edges = obj.edges.get(index) || [];
     const def = defs[index] || {};
     let lo = Infinity;
     let hi = -1;
-    for (const p of triangles) {
+    for (const p of [...triangles, ...edges]) {
       lo = Math.min(lo, p);
       hi = Math.max(hi, p);
     }
@@ -109,6 +110,7 @@ function sceneOf(final, obj, errors, metrics) {
       first: firsts[index] ?? (hi >= 0 ? lo : 0),
       count: def.mesh?.vertices?.length ?? (hi >= 0 ? hi - lo + 1 : 0),
       triangles,
+      edges,
       panel_mesh: panelBodies.has(def.name),
       rest_scale: def.rest_scale || [1, 1, 1],
     });

@@ -124,6 +124,7 @@ export class View {
     this.raycaster = new THREE.Raycaster();
     this.particles = 0;
     this.meshes = [];
+    this.edgeLines = []; // the line segments of edge-only bodies
     this.colliders = [];
     this.pins = [];
     this.sceneSize = 1;
@@ -159,6 +160,7 @@ export class View {
     this.particles = n;
     this.position = new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
     this.color = new THREE.BufferAttribute(new Float32Array(3 * n).fill(0.8), 3).setUsage(THREE.DynamicDrawUsage);
+    this.edgeLines = [];
     this.meshes = scene.bodies.map((body) => {
       const geometry = new THREE.BufferGeometry();
       geometry.setAttribute('position', this.position);
@@ -181,6 +183,16 @@ export class View {
       outline.frustumCulled = false;
       mesh.userData.outline = outline;
       this.bodyGroup.add(mesh, outline);
+      if (body.edges?.length) { // an edge-only body (a net, a cable): its edges as lines
+        const net = new THREE.BufferGeometry();
+        net.setAttribute('position', this.position);
+        net.setAttribute('color', this.color);
+        net.setIndex(new (n > 65535 ? THREE.Uint32BufferAttribute : THREE.Uint16BufferAttribute)(body.edges, 1));
+        const lines = new THREE.LineSegments(net, srgbVertexColors(new THREE.LineBasicMaterial({ vertexColors: true })));
+        lines.frustumCulled = false;
+        this.edgeLines.push(lines);
+        this.bodyGroup.add(lines);
+      }
       return mesh;
     });
 
@@ -381,6 +393,14 @@ export class View {
   }
 
   /** The collider under the cursor: its index and the hit point, or null. */
+  /** The scene pin whose dot is under the cursor ({index, point}), or null. */
+  pickPin(clientX, clientY) {
+    if (!this.pinGroup.visible) return null;
+    this.ray(clientX, clientY);
+    const hit = this.raycaster.intersectObjects(this.pins, false)[0];
+    return hit ? { index: this.pins.indexOf(hit.object), point: hit.object.position.clone() } : null;
+  }
+
   pickCollider(clientX, clientY) {
     this.ray(clientX, clientY);
     const hit = this.raycaster.intersectObjects(this.colliders, false)[0];

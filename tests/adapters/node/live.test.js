@@ -128,11 +128,14 @@ test('a drag moves the corner it holds, and releasing it removes its pin', async
   const f0 = live.session.record.frame;
   const g = await next(page, geometryFrom(f0 + 60), '60 more frames');
   const moved = decode(g.buffer).positions.subarray(3 * corner, 3 * corner + 3);
-  // The corner is on a rigid panel hinged to the pinned one: it swings up as far as the hinges let
-  // it, ending at least halfway to a target 0.4 m above.
-  const left = Math.hypot(moved[0] - target[0], moved[1] - target[1], moved[2] - target[2]);
-  assert.ok(left < 0.2, `corner ${left} m from a target 0.4 m above where it was`);
-  assert.ok(moved[2] - start[2] > 0.2, `corner rose ${moved[2] - start[2]} m`);
+  // The corner is on a panel hinged to the pinned one: the drag lifts it only as far as the panels
+  // stay within their tolerances' max (the drag's reach shrinks as a metric nears it, the drape's
+  // own errors included: measured, a rise of 0.019 m toward a target 0.4 m above in 60 frames).
+  assert.ok(moved[2] - start[2] > 0.01, `corner rose ${moved[2] - start[2]} m`);
+  const r = g.record;
+  const tol = live.session.tolerances;
+  assert.ok(r.planarity_max <= tol.planarity.max && r.thickness_error_max <= tol.thickness.max &&
+            r.miter_error_max <= tol.miter.max, JSON.stringify(r));
   assert.equal(w.counts().pins, pinsBefore + 1);
   send(page, { type: 'drag_end' });
   await paused(page);
@@ -196,6 +199,9 @@ test('bad messages are refused with a reason and change nothing', async () => {
     { type: 'rest_scale', body: 0, scale: -1 }, { type: 'rest_scale', body: 3, scale: 1 },
     { type: 'pause', paused: 'no' }, { type: 'export', format: 'stl' },
     { type: 'export', format: 'gltf', metric: 'beauty' },
+    { type: 'export_all', metric: 'beauty' }, { type: 'drag_end', pin: 'yes' },
+    { type: 'pin_target', index: 4, target: [0, 0, 0] }, { type: 'pin_target', index: -1, target: [0, 0, 0] },
+    { type: 'pin_target', index: 0, target: [0, 0, 1e300] }, { type: 'pin_target', index: 0, target: [0, 0] },
   ];
   for (const msg of bad) {
     send(page, msg);
@@ -283,8 +289,10 @@ test('two pages drag independently; a page that leaves lets go; save keeps no dr
   send(page, { type: 'save' });
   const saved = await next(page, ofType('saved'), 'saved during two drags');
   assert.equal(w.counts().pins, pins + 2);
-  const targets = w.pins().map((p) => [w.pinParticle(p), w.pinTarget(p)[2]]);
-  assert.deepEqual(targets.slice(pins).sort((a, b) => a[0] - b[0]), [[3, 1.5], [60, 2]]);
+  assert.deepEqual(w.pins().slice(pins).map((p) => w.pinParticle(p)).sort((a, b) => a - b), [3, 60]);
+  // Each drag holds its cursor's target; its pin's target leads there at the next step (DRAG_REACH).
+  const targets = [...live.session.drags.values()].map((d) => [d.particle, d.target[2]]);
+  assert.deepEqual(targets.sort((a, b) => a[0] - b[0]), [[3, 1.5], [60, 2]]);
   assert.equal(JSON.parse(saved.json).pins.length, pins, 'the saved design holds the scene\'s pins only');
   other.ws.close();
   await new Promise((resolve) => {
@@ -336,4 +344,74 @@ test('the embra-live command: usage errors exit 1, an invalid scene exits 2 nami
   assert.match(r.stderr, /bad\.json: .*\/bodies\/0/);
   const missing = run('/nonexistent/scene.json', '--port', '0');
   assert.equal(missing.status, 2, missing.stderr);
+});
+
+test('export_all while running: the scene JSON, the glTF and the .3dm of one frame', async () => {
+  send(page, { type: 'pause', paused: false });
+  await next(page, geometryFrom(live.session.record.frame + 5), 'frames while running');
+  const mark = page.inbox.length;
+  send(page, { type: 'export_all', metric: 'thickness' });
+  // The replies come in this order, at once: the scene JSON, the glTF, the .3dm.
+  const rhinoMsg = await next(page, (m) => m.type === 'exported' && m.format === '3dm', 'the .3dm', 30000);
+  const replies = page.inbox.slice(mark).filter((m) => m.type === 'saved' || m.type === 'exported');
+  assert.deepEqual(replies.map((m) => m.format || m.type), ['saved', 'gltf', '3dm']);
+  const [saved, gltfMsg] = replies;
+  const { frame } = saved;
+  await next(page, geometryFrom(frame + 1), 'the world stepping on');
+  await paused(page);
+  assert.equal(gltfMsg.frame, frame);
+  assert.equal(rhinoMsg.frame, frame);
+  for (const m of [saved, gltfMsg, rhinoMsg]) assert.match(path.basename(m.path), new RegExp(`-f${String(frame).padStart(5, '0')}\\.`));
+  // The three hold the same positions: the saved scene's, as floats in the glTF and the .3dm.
+  const again = embra.World.loadJson(saved.json, path.dirname(scene));
+  const positions = again.positions();
+  again.close();
+  const used = Array.from(new Set(live.session.bodies[0].triangles)).sort((a, b) => a - b);
+  const gltf = JSON.parse(Buffer.from(gltfMsg.base64, 'base64').toString());
+  const data = Buffer.from(gltf.buffers[0].uri.split(',')[1], 'base64');
+  const acc = gltf.accessors[gltf.meshes[0].primitives[0].attributes.POSITION];
+  const view = gltf.bufferViews[acc.bufferView];
+  const pos = new Float32Array(data.buffer.slice(data.byteOffset + view.byteOffset, data.byteOffset + view.byteOffset + view.byteLength));
+  const [mesh] = await read3dm(Buffer.from(rhinoMsg.base64, 'base64'));
+  used.forEach((p, i) => {
+    for (let k = 0; k < 3; ++k) {
+      assert.equal(pos[3 * i + k], Math.fround(positions[3 * p + k]), `glTF vertex ${i}`);
+      assert.equal(mesh.positions[3 * i + k], Math.fround(positions[3 * p + k]), `.3dm vertex ${i}`);
+    }
+  });
+});
+
+test('pin here leaves a hard pin at the drag\'s target; pin_target moves a scene pin', async () => {
+  await paused(page);
+  const w = live.session.world;
+  const pins = live.session.pins.length;
+  const start = Array.from(w.positions(3, 1));
+  const target = [start[0], start[1], start[2] + 0.05];
+  send(page, { type: 'drag_start', particle: 3, target: start });
+  send(page, { type: 'drag', target });
+  send(page, { type: 'drag_end', pin: true });
+  const scene = await next(page, (m) => m.type === 'scene' && m.pins.length === pins + 1, 'a scene with the new pin');
+  const pin = scene.pins[pins];
+  assert.equal(pin.particle, 3);
+  assert.equal(pin.name, `pin_here_${pins}`);
+  assert.deepEqual(pin.target, target);
+  assert.equal(live.session.drags.size, 0, 'the drag pin is gone');
+  for (let k = 0; k < 3; k++) {
+    send(page, { type: 'step' });
+    await next(page, ofType('geometry'), 'a step');
+  }
+  // A hard pin: the particle is at its target after a step.
+  assert.deepEqual(Array.from(w.positions(3, 1)), target);
+  send(page, { type: 'pin_target', index: pins, target: start });
+  send(page, { type: 'step' });
+  await next(page, ofType('geometry'), 'a step');
+  assert.deepEqual(Array.from(w.positions(3, 1)), start);
+  // While the pins are off there is nothing to move or pin; back on, each holds its last target.
+  send(page, { type: 'pins', on: false });
+  await next(page, (m) => m.type === 'status' && m.pins_on === false, 'pins off');
+  send(page, { type: 'pin_target', index: 0, target: start });
+  assert.match((await next(page, ofType('error'), 'a refusal')).message, /pins are off/);
+  send(page, { type: 'pins', on: true });
+  const back = await next(page, (m) => m.type === 'scene' && m.pins_on, 'pins on');
+  assert.deepEqual(back.pins[pins].target, start);
 });
