@@ -1109,7 +1109,59 @@ void Session::op_edit() {
   const int32_t index = in_.chance(2) ? in_.u8() % 8 : in_.integer();
   const std::string at = "(group {" + std::to_string(g.index) + ", " + std::to_string(g.generation) + "}, kind " +
                          std::to_string(kind) + ", index " + std::to_string(index);
-  switch (in_.u8() % 10) {
+  switch (in_.u8() % 14) {
+    case 10: {  // point loads
+      const int32_t first = particle();
+      const int32_t count = in_.chance(16) ? -1 : in_.u8() % 6;
+      std::vector<double> xyz(3 * static_cast<size_t>(count > 0 ? count : 0));
+      for (double& v : xyz) v = in_.chance(4) ? in_.value() : in_.coordinate();
+      const double* p = in_.chance(32) ? nullptr : xyz.data();
+      call("embra_world_set_loads(first " + std::to_string(first) + ", count " + std::to_string(count) + ")", true,
+           [&] { return embra_world_set_loads(world_, p, first, count); });
+      std::vector<double> out(3 * 8);
+      call("embra_world_get_loads", false,
+           [&] { return embra_world_get_loads(world_, out.data(), in_.chance(8) ? 2 : 24, first, in_.u8() % 9); });
+      break;
+    }
+    case 11: {  // a support: a pin on a plane or a line
+      embra_support_def d = embra_default_support_def();
+      d.version = version(EMBRA_SUPPORT_DEF_VERSION);
+      d.particle = particle();
+      d.support = in_.chance(4) ? in_.integer() : in_.u8() % 3;
+      fill_vec3(d.target, true);
+      if (in_.chance(2)) fill_vec3(d.axis, !in_.chance(4));
+      if (in_.chance(2)) d.compliance = in_.chance(2) ? 1e-3 : in_.value();
+      if (in_.chance(2)) d.group = pick_id(in_, groups_);
+      embra_pin_id pin{};
+      if (call("embra_support_create(support " + std::to_string(d.support) + ", particle " +
+                   std::to_string(d.particle) + ", compliance " + fmt(d.compliance) + ")",
+               true, [&] { return embra_support_create(world_, &d, &pin); }) == EMBRA_OK)
+        pins_.push_back(pin);
+      break;
+    }
+    case 12: {  // forces out: member forces and reactions, sized or not
+      int64_t n = 0;
+      std::vector<double> forces(64);
+      const bool ask = in_.chance(2);
+      call("embra_group_get_forces" + at + ")", false, [&] {
+        return embra_group_get_forces(world_, g, kind, ask ? nullptr : forces.data(), ask ? 0 : in_.u8() % 65, &n);
+      });
+      std::vector<embra_reaction> reactions(32);
+      int32_t m = 0;
+      call("embra_world_get_reactions", false, [&] {
+        return embra_world_get_reactions(world_, in_.chance(4) ? nullptr : reactions.data(), in_.u8() % 33, &m);
+      });
+      break;
+    }
+    case 13: {  // the OBJ text, into a buffer sized or not
+      int64_t length = 0;
+      std::vector<char> text(static_cast<size_t>(1 + in_.u16() % 4096));
+      call("embra_world_export_obj", false, [&] {
+        return embra_world_export_obj(world_, in_.chance(4) ? nullptr : text.data(),
+                                      static_cast<int64_t>(in_.chance(4) ? 0 : text.size()), &length);
+      });
+      break;
+    }
     case 0: {
       const double c = in_.value();
       call("embra_constraint_set_compliance" + at + ", " + fmt(c) + ")", true,
