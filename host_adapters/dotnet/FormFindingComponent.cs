@@ -9,10 +9,13 @@ using System.Linq;
 
 namespace Embra.Grasshopper
 {
-    public struct Point3d
+    public struct Point3d : IPoint3d
     {
         public double X, Y, Z;
         public Point3d(double x, double y, double z) { X = x; Y = y; Z = z; }
+        double IPoint3d.X { get { return X; } }
+        double IPoint3d.Y { get { return Y; } }
+        double IPoint3d.Z { get { return Z; } }
         public double DistanceTo(Point3d o)
         {
             double dx = X - o.X, dy = Y - o.Y, dz = Z - o.Z;
@@ -28,6 +31,46 @@ namespace Embra.Grasshopper
         public MeshFace(int a, int b, int c) { A = a; B = b; C = c; D = c; }
         public MeshFace(int a, int b, int c, int d) { A = a; B = b; C = c; D = d; }
         public bool IsQuad { get { return C != D; } }
+    }
+
+    /// <summary>A point as a host hands it: the real plugin wraps Rhino.Geometry.Point3d (a struct
+    /// with X, Y, Z) in this; Point3d above implements it.</summary>
+    public interface IPoint3d
+    {
+        double X { get; }
+        double Y { get; }
+        double Z { get; }
+    }
+
+    /// <summary>A mesh as a host hands it: vertices and faces (Rhino's Mesh.Vertices and Mesh.Faces,
+    /// a triangle with C == D). The real plugin wraps Rhino.Geometry.Mesh in this and turns the
+    /// component's output mesh back into one (Mesh.Vertices.Add, Mesh.Faces.AddFace).</summary>
+    public interface IMeshLike
+    {
+        IReadOnlyList<IPoint3d> Vertices { get; }
+        IReadOnlyList<MeshFace> Faces { get; }
+    }
+
+    /// <summary>A mesh held in lists: what the component outputs, and what a host without Rhino passes.</summary>
+    public sealed class ListMesh : IMeshLike
+    {
+        readonly List<IPoint3d> vertices;
+        readonly List<MeshFace> faces;
+        public ListMesh(IEnumerable<IPoint3d> vertices, IEnumerable<MeshFace> faces)
+        {
+            this.vertices = vertices.ToList();
+            this.faces = faces.ToList();
+        }
+        public IReadOnlyList<IPoint3d> Vertices { get { return vertices; } }
+        public IReadOnlyList<MeshFace> Faces { get { return faces; } }
+    }
+
+    /// <summary>What keeps a running component stepping: Grasshopper's
+    /// GH_Document.ScheduleSolution(interval, callback) in the plugin, the callback expiring the
+    /// component so the canvas solves it again; a test drives it by hand.</summary>
+    public interface ISolutionScheduler
+    {
+        void ScheduleSolution(int intervalMs, Action expire);
     }
 
     public enum GH_ParamAccess { item, list }
@@ -127,6 +170,14 @@ namespace Embra.Grasshopper
             RuntimeMessages.Add(new KeyValuePair<GH_RuntimeMessageLevel, string>(level, text));
         }
 
+        /// <summary>Set by the canvas: marks the component for another solution (GH_Component.ExpireSolution).</summary>
+        public Action SolutionExpired;
+
+        protected void ExpireSolution()
+        {
+            if (SolutionExpired != null) SolutionExpired();
+        }
+
         /// <summary>What the canvas calls when an input changes or the timer ticks.</summary>
         public void ComputeData(IGH_DataAccess DA)
         {
@@ -190,20 +241,30 @@ namespace Embra.Grasshopper
     }
 
     /// <summary>Form finding on a mesh: anchors (movable), goals with weights, gravity; Reset rebuilds
-    /// the world from the inputs, Run steps it every solution. Outputs the vertices and the error of
-    /// every goal and anchor, for colouring by fabrication tolerance.</summary>
+    /// the world from the inputs, Run steps it every solution and schedules the next (Scheduler), and
+    /// changed gravity, compliances, damping and anchors act on the running world (ApplyChanges).
+    /// Outputs the mesh on its moved vertices, the vertices and the error of every goal and anchor,
+    /// for colouring by fabrication tolerance.</summary>
     public sealed class FormFindingComponent : GH_Component, IDisposable
     {
         public const int InVertices = 0, InFaces = 1, InAnchors = 2, InAnchorTargets = 3, InGoals = 4, InGravity = 5,
             InMass = 6, InStretchCompliance = 7, InBendCompliance = 8, InStretchWeight = 9, InDamping = 10,
-            InSubsteps = 11, InIterations = 12, InStepsPerSolve = 13, InReset = 14, InRun = 15;
+            InSubsteps = 11, InIterations = 12, InStepsPerSolve = 13, InReset = 14, InRun = 15, InMesh = 16;
         public const int OutVertices = 0, OutGoalErrors = 1, OutAnchorErrors = 2, OutResidual = 3, OutKineticEnergy = 4,
-            OutSettled = 5, OutFrame = 6;
+            OutSettled = 5, OutFrame = 6, OutMesh = 7;
+
+        /// <summary>Keeps the component stepping while Run is on: after each running solution it asks
+        /// for the next one IntervalMs later. Null: one step batch per solution.</summary>
+        public ISolutionScheduler Scheduler;
+        public int IntervalMs = 10;
 
         World world;
         Body body;
         PinId[] pins = new PinId[0];
         Point3d[] anchorTargets = new Point3d[0];
+        List<MeshFace> faces = new List<MeshFace>();
+        Point3d gravityNow;
+        double stretchNow, bendNow, dampingNow, massNow;
         int[] anchors = new int[0];
         List<Goal> goals = new List<Goal>();
         double[] goalRest = new double[0];
@@ -228,7 +289,8 @@ namespace Embra.Grasshopper
             p.Add("Iterations", "I", "Passes per substep, default 1", GH_ParamAccess.item, true);
             p.Add("StepsPerSolve", "N", "Frames stepped per solution while running, default 1", GH_ParamAccess.item, true);
             p.Add("Reset", "R", "Rebuild from the inputs", GH_ParamAccess.item, true);
-            p.Add("Run", "On", "Step while true", GH_ParamAccess.item, true);
+            p.Add("Run", "On", "Step while true (the component schedules its next solution)", GH_ParamAccess.item, true);
+            p.Add("Mesh", "M", "The mesh to shape (instead of Vertices and Faces)", GH_ParamAccess.item, true);
         }
 
         protected override void RegisterOutputParams(ParamList p)
@@ -240,6 +302,7 @@ namespace Embra.Grasshopper
             p.Add("KineticEnergy", "K", "Kinetic energy (J)", GH_ParamAccess.item);
             p.Add("Settled", "Ok", "No vertex moves faster than 1 mm/s", GH_ParamAccess.item);
             p.Add("Frame", "f", "Frames stepped since the last reset", GH_ParamAccess.item);
+            p.Add("Mesh", "M", "The input's faces on the vertices now", GH_ParamAccess.item);
         }
 
         static T Item<T>(IGH_DataAccess DA, int index, T fallback)
@@ -254,17 +317,19 @@ namespace Embra.Grasshopper
             {
                 bool reset = Item(DA, InReset, false), run = Item(DA, InRun, false);
                 if (reset || world == null) Build(DA);
-                var targets = new List<Point3d>();
+                else ApplyChanges(DA);
+                var targets = new List<IPoint3d>();
                 if (DA.GetDataList(InAnchorTargets, targets) && targets.Count > 0)
                 {
                     if (targets.Count != pins.Length)
                         throw new ArgumentException("AnchorTargets: " + targets.Count + " points for " + pins.Length + " anchors");
                     for (int k = 0; k < pins.Length; ++k)
                         world.SetPinTarget(pins[k], new[] { targets[k].X, targets[k].Y, targets[k].Z });
-                    anchorTargets = targets.ToArray();
+                    anchorTargets = targets.Select(t => new Point3d(t.X, t.Y, t.Z)).ToArray();
                 }
                 if (run) world.Step(Item(DA, InStepsPerSolve, 1));
                 Output(DA);
+                if (run && Scheduler != null) Scheduler.ScheduleSolution(IntervalMs, ExpireSolution);
             }
             catch (Exception e)
             {
@@ -277,11 +342,23 @@ namespace Embra.Grasshopper
         void Build(IGH_DataAccess DA)
         {
             var vertices = new List<Point3d>();
-            var faces = new List<MeshFace>();
+            var faceList = new List<MeshFace>();
             var anchorList = new List<int>();
             var goalList = new List<Goal>();
-            if (!DA.GetDataList(InVertices, vertices) || vertices.Count == 0) throw new ArgumentException("Vertices: none given");
-            DA.GetDataList(InFaces, faces);
+            IMeshLike mesh = null;
+            if (DA.GetData(InMesh, ref mesh) && mesh != null)
+            {
+                vertices.AddRange(mesh.Vertices.Select(v => new Point3d(v.X, v.Y, v.Z)));
+                faceList.AddRange(mesh.Faces);
+            }
+            else
+            {
+                var given = new List<IPoint3d>();
+                DA.GetDataList(InVertices, given);
+                vertices.AddRange(given.Select(v => new Point3d(v.X, v.Y, v.Z)));
+                DA.GetDataList(InFaces, faceList);
+            }
+            if (vertices.Count == 0) throw new ArgumentException("Vertices: none given (neither a Mesh nor Vertices)");
             DA.GetDataList(InAnchors, anchorList);
             DA.GetDataList(InGoals, goalList);
             var gravity = Item(DA, InGravity, new Point3d(0, 0, -9.81));
@@ -294,7 +371,7 @@ namespace Embra.Grasshopper
                 xyz[3 * i + 2] = vertices[i].Z;
             }
             var tri = new List<int>();
-            foreach (var f in faces)
+            foreach (var f in faceList)
             {
                 tri.AddRange(new[] { f.A, f.B, f.C });
                 if (f.IsQuad) tri.AddRange(new[] { f.A, f.C, f.D });
@@ -354,11 +431,61 @@ namespace Embra.Grasshopper
                 anchorTargets = anchors.Select(v => vertices[v]).ToArray();
                 goals = goalList;
                 goalRest = rests;
+                faces = faceList;
+                gravityNow = gravity;
+                massNow = def.Material.Mass;
+                stretchNow = def.Material.StretchCompliance;
+                bendNow = def.Material.BendCompliance;
+                dampingNow = solver.Damping;
             }
             catch
             {
                 next.Dispose();
                 throw;
+            }
+        }
+
+        /// <summary>Inputs changed since the last solution, applied to the running world without a
+        /// reset: gravity (embra_world_set_gravity); stretch and bend compliance and damping (the
+        /// body's material, embra_body_set_material); the anchors (pins destroyed and created, each
+        /// new one holding its vertex where it is now). The total mass, the mesh, the goals, the
+        /// substeps and iterations need a Reset (the C ABI has no per-particle mass edit): a changed
+        /// mass is reported on the component.</summary>
+        void ApplyChanges(IGH_DataAccess DA)
+        {
+            var gravity = Item(DA, InGravity, new Point3d(0, 0, -9.81));
+            if (gravity.X != gravityNow.X || gravity.Y != gravityNow.Y || gravity.Z != gravityNow.Z)
+            {
+                world.SetGravity(gravity.X, gravity.Y, gravity.Z);
+                gravityNow = gravity;
+            }
+            double stretch = Item(DA, InStretchCompliance, 0.0), bend = Item(DA, InBendCompliance, 1.0),
+                   damping = Item(DA, InDamping, 0.0);
+            if (stretch != stretchNow || bend != bendNow || damping != dampingNow)
+            {
+                var m = world.GetMaterial(body.Id);
+                m.StretchCompliance = stretch;
+                m.BendCompliance = bend;
+                m.Damping = damping;
+                world.SetMaterial(body.Id, m);
+                stretchNow = stretch;
+                bendNow = bend;
+                dampingNow = damping;
+            }
+            if (Item(DA, InMass, 1.0) != massNow)
+                AddRuntimeMessage(GH_RuntimeMessageLevel.Remark, "Mass: applied at the next Reset");
+            var anchorList = new List<int>();
+            DA.GetDataList(InAnchors, anchorList);
+            if (!anchorList.SequenceEqual(anchors))
+            {
+                foreach (int v in anchorList)
+                    if (v < 0 || v >= body.Count)
+                        throw new ArgumentOutOfRangeException("Anchors", v, "Anchors: vertex " + v + " is not one of the " + body.Count + " vertices");
+                double[] xyz = world.GetPositions(body.First, body.Count);
+                foreach (var pin in pins) world.DestroyPin(pin);
+                pins = anchorList.Select(v => world.CreatePin(body.First + v, new[] { xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2] })).ToArray();
+                anchors = anchorList.ToArray();
+                anchorTargets = anchors.Select(v => new Point3d(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2])).ToArray();
             }
         }
 
@@ -375,6 +502,7 @@ namespace Embra.Grasshopper
             DA.SetData(OutKineticEnergy, report.KineticEnergy);
             DA.SetData(OutSettled, report.Settled != 0);
             DA.SetData(OutFrame, (int)report.Frame);
+            DA.SetData(OutMesh, new ListMesh(points.Cast<IPoint3d>(), faces));
             Message = report.Settled != 0 ? "settled" : "frame " + report.Frame;
         }
 

@@ -248,6 +248,168 @@ namespace Embra.Tests
         }
     }
 
+    /// <summary>The canvas's timer, driven by hand: the component's requests for another solution are
+    /// queued; Tick runs the first one (expiring the component) and says whether there was one.</summary>
+    sealed class ManualScheduler : ISolutionScheduler
+    {
+        readonly Queue<Action> pending = new Queue<Action>();
+        public int Requests;
+        public readonly List<int> Intervals = new List<int>();
+
+        public void ScheduleSolution(int intervalMs, Action expire)
+        {
+            ++Requests;
+            Intervals.Add(intervalMs);
+            pending.Enqueue(expire);
+        }
+
+        public bool Tick()
+        {
+            if (pending.Count == 0) return false;
+            pending.Dequeue()();
+            return true;
+        }
+    }
+
+    [TestFixture]
+    public class GrasshopperComponentTests
+    {
+        const int N = 11;                            // vertices along a side: a 1 m square, 0.1 m quads
+        static readonly int[] Corners = { 0, N - 1, N * (N - 1), N * N - 1 };
+        const int Centre = (N * N) / 2;
+
+        /// <summary>A flat 1 m square of 10 x 10 quads at z = 0, as a Rhino mesh holds it.</summary>
+        static ListMesh Square()
+        {
+            var v = new List<IPoint3d>();
+            for (int j = 0; j < N; ++j)
+                for (int i = 0; i < N; ++i) v.Add(new Point3d(0.1 * i, 0.1 * j, 0.0));
+            var f = new List<MeshFace>();
+            for (int j = 0; j + 1 < N; ++j)
+                for (int i = 0; i + 1 < N; ++i) f.Add(new MeshFace(j * N + i, j * N + i + 1, (j + 1) * N + i + 1, (j + 1) * N + i));
+            return new ListMesh(v, f);
+        }
+
+        static DataAccess Inputs(IMeshLike mesh)
+        {
+            return new DataAccess()
+                .Set(FormFindingComponent.InMesh, mesh).Set(FormFindingComponent.InAnchors, Corners.ToList())
+                .Set(FormFindingComponent.InMass, 0.5).Set(FormFindingComponent.InStretchCompliance, 1e-3)
+                .Set(FormFindingComponent.InBendCompliance, 10.0).Set(FormFindingComponent.InDamping, 4.0)
+                .Set(FormFindingComponent.InSubsteps, 20).Set(FormFindingComponent.InIterations, 2)
+                .Set(FormFindingComponent.InReset, true).Set(FormFindingComponent.InRun, false);
+        }
+
+        /// <summary>Runs the canvas: solves, then solves again on each of the component's requests, at
+        /// most `solutions` times in all. Returns the solutions run.</summary>
+        static int Run(FormFindingComponent c, DataAccess da, ManualScheduler timer, int solutions)
+        {
+            bool expired = true;
+            c.SolutionExpired = () => expired = true;
+            int n = 0;
+            while (n < solutions && expired)
+            {
+                expired = false;
+                c.ComputeData(da);
+                Assert.IsEmpty(c.RuntimeMessages);
+                ++n;
+                if (n < solutions) timer.Tick();
+            }
+            return n;
+        }
+
+        static double Z(DataAccess da, int vertex) { return da.Get<IMeshLike>(FormFindingComponent.OutMesh).Vertices[vertex].Z; }
+
+        /// <summary>A mesh in, a mesh out with the same faces on the moved vertices; with Run on the
+        /// component asks for its next solution every time, so the square, held at its corners, sags;
+        /// with Run off it asks for none and stays at its frame.</summary>
+        [Test]
+        public void MeshInMeshOutAndKeepsSteppingWhileRunIsOn()
+        {
+            var square = Square();
+            var timer = new ManualScheduler();
+            using (var c = new FormFindingComponent { Scheduler = timer })
+            {
+                var da = Inputs(square);
+                c.ComputeData(da);  // Reset: build, no step, no request
+                Assert.AreEqual(0, timer.Requests);
+                da.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                Assert.AreEqual(150, Run(c, da, timer, 150));  // one solution started by hand, 149 by the timer
+                Assert.AreEqual(150, timer.Requests);
+                Assert.That(timer.Intervals.All(ms => ms == c.IntervalMs));
+                Assert.AreEqual(150, da.Get<int>(FormFindingComponent.OutFrame));
+
+                var mesh = da.Get<IMeshLike>(FormFindingComponent.OutMesh);
+                var points = da.GetList<Point3d>(FormFindingComponent.OutVertices);
+                Assert.AreEqual(N * N, mesh.Vertices.Count);
+                CollectionAssert.AreEqual(square.Faces, mesh.Faces);
+                for (int i = 0; i < N * N; ++i)
+                {
+                    Assert.AreEqual(points[i].X, mesh.Vertices[i].X);
+                    Assert.AreEqual(points[i].Z, mesh.Vertices[i].Z);
+                }
+                foreach (int k in Corners) Assert.AreEqual(0.0, mesh.Vertices[k].Z);  // hard anchors
+                Assert.Less(mesh.Vertices[Centre].Z, -0.02);                            // sagged under gravity
+                Console.WriteLine("centre after 150 frames: z = {0:E3} m", mesh.Vertices[Centre].Z);
+
+                da.Set(FormFindingComponent.InRun, false);
+                Assert.IsTrue(timer.Tick());  // the solution the last running one scheduled
+                c.ComputeData(da);
+                Assert.AreEqual(150, timer.Requests);  // and no further request
+                Assert.IsFalse(timer.Tick());
+                Assert.AreEqual(150, da.Get<int>(FormFindingComponent.OutFrame));
+            }
+        }
+
+        /// <summary>Inputs changed while running act on the running world, no reset (the frame count
+        /// goes on): gravity reversed mirrors the sag (the same square under +g is the mirror image of
+        /// it under -g); a softer membrane sags deeper; a vertex made an anchor stays where it was; a
+        /// changed mass is reported as waiting for a Reset.</summary>
+        [Test]
+        public void ChangedInputsApplyWithoutAReset()
+        {
+            var timer = new ManualScheduler();
+            using (var c = new FormFindingComponent { Scheduler = timer })
+            {
+                var da = Inputs(Square());
+                c.ComputeData(da);
+                da.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                Run(c, da, timer, 300);
+                double down = Z(da, Centre);
+
+                da.Set(FormFindingComponent.InGravity, new Point3d(0, 0, 9.81));
+                Run(c, da, timer, 300);
+                double up = Z(da, Centre);
+                Assert.AreEqual(600, da.Get<int>(FormFindingComponent.OutFrame));
+                Console.WriteLine("centre: {0:E6} m under -g, {1:E6} m under +g", down, up);
+                Assert.Less(down, -0.02);
+                Assert.AreEqual(-down, up, 1e-6);  // measured 1.4e-7 m apart
+
+                da.Set(FormFindingComponent.InStretchCompliance, 1e-1);
+                Run(c, da, timer, 300);
+                double soft = Z(da, Centre);
+                Console.WriteLine("centre: {0:E6} m with stretch compliance 1e-1 m/N", soft);
+                Assert.Greater(soft, 2.0 * up);  // measured 0.469 m against 0.096 m
+
+                var held = da.Get<IMeshLike>(FormFindingComponent.OutMesh).Vertices[Centre];
+                da.Set(FormFindingComponent.InAnchors, Corners.Concat(new[] { Centre }).ToList());
+                da.Set(FormFindingComponent.InGravity, new Point3d(0, 0, -9.81));
+                Run(c, da, timer, 120);
+                var now = da.Get<IMeshLike>(FormFindingComponent.OutMesh).Vertices[Centre];
+                Assert.AreEqual(held.X, now.X);
+                Assert.AreEqual(held.Y, now.Y);
+                Assert.AreEqual(held.Z, now.Z);
+                Assert.AreEqual(5, da.GetList<double>(FormFindingComponent.OutAnchorErrors).Count);
+                Assert.AreEqual(1020, da.Get<int>(FormFindingComponent.OutFrame));
+
+                da.Set(FormFindingComponent.InMass, 1.0).Set(FormFindingComponent.InRun, false);
+                c.ComputeData(da);
+                Assert.AreEqual(1, c.RuntimeMessages.Count);
+                Assert.AreEqual(GH_RuntimeMessageLevel.Remark, c.RuntimeMessages[0].Key);
+            }
+        }
+    }
+
     [TestFixture]
     public class ConstraintKindTests
     {
@@ -1436,7 +1598,7 @@ namespace Embra.Tests
             var goals = new List<Goal> { Goal.Length(20, 24, 0.5, 0, 5), Goal.Angle(0, 1, 5) };
             using (var component = new FormFindingComponent())
             {
-                Assert.AreEqual(16, component.Inputs.Count);
+                Assert.AreEqual(17, component.Inputs.Count);  // the last is Mesh, instead of Vertices and Faces
                 var da = new DataAccess().Set(0, vertices).Set(1, faces).Set(2, new List<int> { 0, 4 }).Set(4, goals)
                     .Set(FormFindingComponent.InIterations, 4).Set(FormFindingComponent.InStepsPerSolve, 30)
                     .Set(FormFindingComponent.InReset, true).Set(FormFindingComponent.InRun, false);
