@@ -93,6 +93,28 @@ void consume_cancel(embra_world* world, embra_status status) {
 
 }  // namespace embra::capi
 
+namespace {
+
+/// One value per constraint of `kind` in `group` (World::constraint_residuals, constraint_forces), in
+/// the two-call pattern.
+embra_status per_constraint(const char* function,
+                            std::vector<double> (embra::World::*values)(embra::Id, embra::Kind) const,
+                            const embra_world* world, embra_group_id group, int32_t kind, double* out, int64_t capacity,
+                            int64_t* out_count) {
+  return guard(function, world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    if (!embra::is_kind(kind))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "kind " + num(kind) + " is not an embra_constraint_kind");
+    const std::vector<double> v = (world->world.*values)(to_id(group), static_cast<embra::Kind>(kind));
+    const int64_t n = static_cast<int64_t>(v.size());
+    if (fits(out, capacity, n, "doubles")) std::copy(v.begin(), v.end(), out);
+    *out_count = n;
+  });
+}
+
+}  // namespace
+
 extern "C" {
 
 embra_solver_def embra_default_solver_def(void) {
@@ -304,38 +326,14 @@ embra_status embra_world_get_group_conflicts(const embra_world* world, embra_gro
 
 embra_status embra_group_get_residuals(const embra_world* world, embra_group_id group, int32_t kind, double* out,
                                        int64_t capacity, int64_t* out_count) {
-  return guard("embra_group_get_residuals", world, [&] {
-    need(out_count, "out_count");
-    need_count(capacity, "capacity");
-    if (!embra::is_kind(kind))
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "kind " + num(kind) + " is not an embra_constraint_kind");
-    const std::vector<double> r = world->world.constraint_residuals(to_id(group), static_cast<embra::Kind>(kind));
-    const int64_t n = static_cast<int64_t>(r.size());
-    if (!fits(out, capacity, n, "doubles")) {
-      *out_count = n;
-      return;
-    }
-    std::copy(r.begin(), r.end(), out);
-    *out_count = n;
-  });
+  return per_constraint("embra_group_get_residuals", &embra::World::constraint_residuals, world, group, kind, out,
+                        capacity, out_count);
 }
 
 embra_status embra_group_get_forces(const embra_world* world, embra_group_id group, int32_t kind, double* out,
                                     int64_t capacity, int64_t* out_count) {
-  return guard("embra_group_get_forces", world, [&] {
-    need(out_count, "out_count");
-    need_count(capacity, "capacity");
-    if (!embra::is_kind(kind))
-      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "kind " + num(kind) + " is not an embra_constraint_kind");
-    const std::vector<double> f = world->world.constraint_forces(to_id(group), static_cast<embra::Kind>(kind));
-    const int64_t n = static_cast<int64_t>(f.size());
-    if (!fits(out, capacity, n, "doubles")) {
-      *out_count = n;
-      return;
-    }
-    std::copy(f.begin(), f.end(), out);
-    *out_count = n;
-  });
+  return per_constraint("embra_group_get_forces", &embra::World::constraint_forces, world, group, kind, out, capacity,
+                        out_count);
 }
 
 embra_status embra_world_get_reactions(const embra_world* world, embra_reaction* out, int32_t capacity,

@@ -903,11 +903,7 @@ namespace Embra
         /// order they were added, in the kind's unit (embra_group_get_residuals).</summary>
         public double[] GroupResiduals(GroupId group, ConstraintKind kind)
         {
-            long n = 0;
-            Call(w => Native.embra_group_get_residuals(w, group, (int)kind, null, 0, out n));
-            var res = new double[n];
-            Call(w => Native.embra_group_get_residuals(w, group, (int)kind, res, res.Length, out n));
-            return res;
+            return PerConstraint(Native.embra_group_get_residuals, group, kind);
         }
 
         /// <summary>The force of every constraint of `kind` in `group` after the last step, in the order
@@ -915,11 +911,19 @@ namespace Embra
         /// tether its tension in N (positive pulling its ends together).</summary>
         public double[] ConstraintForces(GroupId group, ConstraintKind kind)
         {
+            return PerConstraint(Native.embra_group_get_forces, group, kind);
+        }
+
+        delegate int PerConstraintList(IntPtr world, GroupId group, int kind, double[] buffer, long capacity, out long count);
+
+        // One value per constraint of `kind` in `group`, through a two-call listing.
+        double[] PerConstraint(PerConstraintList list, GroupId group, ConstraintKind kind)
+        {
             long n = 0;
-            Call(w => Native.embra_group_get_forces(w, group, (int)kind, null, 0, out n));
-            var res = new double[n];
-            Call(w => Native.embra_group_get_forces(w, group, (int)kind, res, res.Length, out n));
-            return res;
+            Call(w => list(w, group, (int)kind, null, 0, out n));
+            var values = new double[n];
+            Call(w => list(w, group, (int)kind, values, values.LongLength, out n));
+            return values;
         }
 
         /// <summary>The force (N) every live pin exerts on its particle after the last step
@@ -987,12 +991,17 @@ namespace Embra
         }
 
         // --- JSON scenes ------------------------------------------------------------------------
-        public string SaveJson()
+        public string SaveJson() { return Text(Native.embra_world_save_json); }
+
+        delegate int TextListing(IntPtr world, byte[] buffer, long capacity, out long length);
+
+        // A NUL-terminated UTF-8 text through a two-call listing (the length counts the NUL).
+        string Text(TextListing write)
         {
             long n = 0;
-            Call(w => Native.embra_world_save_json(w, null, 0, out n));
+            Call(w => write(w, null, 0, out n));
             var text = new byte[n];
-            Call(w => Native.embra_world_save_json(w, text, text.LongLength, out n));
+            Call(w => write(w, text, text.LongLength, out n));
             return Encoding.UTF8.GetString(text, 0, (int)n - 1);
         }
 
@@ -1006,14 +1015,7 @@ namespace Embra
         /// <summary>The world as Wavefront OBJ text (embra_world_export_obj): every particle a `v` line in
         /// world order, each body's triangles as `f` lines, a body without triangles (a hanging net) as `l`
         /// lines of its edges.</summary>
-        public string ExportObj()
-        {
-            long n = 0;
-            Call(w => Native.embra_world_export_obj(w, null, 0, out n));
-            var text = new byte[n];
-            Call(w => Native.embra_world_export_obj(w, text, text.LongLength, out n));
-            return Encoding.UTF8.GetString(text, 0, (int)n - 1);
-        }
+        public string ExportObj() { return Text(Native.embra_world_export_obj); }
 
         /// <summary>Writes ExportObj()'s text to a file (replaced whole; no partial file on failure).</summary>
         public void WriteObj(string path)

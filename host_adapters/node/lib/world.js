@@ -1123,13 +1123,7 @@ class World {
    * added, in the kind's unit (embra_group_get_residuals): a Float64Array.
    */
   groupResiduals(group, kind) {
-    if (!(group instanceof GroupId)) throw new TypeError(`group: expected a GroupId, got ${buf.describe(group)}`);
-    const k = enumValue(kind, KINDS, 'kind');
-    const n = [0];
-    this.#call('embra_group_get_residuals', group, k, null, 0, n);
-    const out = new Float64Array(Number(n[0]));
-    this.#call('embra_group_get_residuals', group, k, out, out.length, n);
-    return out;
+    return this.#perConstraint('embra_group_get_residuals', group, kind);
   }
 
   /**
@@ -1138,12 +1132,17 @@ class World {
    * tension in N (positive pulling its ends together). A Float64Array.
    */
   constraintForces(group, kind) {
+    return this.#perConstraint('embra_group_get_forces', group, kind);
+  }
+
+  /** One value per constraint of `kind` in `group`, through a two-call listing: a Float64Array. */
+  #perConstraint(name, group, kind) {
     if (!(group instanceof GroupId)) throw new TypeError(`group: expected a GroupId, got ${buf.describe(group)}`);
     const k = enumValue(kind, KINDS, 'kind');
     const n = [0];
-    this.#call('embra_group_get_forces', group, k, null, 0, n);
+    this.#call(name, group, k, null, 0, n);
     const out = new Float64Array(Number(n[0]));
-    this.#call('embra_group_get_forces', group, k, out, out.length, n);
+    this.#call(name, group, k, out, out.length, n);
     return out;
   }
 

@@ -848,22 +848,21 @@ class World:
     def group_residuals(self, group, kind):
         """The residual of every constraint of `kind` in `group` after the last step, in the order they
         were added, in the kind's unit (embra_group_get_residuals): a list of floats."""
-        g, k = _id(group, GroupId, "group"), _enum(kind, KINDS, "kind")
-        n = c_int64()
-        self._call("embra_group_get_residuals", g, k, None, 0, byref(n))
-        out = (c_double * max(n.value, 1))()
-        self._call("embra_group_get_residuals", g, k, out, n.value, byref(n))
-        return list(out[:n.value])
+        return self._per_constraint("embra_group_get_residuals", group, kind)
 
     def constraint_forces(self, group, kind):
         """The force of every constraint of `kind` in `group` after the last step, in the order they
         were added (embra_group_get_forces): -lambda / h^2 of the last substep; for a distance or
         tether its tension in N (positive pulling its ends together). A list of floats."""
+        return self._per_constraint("embra_group_get_forces", group, kind)
+
+    def _per_constraint(self, name, group, kind):
+        """One value per constraint of `kind` in `group`, through a two-call listing: a list of floats."""
         g, k = _id(group, GroupId, "group"), _enum(kind, KINDS, "kind")
         n = c_int64()
-        self._call("embra_group_get_forces", g, k, None, 0, byref(n))
+        self._call(name, g, k, None, 0, byref(n))
         out = (c_double * max(n.value, 1))()
-        self._call("embra_group_get_forces", g, k, out, n.value, byref(n))
+        self._call(name, g, k, out, n.value, byref(n))
         return list(out[:n.value])
 
     def reactions(self):

@@ -634,9 +634,10 @@ class World {
 
  private:
   Group& group_mut(Id id);
-  /// The constraint array and slot an edit names (refused: stale group, unknown kind, index out of
-  /// range; `edit`: a generated constraint too).
-  ConstraintArray& edited_array(Id group, Kind kind, int64_t index, bool edit);
+  /// The constraint array a constraint is in (refused: stale group, unknown kind, index out of range).
+  const ConstraintArray& constraint_array(Id group, Kind kind, int64_t index) const;
+  /// The same, for an edit: a generated constraint is refused too.
+  ConstraintArray& edited_array(Id group, Kind kind, int64_t index);
   /// A field desc checked as create_field and set_field take it (a pressure's rest volume 0
   /// measured now).
   FieldDesc checked_field(const FieldDesc& desc) const;
