@@ -10,10 +10,13 @@
  *   new pose, so the copy's collider stood still; /state/colliders now holds the frame's start);
  * - a hard pin's target moved 1e300 away (accepted: within EMBRA_MAX_ABS_VALUE) is reached in one
  *   frame at a speed beyond 1e300, which no scene can hold: the step stepped, and the saved world
- *   did not load back. Such a step now fails with EMBRA_ERROR_NUMERICAL and is undone;
+ *   did not load back. Such a step now fails with EMBRA_ERROR_NUMERICAL and is undone, the members'
+ *   forces and the worst constraints included (they read the failed frame's infinite multipliers, and
+ *   the command line wrote "inf" into forces.json);
  * - a collider rotation a few ulp from unit length was normalized when set and normalized again
  *   when its saved scene was loaded, which changed its last bits: save, load, save differed.
  *   Normalizing is now idempotent (a rotation unit to rounding is kept as it is). */
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -157,7 +160,11 @@ static void test_state_beyond_the_range_fails_the_step(void) {
   embra_pin_id pin_id;
   embra_warning warning;
   const double far[3] = {-EMBRA_MAX_ABS_VALUE, -EMBRA_MAX_ABS_VALUE, 1e299};
-  double before[12], after[12];
+  double before[12], after[12], forces_before[3], forces_after[3];
+  embra_constraint_residual worst_before[3], worst_after[3];
+  embra_group_id group;
+  int64_t count = 0;
+  int32_t worst_count = 0, worst_after_count = 0;
   char *text, *saved;
   int i;
   CHECK_OK(embra_world_create(&w, NULL));
@@ -169,8 +176,21 @@ static void test_state_beyond_the_range_fails_the_step(void) {
   CHECK_OK(embra_world_step(w));
   CHECK_OK(embra_pin_set_target(w, pin_id, far)); /* a target within the range is accepted */
   CHECK_OK(embra_world_get_positions(w, before, 12, 0, 4));
+  CHECK_OK(embra_world_default_group(w, &group));
+  CHECK_OK(embra_group_get_forces(w, group, EMBRA_CONSTRAINT_DISTANCE, forces_before, 3, &count));
+  CHECK_OK(embra_world_get_worst_constraints(w, worst_before, 3, &worst_count));
   text = capi_test_save(w);
   CHECK_STATUS(embra_world_step(w), EMBRA_ERROR_NUMERICAL); /* reached at ~1e302 m/s */
+  /* What the reports read is the last completed frame's too: the members' forces and the worst
+   * constraints as before the failed step (the failed frame's multipliers were not finite). */
+  CHECK_OK(embra_group_get_forces(w, group, EMBRA_CONSTRAINT_DISTANCE, forces_after, 3, &count));
+  for (i = 0; i < 3; ++i) CHECK(isfinite(forces_before[i]) && forces_before[i] == forces_after[i]);
+  CHECK_OK(embra_world_get_worst_constraints(w, worst_after, 3, &worst_after_count));
+  CHECK_INT(worst_after_count, worst_count);
+  for (i = 0; i < worst_count && i < worst_after_count; ++i) {
+    CHECK(isfinite(worst_after[i].force) && isfinite(worst_after[i].residual));
+    CHECK(worst_after[i].force == worst_before[i].force && worst_after[i].residual == worst_before[i].residual);
+  }
   CHECK_OK(embra_world_get_warning(w, &warning));
   CHECK_INT(warning.particle, 0);
   CHECK_OK(embra_world_get_positions(w, after, 12, 0, 4));

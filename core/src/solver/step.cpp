@@ -439,6 +439,24 @@ void World::restore(const FrameStart& f) {
     }
   }
   settings_.gravity = f.gravity;
+  // The multipliers the reports read (forces, the worst constraints, reactions) go back to the last
+  // completed frame's (end_frame's copy, reversed); the failed frame's contacts are dropped (each
+  // substep finds them afresh).
+  for (Group& g : groups_) {
+    for (int k = 0; k < kKindCount && !solver_dirty_; ++k) {
+      SolverArray& a = g.solve[k];
+      const std::vector<double>& kept = g.arrays[k].lambda;
+      const size_t per = static_cast<size_t>(multipliers(static_cast<Kind>(k)));
+      for (size_t i = 0; i < a.size(); ++i)
+        for (size_t c = 0; c < per; ++c) {
+          const size_t from = per * static_cast<size_t>(a.source[i]) + c;
+          a.lambda[per * i + c] = from < kept.size() ? kept[from] : 0.0;
+        }
+    }
+    g.contacts.clear();
+  }
+  face_contacts_.clear();
+  self_contacts_.clear();
 }
 
 void World::step(const StepControl& control) {
