@@ -21,11 +21,21 @@ echo "embra: Windows cross-build took $((SECONDS - start)) s" >&2
 [[ "${1:-}" == "--build-only" ]] && exit 0
 
 # wine64 must start (it makes its prefix on first use, about 20 s); if it cannot, say so and skip.
-if ! why=$(bash tests/windows/wine.sh "$PWD/build-windows/wine" build-windows/bin/embra.exe version 2>&1); then
-  echo "embra: SKIPPED the Windows tests: wine64 cannot start here: $why" >&2
+prefix=$PWD/build-windows/wine
+if ! bash tests/windows/wine.sh "$prefix" build-windows/bin/embra.exe version >build-windows/wine-start.log 2>&1 \
+  </dev/null; then
+  echo "embra: SKIPPED the Windows tests: wine64 cannot start here: $(cat build-windows/wine-start.log)" >&2
   exit 0
 fi
 [[ -n "$linux_embra" ]] || echo "embra: no Linux build (build/): windows.same_bits is not run" >&2
+# One wineserver for the whole run (it would otherwise start again for each program, about 3 s
+# each), and wine's own background programs started by a first program whose output goes to a file:
+# started by a test, they would hold its output pipe open as long as the server lives.
+server=$(command -v wineserver || echo /usr/lib/wine/wineserver)
+WINEPREFIX=$prefix "$server" -w
+WINEPREFIX=$prefix "$server" -p
+trap 'WINEPREFIX=$prefix "$server" -k 2>/dev/null || true' EXIT
+bash tests/windows/wine.sh "$prefix" build-windows/bin/embra.exe version >>build-windows/wine-start.log 2>&1 </dev/null
 tests=$SECONDS
 # The heavy 32 x 32 drape (two minutes natively) is left to the Linux build.
 ctest --test-dir build-windows --output-on-failure -j "$jobs" -LE heavy
