@@ -14,6 +14,9 @@ packages=(
   mono-mcs nunit-console libnunit-cil-dev
   abigail-tools
   chromium
+  # The Windows cross-build and its tests (scripts/windows.sh): the -posix compilers of
+  # g++-mingw-w64-x86-64 only (the toolchain file's; the -win32 ones would add 180 MB), and wine64.
+  g++-mingw-w64-x86-64-posix wine64
 )
 # Node.js and npm: the Node adapter, embra-live and the page. Any Node >= 18 will do; Debian 12's
 # nodejs is 18. A machine with Node from elsewhere (nodesource ships npm inside its nodejs) keeps it.

@@ -2,11 +2,9 @@
 #include "guard.hpp"
 
 #include "embra/core/limits.hpp"
+#include "embra/io/files.hpp"
 #include "embra/io/obj.hpp"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <memory>
 
 using namespace embra::capi;
@@ -25,29 +23,14 @@ embra_world* load(std::string_view text, const std::string& base_dir) {
   return load_with(text, options);
 }
 
-/// Writes `text` to `path` through a temporary file beside it: the file is replaced whole or not at all.
+/// Writes `text` to `path` (embra::io::replace_file: whole or not at all), or refuses.
 void replace_file(const char* path, const std::string& text) {
-  const std::string tmp = std::string(path) + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp + ": " + std::strerror(errno));
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok) {
-    std::remove(tmp.c_str());
-    refuse(EMBRA_ERROR_INVALID_ARGUMENT, "cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path) != 0) {
-    std::remove(tmp.c_str());
-    refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string("cannot replace ") + path + ": " + std::strerror(errno));
-  }
+  std::string error;
+  if (!embra::io::replace_file(path, text, error)) refuse(EMBRA_ERROR_INVALID_ARGUMENT, error);
 }
 
 std::string obj_text(const embra_world* world) {
   return embra::io::export_obj(world->world, std::string("embra ") + embra_version_string());
-}
-
-std::string folder_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
 }
 
 }  // namespace
@@ -95,7 +78,7 @@ embra_status embra_world_load_file(embra_world** out_world, const char* path) {
     std::string text, error;
     if (!embra::io::read_regular_file(path, embra::limits::kMaxSceneBytes, text, error))
       refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(path) + " " + error);
-    *out_world = load(text, folder_of(path));
+    *out_world = load(text, embra::io::folder_of(path));
   });
 }
 

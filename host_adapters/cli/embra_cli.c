@@ -33,20 +33,255 @@
  * Exit codes: 0 ok, 1 usage (a non-empty DIR without --force too), 2 invalid input, 3 the simulation
  * failed (non-finite state), 4 --until: the world did not come to rest within tolerance. */
 #define _POSIX_C_SOURCE 200809L
-#include <dirent.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
+
+#ifdef _WIN32
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+/* after windows.h */
+#include <direct.h>
+#include <io.h>
+#include <shellapi.h>
+#else
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+#endif
 
 #include "embra/embra.h"
 
 enum { EXIT_USAGE = 1, EXIT_INVALID = 2, EXIT_SIM = 3, EXIT_UNSETTLED = 4 };
+
+/* --- The platform: files by UTF-8 names, folders, the clock, the terminal ----------------------
+ * Every path is UTF-8, as embra.h takes it. Windows widens it to UTF-16 for its file calls (their
+ * char versions read the ANSI code page); main() reads the command line as UTF-16 and makes it
+ * UTF-8. Files are written in binary mode: the same bytes, "\n" line ends, on every platform. */
+
+#ifdef _WIN32
+/* UTF-8 to UTF-16 (malloc'd); NULL with errno EINVAL for bytes that are not UTF-8. */
+static wchar_t* widen(const char* utf8) {
+  const int n = MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, utf8, -1, NULL, 0);
+  wchar_t* w = n > 0 ? malloc(sizeof *w * (size_t)n) : NULL;
+  if (w == NULL || MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, utf8, -1, w, n) != n) {
+    free(w);
+    errno = n > 0 ? ENOMEM : EINVAL;
+    return NULL;
+  }
+  return w;
+}
+
+/* UTF-16 to UTF-8 (malloc'd), or NULL. */
+static char* narrow(const wchar_t* w) {
+  const int n = WideCharToMultiByte(CP_UTF8, 0, w, -1, NULL, 0, NULL, NULL);
+  char* s = n > 0 ? malloc((size_t)n) : NULL;
+  if (s != NULL && WideCharToMultiByte(CP_UTF8, 0, w, -1, s, n, NULL, NULL) != n) {
+    free(s);
+    s = NULL;
+  }
+  return s;
+}
+
+/* What Windows says of its last error, as one line (a static buffer). */
+static const char* last_error_text(void) {
+  static char text[256];
+  const DWORD n = FormatMessageA(FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS, NULL, GetLastError(),
+                                 MAKELANGID(LANG_NEUTRAL, SUBLANG_DEFAULT), text, sizeof text, NULL);
+  size_t len = n > 0 ? strlen(text) : 0;
+  while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '\r' || text[len - 1] == '.')) text[--len] = 0;
+  if (len == 0) snprintf(text, sizeof text, "Windows error %lu", (unsigned long)GetLastError());
+  return text;
+}
+#endif
+
+/* Whether `c` separates folders in a path. */
+static int is_separator(char c) {
+#ifdef _WIN32
+  return c == '/' || c == '\\';
+#else
+  return c == '/';
+#endif
+}
+
+/* Opens `path` for writing, in binary mode; NULL (errno set) on failure. */
+static FILE* open_write(const char* path) {
+#ifdef _WIN32
+  wchar_t* w = widen(path);
+  FILE* f = w ? _wfopen(w, L"wb") : NULL;
+  free(w);
+  return f;
+#else
+  return fopen(path, "wb");
+#endif
+}
+
+/* Makes the folder `path` (its parent must exist); 0, or -1 with errno (EEXIST: it is there). */
+static int make_one_dir(const char* path) {
+#ifdef _WIN32
+  wchar_t* w = widen(path);
+  const int rc = w ? _wmkdir(w) : -1;
+  free(w);
+  return rc;
+#else
+  return mkdir(path, 0755);
+#endif
+}
+
+/* Whether `path` is a folder with anything in it (a missing folder, or a file, is not). */
+static int folder_has_entries(const char* path) {
+#ifdef _WIN32
+  const size_t n = strlen(path);
+  char* pattern = malloc(n + 3);
+  if (pattern == NULL) return 0;
+  snprintf(pattern, n + 3, "%s%s*", path, n > 0 && is_separator(path[n - 1]) ? "" : "\\");
+  wchar_t* w = widen(pattern);
+  free(pattern);
+  if (w == NULL) return 0;
+  WIN32_FIND_DATAW entry;
+  const HANDLE h = FindFirstFileW(w, &entry);
+  free(w);
+  if (h == INVALID_HANDLE_VALUE) return 0;
+  int found = 0;
+  do found = wcscmp(entry.cFileName, L".") != 0 && wcscmp(entry.cFileName, L"..") != 0;
+  while (!found && FindNextFileW(h, &entry));
+  FindClose(h);
+  return found;
+#else
+  DIR* d = opendir(path);
+  if (d == NULL) return 0;
+  int found = 0;
+  for (struct dirent* e; !found && (e = readdir(d)) != NULL;)
+    found = strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+  closedir(d);
+  return found;
+#endif
+}
+
+/* Milliseconds on a monotonic clock. */
+static double now_ms(void) {
+#ifdef _WIN32
+  LARGE_INTEGER count, frequency;
+  QueryPerformanceCounter(&count);
+  QueryPerformanceFrequency(&frequency);
+  return (double)count.QuadPart * 1e3 / (double)frequency.QuadPart;
+#else
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+#endif
+}
+
+static int stderr_is_terminal(void) {
+#ifdef _WIN32
+  return _isatty(_fileno(stderr));
+#else
+  return isatty(2);
+#endif
+}
+
+/* Reads the scene file at `path` whole into *text (malloc'd, *length bytes): a regular file of at
+ * most 2 GiB, opened without blocking (a pipe or device is refused before a byte is read). On
+ * failure prints why and returns -1. */
+static int read_scene_text(const char* path, char** text, size_t* length) {
+  const int64_t max = (int64_t)1 << 31;
+  *text = NULL;
+  *length = 0;
+#ifdef _WIN32
+  wchar_t* w = widen(path);
+  const HANDLE h = w ? CreateFileW(w, GENERIC_READ, FILE_SHARE_READ | FILE_SHARE_WRITE, NULL, OPEN_EXISTING,
+                                   FILE_FLAG_BACKUP_SEMANTICS, NULL)
+                     : INVALID_HANDLE_VALUE;
+  free(w);
+  if (h == INVALID_HANDLE_VALUE) {
+    fprintf(stderr, "embra: %s: %s\n", path, w ? last_error_text() : "the path is not UTF-8");
+    return -1;
+  }
+  BY_HANDLE_FILE_INFORMATION info;
+  int64_t size = 0;
+  int ok = GetFileType(h) == FILE_TYPE_DISK && GetFileInformationByHandle(h, &info) &&
+           !(info.dwFileAttributes & FILE_ATTRIBUTE_DIRECTORY);
+  if (ok) size = (int64_t)(((uint64_t)info.nFileSizeHigh << 32) | info.nFileSizeLow);
+  if (!ok || size > max) {
+    fprintf(stderr, "embra: %s: not a regular file of at most 2 GiB\n", path);
+    CloseHandle(h);
+    return -1;
+  }
+  char* buffer = malloc((size_t)size + 1);
+  size_t got = 0;
+  DWORD n = 1;
+  while (buffer != NULL && n > 0 && got <= (size_t)size)
+    if (!ReadFile(h, buffer + got, (DWORD)((size_t)size + 1 - got), &n, NULL))
+      break;
+    else
+      got += n;
+  CloseHandle(h);
+  const int failed = buffer == NULL || n != 0 || got != (size_t)size;
+#else
+  struct stat st;
+  const int fd = open(path, O_RDONLY | O_NONBLOCK); /* a pipe does not block the open */
+  FILE* f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+  if (f == NULL || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > max) {
+    fprintf(stderr, "embra: %s: %s\n", path, f == NULL ? strerror(errno) : "not a regular file of at most 2 GiB");
+    if (f)
+      fclose(f);
+    else if (fd >= 0)
+      close(fd);
+    return -1;
+  }
+  char* buffer = malloc((size_t)st.st_size + 1);
+  const size_t got = buffer ? fread(buffer, 1, (size_t)st.st_size + 1, f) : 0;
+  const int failed = buffer == NULL || ferror(f) || got != (size_t)st.st_size;
+  fclose(f);
+#endif
+  if (failed) {
+    fprintf(stderr, "embra: %s: cannot read it\n", path);
+    free(buffer);
+    return -1;
+  }
+  *text = buffer;
+  *length = got;
+  return 0;
+}
+
+/* Text that grows as it is printed to (the run's index). */
+typedef struct text_buffer {
+  char* text;
+  size_t length, capacity;
+  int failed;
+} text_buffer;
+
+static void text_printf(text_buffer* b, const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  const int n = vsnprintf(NULL, 0, format, args);
+  va_end(args);
+  if (b->failed || n < 0) {
+    b->failed = 1;
+    return;
+  }
+  const size_t need = b->length + (size_t)n + 1;
+  if (need > b->capacity) {
+    size_t capacity = b->capacity > 0 ? b->capacity : 256;
+    while (capacity < need) capacity *= 2;
+    char* grown = realloc(b->text, capacity);
+    if (grown == NULL) {
+      b->failed = 1;
+      return;
+    }
+    b->text = grown;
+    b->capacity = capacity;
+  }
+  va_start(args, format);
+  vsnprintf(b->text + b->length, (size_t)n + 1, format, args);
+  va_end(args);
+  b->length += (size_t)n;
+}
 
 static const char kUsage[] =
     "usage: embra version\n"
@@ -112,32 +347,20 @@ static int load_scene_file(const char* path, int allow_outside, embra_world** wo
     fprintf(stderr, "embra: %s: %s\n", path, embra_last_error_message());
     return EXIT_INVALID;
   }
-  struct stat st;
-  const int fd = open(path, O_RDONLY | O_NONBLOCK); /* a pipe does not block the open */
-  FILE* f = fd >= 0 ? fdopen(fd, "rb") : NULL;
-  if (f == NULL || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > ((int64_t)1 << 31)) {
-    fprintf(stderr, "embra: %s: %s\n", path, f == NULL ? strerror(errno) : "not a regular file of at most 2 GiB");
-    if (f)
-      fclose(f);
-    else if (fd >= 0)
-      close(fd);
-    return EXIT_INVALID;
-  }
-  char* text = malloc((size_t)st.st_size + 1);
-  const size_t got = text ? fread(text, 1, (size_t)st.st_size + 1, f) : 0;
-  const int failed = text == NULL || ferror(f) || got != (size_t)st.st_size;
-  fclose(f);
-  if (failed) {
-    fprintf(stderr, "embra: %s: cannot read it\n", path);
-    free(text);
-    return EXIT_INVALID;
-  }
+  char* text = NULL;
+  size_t got = 0;
+  if (read_scene_text(path, &text, &got) != 0) return EXIT_INVALID;
+  /* The scene's folder, as embra_world_load_file finds it: "." for a bare name, "/" for a file at
+   * the root; on Windows "\\" separates too and "C:\\" is a root. */
   char folder[4096];
-  const char* slash = strrchr(path, '/');
+  const char* slash = NULL;
+  for (const char* p = path; *p; ++p)
+    if (is_separator(*p)) slash = p;
+  const int drive = is_separator('\\') && path[0] != 0 && path[1] == ':';
   if (slash == NULL)
-    snprintf(folder, sizeof folder, ".");
-  else if (slash == path)
-    snprintf(folder, sizeof folder, "/");
+    snprintf(folder, sizeof folder, "%.*s", drive ? 2 : 1, drive ? path : ".");
+  else if (slash == path || (drive && slash == path + 2))
+    snprintf(folder, sizeof folder, "%.*s", (int)(slash - path + 1), path);
   else
     snprintf(folder, sizeof folder, "%.*s", (int)(slash - path), path);
   embra_load_options options = embra_default_load_options();
@@ -174,28 +397,21 @@ static int option_int(int argc, char** argv, int i, long lo, long hi, long* out)
   return 0;
 }
 
+/* Makes the folder `path` with its parents; 0, or -1 with errno. */
 static int make_dir(const char* path) {
   char buf[4096];
   if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
+  /* On Windows "C:\\" is a drive's root, not a folder to make. */
+  const int drive = buf[0] != 0 && buf[1] == ':' && is_separator('\\');
   for (char* p = buf + 1; *p; ++p)
-    if (*p == '/') {
+    if (is_separator(*p) && !(drive && p == buf + 2)) {
+      const char separator = *p;
       *p = 0;
-      if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
-      *p = '/';
+      if (make_one_dir(buf) != 0 && errno != EEXIST) return -1;
+      *p = separator;
     }
-  if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
+  if (make_one_dir(buf) != 0 && errno != EEXIST) return -1;
   return 0;
-}
-
-/* Whether `path` is a folder with anything in it (a missing folder, or a file, is not). */
-static int folder_has_entries(const char* path) {
-  DIR* d = opendir(path);
-  if (d == NULL) return 0;
-  int found = 0;
-  for (struct dirent* e; !found && (e = readdir(d)) != NULL;)
-    found = strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-  closedir(d);
-  return found;
 }
 
 /* The output folder: refused when it holds anything and `force` is not set (an earlier run's files
@@ -384,12 +600,6 @@ done:
   return rc;
 }
 
-static double now_ms(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
-}
-
 /* The ids of the world's bodies (malloc'd, *count of them; NULL on failure or none). */
 static embra_body_id* world_bodies(const embra_world* world, int32_t* count) {
   *count = 0;
@@ -468,7 +678,7 @@ static int write_error_fields(const char* path, embra_world* world, const embra_
   const size_t np = (size_t)(counts.particles > 0 ? counts.particles : 1);
   double* value = malloc(sizeof(double) * np);
   unsigned char* measured = calloc(np, 1);
-  FILE* f = value && measured ? fopen(path, "w") : NULL;
+  FILE* f = value && measured ? open_write(path) : NULL;
   int rc = f ? 0 : -1;
   if (!f && value && measured) fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
   if (f) {
@@ -526,7 +736,7 @@ static int write_cuts(embra_world* world, const embra_body_id* bodies, int n, co
       }
       char path[4200];
       snprintf(path, sizeof path, "%s/panels_%u.%s", dir, bodies[i].index, format == EMBRA_CUTS_JSON ? "json" : "csv");
-      FILE* f = fopen(path, "w");
+      FILE* f = open_write(path);
       if (!f) {
         fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
         free(text);
@@ -566,35 +776,24 @@ static int cmd_validate(int argc, char** argv) {
  * collider was, so a replay shows the colliders where they were without re-running the scene. The
  * entries accumulate in memory streams and are written at the end. */
 typedef struct run_index {
-  FILE* files;
-  FILE* frames;
-  char *files_text, *frames_text;
-  size_t files_length, frames_length;
+  text_buffer files, frames;
   int file_count, frame_count;
 } run_index;
 
-static int run_index_open(run_index* x) {
+static void run_index_open(run_index* x) {
   memset(x, 0, sizeof *x);
-  x->files = open_memstream(&x->files_text, &x->files_length);
-  x->frames = open_memstream(&x->frames_text, &x->frames_length);
-  if (x->files && x->frames) return 0;
-  if (x->files) fclose(x->files);
-  if (x->frames) fclose(x->frames);
-  free(x->files_text);
-  free(x->frames_text);
-  return -1;
 }
 
 /* Records a file written into DIR (its name only: every name embra writes is plain ASCII). */
 static void run_index_file(run_index* x, const char* name) {
-  fprintf(x->files, "%s\"%s\"", x->file_count++ ? "," : "", name);
+  text_printf(&x->files, "%s\"%s\"", x->file_count++ ? "," : "", name);
 }
 
 /* Records an OBJ frame: its files (errors: NULL for none) and every live collider's pose. */
 static void run_index_frame(run_index* x, embra_world* world, long frame, const char* obj, const char* errors) {
-  fprintf(x->frames, "%s{\"frame\":%ld,\"obj\":\"%s\"", x->frame_count++ ? "," : "", frame, obj);
-  if (errors) fprintf(x->frames, ",\"errors\":\"%s\"", errors);
-  fputs(",\"colliders\":[", x->frames);
+  text_printf(&x->frames, "%s{\"frame\":%ld,\"obj\":\"%s\"", x->frame_count++ ? "," : "", frame, obj);
+  if (errors) text_printf(&x->frames, ",\"errors\":\"%s\"", errors);
+  text_printf(&x->frames, ",\"colliders\":[");
   int32_t n = 0;
   if (embra_world_get_colliders(world, NULL, 0, &n) == EMBRA_OK && n > 0) {
     embra_collider_id* ids = malloc(sizeof *ids * (size_t)n);
@@ -602,13 +801,13 @@ static void run_index_frame(run_index* x, embra_world* world, long frame, const 
       for (int32_t i = 0; i < n; ++i) {
         double p[3], q[4];
         if (embra_collider_get_transform(world, ids[i], p, q) != EMBRA_OK) continue;
-        fprintf(x->frames, "%s[%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g]", i ? "," : "", p[0], p[1], p[2], q[0], q[1],
-                q[2], q[3]);
+        text_printf(&x->frames, "%s[%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g]", i ? "," : "", p[0], p[1], p[2], q[0],
+                    q[1], q[2], q[3]);
       }
     }
     free(ids);
   }
-  fputs("]}", x->frames);
+  text_printf(&x->frames, "]}");
 }
 
 /* Writes DIR/forces.json: the last step's statics (embra_world_get_reactions, embra_group_get_forces):
@@ -620,7 +819,7 @@ static void run_index_frame(run_index* x, embra_world* world, long frame, const 
  * a group's kinds listed when it holds any, each constraint's tension (N, positive pulling its ends
  * together) in the order the constraints were added. */
 static int write_forces(const char* path, const embra_world* world) {
-  FILE* f = fopen(path, "w");
+  FILE* f = open_write(path);
   if (!f) {
     fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
     return -1;
@@ -670,21 +869,23 @@ static int write_forces(const char* path, const embra_world* world) {
 
 /* Writes DIR/index.json and frees the index. */
 static int run_index_write(run_index* x, const char* dir) {
-  fclose(x->files);
-  fclose(x->frames);
   char path[4200];
   snprintf(path, sizeof path, "%s/index.json", dir);
-  FILE* f = fopen(path, "w");
   int rc = -1;
-  if (f) {
-    fprintf(f, "{\"format\":\"embra-run-index\",\"version\":1,\"files\":[%s,\"index.json\"],\"frames\":[%s]}\n",
-            x->files_text, x->frames_text);
-    rc = fclose(f) == 0 ? 0 : -1;
+  if (x->files.failed || x->frames.failed) {
+    fprintf(stderr, "embra: cannot write %s: out of memory\n", path);
   } else {
-    fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    FILE* f = open_write(path);
+    if (f) {
+      fprintf(f, "{\"format\":\"embra-run-index\",\"version\":1,\"files\":[%s,\"index.json\"],\"frames\":[%s]}\n",
+              x->files.text ? x->files.text : "", x->frames.text ? x->frames.text : "");
+      rc = fclose(f) == 0 ? 0 : -1;
+    } else {
+      fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
+    }
   }
-  free(x->files_text);
-  free(x->frames_text);
+  free(x->files.text);
+  free(x->frames.text);
   return rc;
 }
 
@@ -870,25 +1071,20 @@ static int cmd_run(int argc, char** argv) {
   }
   char path[4200];
   snprintf(path, sizeof path, "%s/metrics.jsonl", out);
-  FILE* metrics = fopen(path, "w");
+  FILE* metrics = open_write(path);
   if (!metrics) {
     fprintf(stderr, "embra: cannot write %s: %s\n", path, strerror(errno));
     embra_world_destroy(world);
     return EXIT_INVALID;
   }
   run_index index;
-  if (run_index_open(&index) != 0) {
-    fprintf(stderr, "embra: out of memory\n");
-    fclose(metrics);
-    embra_world_destroy(world);
-    return EXIT_INVALID;
-  }
+  run_index_open(&index);
   embra_body_id panel_bodies[MAX_PANEL_MESHES];
   const int panel_count = find_panel_meshes(world, panel_bodies);
   panel_totals pt;
   memset(&pt, 0, sizeof pt);
   long within_since = -1;
-  const int tty = isatty(2);
+  const int tty = stderr_is_terminal();
   const long stride = calls >= 10 ? calls / 10 : 1;
   if (frames > 0)
     printf("%7s %9s %13s %13s %13s %13s %8s\n", "frame", "ms", "residual_max", "residual_rms", "kinetic_J", "max_speed",
@@ -1041,7 +1237,7 @@ static int cmd_run(int argc, char** argv) {
   return rc;
 }
 
-int main(int argc, char** argv) {
+static int run_main(int argc, char** argv) {
   if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) {
     fprintf(stderr, "embra: %s\n", embra_last_error_message());
     return EXIT_INVALID;
@@ -1056,4 +1252,27 @@ int main(int argc, char** argv) {
   if (strcmp(argv[1], "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(argv[1], "demo") == 0 && argc >= 3 && strcmp(argv[2], "tent") == 0) return demo_tent(argc - 3, argv + 3);
   return bad_usage("unknown command '%s'%s", argv[1], " (see embra help)");
+}
+
+int main(int argc, char** argv) {
+#ifdef _WIN32
+  /* The arguments as UTF-8 (the C runtime's argv is in the ANSI code page), and UTF-8 on the console. */
+  int wide_argc = 0;
+  wchar_t** wide_argv = CommandLineToArgvW(GetCommandLineW(), &wide_argc);
+  char** utf8_argv = wide_argv ? calloc((size_t)wide_argc + 1, sizeof *utf8_argv) : NULL;
+  for (int i = 0; utf8_argv != NULL && i < wide_argc; ++i)
+    if ((utf8_argv[i] = narrow(wide_argv[i])) == NULL) {
+      fprintf(stderr, "embra: cannot read argument %d of the command line\n", i);
+      return EXIT_USAGE;
+    }
+  if (wide_argv) LocalFree(wide_argv);
+  if (utf8_argv == NULL) {
+    fprintf(stderr, "embra: cannot read the command line\n");
+    return EXIT_USAGE;
+  }
+  SetConsoleOutputCP(CP_UTF8);
+  argc = wide_argc;
+  argv = utf8_argv;
+#endif
+  return run_main(argc, argv);
 }

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Checks libembra.so's dynamic symbol table and SONAME:
+# Checks libembra.so's dynamic symbol table and SONAME, or embra.dll's export table and name:
 #   1. every exported (defined, dynamic) symbol starts with embra_, apart from the linker's own
 #      bookkeeping symbols listed in IGNORED below;
 #   2. every function embra.h declares with EMBRA_API is exported, and every exported embra_
 #      symbol is declared in embra.h (no private helper leaks out, no declared function is missing);
-#   3. the SONAME is libembra.so.<EMBRA_ABI_VERSION>.
+#   3. the SONAME is libembra.so.<EMBRA_ABI_VERSION> (a DLL: its export table names it embra.dll).
 #
-# usage: check_exports.sh <path/to/libembra.so> <path/to/embra.h> <abi_version>
+# usage: check_exports.sh <path/to/libembra.so or embra.dll> <path/to/embra.h> <abi_version>
 set -euo pipefail
 
 lib=${1:?usage: check_exports.sh LIB HEADER ABI_VERSION}
@@ -24,9 +24,19 @@ pass() { echo "ok:   $*"; }
 [[ -f "$lib" ]] || { echo "FAIL: no library at $lib"; exit 1; }
 [[ -f "$header" ]] || { echo "FAIL: no header at $header"; exit 1; }
 
-# Names only (strip versions such as @@GLIBC_...); `nm -D --defined-only` prints "addr type name".
-mapfile -t exported < <(nm -D --defined-only "$lib" | awk 'NF >= 3 { print $3 }' | sed 's/@.*//' | sort -u)
-[[ ${#exported[@]} -gt 0 ]] || fail "nm -D --defined-only $lib printed no symbols"
+dll=0
+[[ "$lib" == *.dll ]] && dll=1
+if [[ $dll -eq 1 ]]; then
+  # The export table as `objdump -p` prints it: "\t[   N] name" under "[Ordinal/Name Pointer] Table".
+  objdump=$(command -v x86_64-w64-mingw32-objdump || command -v objdump)
+  mapfile -t exported < <("$objdump" -p "$lib" |
+                          sed -n '/\[Ordinal\/Name Pointer\] Table/,/^$/p' | sed -n 's/^\s*\[ *[0-9]*\] //p' | sort -u)
+  [[ ${#exported[@]} -gt 0 ]] || fail "$objdump -p $lib listed no exports"
+else
+  # Names only (strip versions such as @@GLIBC_...); `nm -D --defined-only` prints "addr type name".
+  mapfile -t exported < <(nm -D --defined-only "$lib" | awk 'NF >= 3 { print $3 }' | sed 's/@.*//' | sort -u)
+  [[ ${#exported[@]} -gt 0 ]] || fail "nm -D --defined-only $lib printed no symbols"
+fi
 
 is_ignored() {
   local s=$1 i
@@ -58,8 +68,15 @@ extra=$(comm -13 <(printf '%s\n' "${declared[@]}") <(printf '%s\n' "${api[@]}"))
 [[ -z "$extra" ]] || fail "exported but not declared in embra.h: $(echo $extra)"
 [[ -z "$missing" && -z "$extra" ]] && pass "exports and header declarations match"
 
-soname=$(readelf -d "$lib" | sed -n 's/.*(SONAME).*\[\(.*\)\].*/\1/p')
-if [[ "$soname" == "libembra.so.$abi" ]]; then
+if [[ $dll -eq 1 ]]; then
+  # A DLL has no SONAME: hosts load it by its file name, which its export table repeats.
+  name=$("$objdump" -p "$lib" | sed -n 's/^Name[[:space:]]*[0-9a-f]* //p' | head -1)
+  if [[ "$name" == "embra.dll" ]]; then
+    pass "the export table names embra.dll"
+  else
+    fail "the export table names '${name}', expected embra.dll"
+  fi
+elif soname=$(readelf -d "$lib" | sed -n 's/.*(SONAME).*\[\(.*\)\].*/\1/p') && [[ "$soname" == "libembra.so.$abi" ]]; then
   pass "SONAME is $soname"
 else
   fail "SONAME is '${soname}', expected libembra.so.$abi"

@@ -1,4 +1,4 @@
-// The C# consumer of an installed embra (lib/Embra.dll beside libembra.so): the free fall of
+// The C# consumer of an installed embra (lib/Embra.Net.dll beside libembra.so): the free fall of
 // consumer.c, checked against the same closed form. Prints "consumer ok" when it agrees.
 using System;
 

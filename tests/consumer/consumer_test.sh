@@ -60,9 +60,9 @@ if [[ -n "$python" ]]; then
   echo "ok:   Python consumer ran on the installed package"
 fi
 
-# 5. C#: compiled against the installed Embra.dll, which finds libembra.so beside itself.
+# 5. C#: compiled against the installed Embra.Net.dll, which finds libembra.so beside itself.
 if [[ -n "$mcs" ]]; then
-  "$mcs" -nologo -warnaserror+ -r:"$libdir/Embra.dll" -out:"$work/Consumer.exe" "$here/Consumer.cs"
+  "$mcs" -nologo -warnaserror+ -r:"$libdir/Embra.Net.dll" -out:"$work/Consumer.exe" "$here/Consumer.cs"
   MONO_PATH="$libdir" mono "$work/Consumer.exe" | tee "$work/cs-run.log"
   grep -q "consumer ok" "$work/cs-run.log"
   echo "ok:   C# consumer ran on the installed assembly"

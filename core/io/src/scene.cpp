@@ -2,6 +2,8 @@
 // through embra::World, and save back.
 #include "embra/io/scene.hpp"
 
+#include "embra/io/files.hpp"
+
 #include "embra/core/kinds.hpp"
 #include "embra/core/limits.hpp"
 
@@ -16,15 +18,9 @@
 #include <valijson/schema_parser.hpp>
 #include <valijson/validator.hpp>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <iterator>
 #include <limits>
@@ -803,17 +799,19 @@ std::string read_obj_file(const std::string& rel, const LoadOptions& options, co
                           std::string& shown) {
   namespace fs = std::filesystem;
   shown = "OBJ file " + json(rel).dump(-1, ' ', true);
-  const fs::path given(rel);
-  const fs::path base(options.base_dir.empty() ? "." : options.base_dir);
-  fs::path path = given.is_absolute() ? given : base / given;
+  const fs::path given = path_from_utf8(rel);
+  const fs::path base = path_from_utf8(options.base_dir.empty() ? "." : options.base_dir);
+  // On Windows "\x" (the current drive's root) and "C:x" are not absolute, yet not inside either.
+  const bool absolute = given.is_absolute() || given.has_root_path();
+  fs::path path = absolute ? given : base / given;
   if (!options.allow_paths_outside_base) {
-    if (given.is_absolute())
-      fail(where, shown + ": an absolute path is refused: OBJ paths are relative to the scene's folder");
+    if (absolute) fail(where, shown + ": an absolute path is refused: OBJ paths are relative to the scene's folder");
     std::error_code ec;
     const fs::path root = fs::canonical(base, ec);
-    if (ec) fail(where, "cannot open " + shown + " (" + path.string() + "): the scene's folder: " + ec.message());
+    if (ec)
+      fail(where, "cannot open " + shown + " (" + utf8_from_path(path) + "): the scene's folder: " + ec.message());
     const fs::path resolved = fs::weakly_canonical(path, ec);
-    if (ec) fail(where, "cannot open " + shown + " (" + path.string() + "): " + ec.message());
+    if (ec) fail(where, "cannot open " + shown + " (" + utf8_from_path(path) + "): " + ec.message());
     // Inside: the folder's components are the first of the file's (both canonical, no "..").
     const bool inside = std::distance(root.begin(), root.end()) <= std::distance(resolved.begin(), resolved.end()) &&
                         std::mismatch(root.begin(), root.end(), resolved.begin()).first == root.end();
@@ -824,8 +822,8 @@ std::string read_obj_file(const std::string& rel, const LoadOptions& options, co
     path = resolved;
   }
   std::string text, error;
-  if (!read_regular_file(path.string(), limits::kMaxObjBytes, text, error))
-    fail(where, shown + (error.starts_with("could not") ? " (" + path.string() + ")" : "") + " " + error);
+  if (!read_regular_file(utf8_from_path(path), limits::kMaxObjBytes, text, error))
+    fail(where, shown + (error.starts_with("could not") ? " (" + utf8_from_path(path) + ")" : "") + " " + error);
   return text;
 }
 
@@ -1485,42 +1483,6 @@ std::unique_ptr<World> load_scene(std::string_view text, const std::string& base
   LoadOptions options;
   options.base_dir = base_dir;
   return load_scene(text, options, out_meta);
-}
-
-bool read_regular_file(const std::string& path, int64_t max_bytes, std::string& out, std::string& error) {
-  const auto refuse = [&](std::string why) {
-    error = std::move(why);
-    return false;
-  };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) return refuse(std::string("could not be opened: ") + std::strerror(errno));
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st;
-  if (::fstat(fd, &st) != 0) return refuse(std::string("could not be read: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) return refuse("is not a regular file (a folder, device or pipe is refused)");
-  const std::string too_large = "is larger than " + std::to_string(max_bytes) + " bytes, the most it may have";
-  if (st.st_size > max_bytes) return refuse(too_large);
-  const size_t cap = static_cast<size_t>(max_bytes) + 1;  // one byte more shows a file that grew
-  std::string text;
-  text.resize(std::min(static_cast<size_t>(st.st_size) + 1, cap));
-  size_t got = 0;
-  for (;;) {
-    if (got == text.size()) {
-      if (text.size() >= cap) return refuse(too_large);
-      text.resize(std::min(2 * text.size(), cap));
-    }
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return refuse(std::string("could not be read: ") + std::strerror(errno));
-    if (n == 0) break;
-    got += static_cast<size_t>(n);
-  }
-  text.resize(got);
-  out = std::move(text);
-  return true;
 }
 
 std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& options, SceneMeta& out_meta) {

@@ -15,6 +15,8 @@
 //   `_Out_` pointers filled into a JS object or a one-element array;
 // - fixed arrays inside structs (gravity[3], rotation[4], ...) decode as plain JS arrays.
 
+const fs = require('fs');
+const nodePath = require('path');
 const generated = require('./capi_generated');
 
 // ABI_VERSION: the EMBRA_ABI_VERSION these bindings were generated for (the SONAME's number).
@@ -28,9 +30,20 @@ function defaultLibraryName() {
   return `libembra.so.${ABI_VERSION}`; // by SONAME, through the dynamic loader's search
 }
 
+// Beside the package (a copy of embra.dll or libembra carried with it), else the name for the
+// system's search (on Windows: the program's folder, the system folders, PATH).
+function defaultLibraryPath() {
+  const name = defaultLibraryName();
+  for (const folder of [nodePath.join(__dirname, '..'), __dirname]) {
+    const candidate = nodePath.join(folder, name);
+    if (fs.existsSync(candidate)) return candidate;
+  }
+  return name;
+}
+
 function load() {
   const env = process.env[LIBRARY_ENV];
-  const path = env ? env : defaultLibraryName();
+  const path = env ? env : defaultLibraryPath();
   let handle;
   try {
     handle = koffi.load(path);

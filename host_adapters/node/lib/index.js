@@ -9,7 +9,8 @@
 //   console.log(world.positions());
 //   world.close();
 //
-// libembra is loaded from $EMBRA_LIBRARY, else as libembra.so.1 through the dynamic loader's search.
+// libembra is loaded from $EMBRA_LIBRARY, else from beside the package (embra.dll on Windows,
+// libembra.so.1 on Linux), else by that name through the system's search (on Windows PATH too).
 
 const capi = require('./capi');
 const errors = require('./errors');

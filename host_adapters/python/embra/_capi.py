@@ -17,22 +17,39 @@ from ._capi_generated import ABI_VERSION, PROTOTYPES, _Id  # noqa: F401 - _Id: t
 LIBRARY_ENV = "EMBRA_LIBRARY"
 
 
-def _candidates():
+def _library_names(platform):
+    """The file names libembra has on `platform` (sys.platform), the usual first."""
+    if platform.startswith("linux"):
+        return [f"libembra.so.{ABI_VERSION}", "libembra.so"]
+    if platform == "win32":
+        return ["embra.dll"]
+    if platform == "darwin":
+        return [f"libembra.{ABI_VERSION}.dylib", "libembra.dylib"]
+    return ["libembra.so"]
+
+
+def _candidates(platform=sys.platform, here=None, environ=os.environ):
     """Where libembra is looked for, in order: $EMBRA_LIBRARY, next to this package, the system."""
-    env = os.environ.get(LIBRARY_ENV)
+    env = environ.get(LIBRARY_ENV)
     if env:
         yield env
         return
-    here = os.path.dirname(os.path.abspath(__file__))
-    names = [f"libembra.so.{ABI_VERSION}", "libembra.so"] if sys.platform.startswith("linux") else \
-        ["libembra.dylib", "embra.dll", "libembra.so"]
+    here = here or os.path.dirname(os.path.abspath(__file__))
+    names = _library_names(platform)
     # beside the package (or its folder); then the library folder of an installed prefix, which
-    # holds the package in lib/python3/dist-packages/embra (cmake --install)
-    for folder in (here, os.path.dirname(here), os.path.normpath(os.path.join(here, "..", "..", ".."))):
+    # holds the package in lib/python3/dist-packages/embra (cmake --install), and on Windows the
+    # prefix's bin folder, where a DLL is installed
+    prefix_lib = os.path.normpath(os.path.join(here, "..", "..", ".."))
+    folders = [here, os.path.dirname(here), prefix_lib]
+    if platform == "win32":
+        folders.append(os.path.join(os.path.dirname(prefix_lib), "bin"))
+    for folder in folders:
         for name in names:
             path = os.path.join(folder, name)
             if os.path.exists(path):
                 yield path
+    # the system: on Windows find_library searches PATH (which LoadLibrary by name no longer does
+    # for Python's ctypes), elsewhere the loader's cache
     found = ctypes.util.find_library("embra")
     if found:
         yield found

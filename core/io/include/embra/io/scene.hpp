@@ -57,14 +57,6 @@ std::unique_ptr<World> load_scene(std::string_view text, const LoadOptions& opti
 /// load_scene with OBJ paths confined to `base_dir`.
 std::unique_ptr<World> load_scene(std::string_view text, const std::string& base_dir, SceneMeta& out_meta);
 
-/// The whole content of the regular file at `path`, at most `max_bytes`: opened without blocking
-/// and checked before a byte is read, so a folder, device or pipe (/dev/zero, a FIFO) is refused
-/// rather than read for ever or waited on; a file that grows past max_bytes while read is refused
-/// too. On failure returns false with `error` completing a sentence that starts with the path
-/// ("could not be opened: ...", "is not a regular file ...", "is larger than N bytes ..."), never
-/// quoting the file's content.
-bool read_regular_file(const std::string& path, int64_t max_bytes, std::string& out, std::string& error);
-
 /// Writes the complete world and its meta as a scene document (floats round-trip exactly).
 std::string save_scene(const World& world, const SceneMeta& meta);
 
