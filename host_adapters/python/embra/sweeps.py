@@ -277,7 +277,7 @@ def run_variant(task):
 
     from . import World
 
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     out = {"index": task["index"], "name": task["name"], "key": task["key"], "status": "ok", "error": None,
            "settled": None, "outcome": None, "frames": 0, "worker": f"{socket.gethostname()}:{os.getpid()}"}
     run, keep = task["run"], task["keep"]
@@ -319,6 +319,7 @@ def run_variant(task):
     if keep["metrics"]:
         out["metrics_jsonl"] = "".join(json.dumps(r) + "\n" for r in records)
     out["seconds"] = time.perf_counter() - t0
+    out["cpu_seconds"] = time.process_time() - cpu0  # below seconds when the machine's cores are shared
     return out
 
 
@@ -335,7 +336,7 @@ def _row(sweep, result, values):
     """The flat record of results.jsonl / results.csv."""
     row = {"index": result["index"], "name": result["name"]}
     row.update(values)
-    for k in ("status", "error", "settled", "outcome", "frames", "seconds"):
+    for k in ("status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds"):
         row[k] = result.get(k)
     m = result.get("metrics") or {}
     for k, v in m.items():
@@ -345,7 +346,7 @@ def _row(sweep, result, values):
 
 def _columns(sweep, rows):
     cols = ["index", "name"] + [p["name"] for p in sweep.parameters]
-    cols += ["status", "error", "settled", "outcome", "frames", "seconds"]
+    cols += ["status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds"]
     for r in rows:
         for k in r:
             if k not in cols:
@@ -385,7 +386,8 @@ def _csv_rows(f, cols, rows):
 
 def _write_variant(out, sweep, scene_text, result, values):
     """The variant's folder, written whole under a temporary name and renamed: a folder with a
-    result.json is complete."""
+    result.json is complete. (The worker's figures: seconds of wall time, cpu_seconds of its
+    process's CPU time over the run.)"""
     final = os.path.join(out, result["name"])
     tmp = final + ".partial"
     shutil.rmtree(tmp, ignore_errors=True)
@@ -490,8 +492,10 @@ def sweep(document, out="sweep_out", *, scheduler=None, workers=None, client=Non
                     client = own_client = Client(scheduler)
                 else:
                     n = workers or os.cpu_count() or 1
+                    # one single-threaded process per variant at a time; the scheduler's web page on a
+                    # free port of this machine only (not 8787 on every interface)
                     own_cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                               dashboard_address=None)
+                                               dashboard_address="127.0.0.1:0")
                     client = own_client = Client(own_cluster)
             _run(sw, out, client, todo, texts, keys, rows, records, objs, bar, on_result)
         finally:
