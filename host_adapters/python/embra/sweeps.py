@@ -336,7 +336,7 @@ def _row(sweep, result, values):
     """The flat record of results.jsonl / results.csv."""
     row = {"index": result["index"], "name": result["name"]}
     row.update(values)
-    for k in ("status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds"):
+    for k in ("status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds", "worker"):
         row[k] = result.get(k)
     m = result.get("metrics") or {}
     for k, v in m.items():
@@ -346,7 +346,7 @@ def _row(sweep, result, values):
 
 def _columns(sweep, rows):
     cols = ["index", "name"] + [p["name"] for p in sweep.parameters]
-    cols += ["status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds"]
+    cols += ["status", "error", "settled", "outcome", "frames", "seconds", "cpu_seconds", "worker"]
     for r in rows:
         for k in r:
             if k not in cols:
@@ -606,7 +606,7 @@ def render_png(path, items, columns=None, title=None):
         ax.set_axis_off()
         m = record.get("metrics") or {}
         ratio = m.get("worst_ratio")
-        label = f"#{k + 1} {record['name']}\n" + "\n".join(f"{a} = {_short(v)}" for a, v in values.items())
+        label = ("" if single else f"#{k + 1} ") + f"{record['name']}\n" + "\n".join(f"{a} = {_short(v)}" for a, v in values.items())
         if record["status"] != "ok":
             label += f"\nfailed: {record['error'][:60]}"
         if ratio is not None:
@@ -620,16 +620,22 @@ def render_png(path, items, columns=None, title=None):
                                         edgecolor=(0, 0, 0, 0.25), linewidth=0.2)
                 ax.add_collection3d(poly)
                 xs, ys, zs = zip(*verts)
-                c = [(max(a) + min(a)) / 2 for a in (xs, ys, zs)]
-                half = max(max(a) - min(a) for a in (xs, ys, zs)) / 2 or 1.0
-                ax.set_xlim(c[0] - half, c[0] + half)
-                ax.set_ylim(c[1] - half, c[1] + half)
-                ax.set_zlim(c[2] - half, c[2] + half)
-                ax.view_init(elev=25, azim=-60)
+                extent = [max(a) - min(a) for a in (xs, ys, zs)]
+                size = max(extent) or 1.0
+                extent = [max(e, 0.05 * size) for e in extent]  # a flat shape keeps some depth
+                for lim, a, e in ((ax.set_xlim, xs, extent[0]), (ax.set_ylim, ys, extent[1]),
+                                  (ax.set_zlim, zs, extent[2])):
+                    c = (max(a) + min(a)) / 2
+                    lim(c - e / 2, c + e / 2)
+                ax.set_box_aspect(extent, zoom=1.05)  # true proportions
+                ax.view_init(elev=30, azim=-60)
         ax.set_title(label, fontsize=7)
     if title:
         fig.suptitle(f"{title}: ranked by worst fabrication metric (value / target)", fontsize=9)
-    if not single:
+    if single:
+        fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.78)
+    else:
+        fig.subplots_adjust(left=0.01, right=0.9, bottom=0.01, top=0.88 if title else 0.93, wspace=0.02, hspace=0.3)
         cax = fig.add_axes([0.93, 0.15, 0.015, 0.7])
         bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax)
         bar.set_ticks([0, 1, 2])
