@@ -200,6 +200,10 @@ def test_invalid_pointer_fails_before_anything_runs(tmp_path):
     with pytest.raises(embra.SweepError, match="/combine"):
         embra.sweep(doc, str(out), client=NoClient(), progress=None)
     doc = example_sweep()
+    doc["run"] = {"frames": 10, "until": "settled"}  # one or the other
+    with pytest.raises(embra.SweepError, match="/run"):
+        embra.sweep(doc, str(out), client=NoClient(), progress=None)
+    doc = example_sweep()
     doc["parameters"][1]["targets"] = ["panel_meshes/0/thickness"]  # not a JSON pointer
     with pytest.raises(embra.SweepError, match="/parameters/1/targets/0"):
         embra.sweep(doc, str(out), client=NoClient(), progress=None)
@@ -249,3 +253,29 @@ def test_zip_and_range(tmp_path):
     doc["parameters"][1]["values"] = [0.01]
     with pytest.raises(embra.SweepError, match="zip"):
         sweeps.Sweep(doc)
+
+
+def test_until_settled_same_bits_as_embra_run_until(client, tmp_path):
+    """run {"until": "settled"}: World.solve in the worker, `embra run --until settled` in C (both
+    embra_world_solve with the same frame budget): the same frames and the same final.json bytes."""
+    doc = example_sweep()
+    doc["combine"] = "zip"
+    doc["parameters"][0]["values"] = [0.05, 0.1]
+    doc["parameters"][1]["values"] = [0.01, 0.02]
+    doc["run"] = {"until": "settled", "max_frames": 400}
+    doc["keep"] = {"thumbnail": False}
+    out = tmp_path / "sweep"
+    rows = embra.sweep(doc, str(out), client=client, progress=None)
+    for row, (d, t) in zip(rows, [(0.05, 0.01), (0.1, 0.02)]):
+        scene = tmp_path / f"{row['name']}.json"
+        scene.write_text(json.dumps(variant_scene(d, t)))
+        ref = tmp_path / f"{row['name']}_cli"
+        p = subprocess.run([os.environ["EMBRA_CLI"], "run", str(scene), "--until", "settled", "--frames", "400",
+                            "--out", str(ref)], stdout=subprocess.PIPE, text=True)
+        assert p.returncode in (0, 4), p.stdout
+        assert row["status"] == "ok" and row["settled"] is (p.returncode == 0)
+        # the scene's last action key is at frame 180: at rest before it does not count
+        assert 180 < row["frames"] <= 400
+        assert read(out / row["name"] / "final.json") == read(ref / "final.json")
+        with open(ref / "metrics.jsonl") as f:
+            assert json.loads(f.read().splitlines()[-1])["frame"] == row["frames"]
