@@ -253,6 +253,12 @@ def test_zip_and_range(tmp_path):
     doc["parameters"][1]["values"] = [0.01]
     with pytest.raises(embra.SweepError, match="zip"):
         sweeps.Sweep(doc)
+    # a grid too large to hold is refused before it is made: 1000^3 variants
+    doc["combine"] = "product"
+    doc["parameters"] = [{"name": f"p{i}", "targets": ["/solver/settle_speed"],
+                          "range": {"from": 0.001, "to": 0.002, "count": 1000}} for i in range(3)]
+    with pytest.raises(embra.SweepError, match="1000000000 variants: a sweep has at most 1000000"):
+        sweeps.Sweep(doc)
 
 
 def test_until_settled_same_bits_as_embra_run_until(client, tmp_path):

@@ -58,6 +58,9 @@ METRIC_TOLERANCE = {
 }
 
 
+MAX_VARIANTS = 1000000  # variants of one sweep: each is a task, a folder and a row
+
+
 class SweepError(ValueError):
     """A sweep document that cannot run: its schema, its base scene or a pointer (named)."""
 
@@ -167,6 +170,9 @@ class Sweep:
                     raise SweepError(f"parameter '{p['name']}': the pointer {pointer} does not resolve in "
                                      f"{doc['scene']}: {e.args[0]}") from None
         value_lists = [_values(p) for p in self.parameters]
+        count = len(value_lists[0]) if doc.get("combine", "product") == "zip" else math.prod(map(len, value_lists))
+        if count > MAX_VARIANTS:
+            raise SweepError(f"{count} variants: a sweep has at most {MAX_VARIANTS} (split it, or use fewer values)")
         combos = []
         if doc.get("combine", "product") == "zip":
             counts = {len(v) for v in value_lists}
