@@ -16,6 +16,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -121,8 +122,12 @@ def check_against_cli(out, rows, cli_runs):
 
 def test_same_bits_as_embra_run(client, cli_runs, tmp_path):
     out = tmp_path / "sweep"
-    rows = embra.sweep(example_sweep(), str(out), client=client, progress=None)
+    streamed = []
+    rows = embra.sweep(example_sweep(), str(out), client=client, progress=None,
+                       on_result=lambda record: streamed.append((record["name"], (out / record["name"]).is_dir())))
     check_against_cli(str(out), rows, cli_runs)
+    # each variant was handed over once, its folder already written
+    assert sorted(streamed) == [(f"v{i:04d}", True) for i in range(9)]
     # the tables hold one row per variant, in variant order, with both parameters
     with open(out / "results.jsonl") as f:
         table = [json.loads(line) for line in f]
@@ -148,24 +153,38 @@ def test_same_bits_as_embra_run(client, cli_runs, tmp_path):
 def test_killed_worker_loses_nothing(client, cli_runs, tmp_path):
     killed = {}
 
-    def kill_one(record):
-        if killed:
-            return
-        # a worker busy with a variant, ended by SIGKILL: its nanny starts another, the scheduler
-        # runs its tasks again elsewhere
-        processing = client.processing()
-        busy = [addr for addr, keys in processing.items() if keys]
-        assert busy, "no worker had a variant in progress"
-        pids = client.run(os.getpid, workers=[busy[0]])
-        killed["pid"] = pids[busy[0]]
-        killed["tasks"] = list(processing[busy[0]])
-        killed["done_before"] = record["name"]
-        os.kill(killed["pid"], signal.SIGKILL)
+    def task_states(dask_scheduler):
+        return {k: ts.state for k, ts in dask_scheduler.tasks.items() if str(k).startswith("embra-variant-")}
+
+    def kill_one():
+        # once a variant is done and another is in progress on a worker, that worker is ended by
+        # SIGKILL: its nanny starts another, the scheduler runs its tasks again elsewhere
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            states = client.run_on_scheduler(task_states)
+            busy = [(a, keys) for a, keys in client.processing().items() if keys]
+            if busy and "memory" in states.values():
+                addr, keys = busy[0]
+                pid = client.run(os.getpid, workers=[addr])[addr]
+                killed.update(pid=pid, tasks=list(keys))
+                os.kill(pid, signal.SIGKILL)
+                return
+            if states and all(s in ("memory", "released", "forgotten") for s in states.values()) and len(states) == 9:
+                return  # all done before a kill: the test fails below
+            time.sleep(0.005)
 
     out = tmp_path / "sweep"
-    rows = embra.sweep(example_sweep(), str(out), client=client, progress=None, on_result=kill_one)
-    assert killed and killed["tasks"]
+    killer = threading.Thread(target=kill_one)
+    killer.start()
+    try:
+        rows = embra.sweep(example_sweep(), str(out), client=client, progress=None)
+    finally:
+        killer.join()
+    assert killed and killed["tasks"], "no variant was in progress on a worker after the first had finished"
     check_against_cli(str(out), rows, cli_runs)
+    # what the killed worker had in hand was run again by another process
+    lost = [r for r in rows if any(k.startswith(f"embra-variant-{r['name']}-") for k in killed["tasks"])]
+    assert lost and any(not r["worker"].endswith(f":{killed['pid']}") for r in lost)
     # the killed process is gone and the cluster has two workers again
     deadline = time.monotonic() + 60
     while len(client.scheduler_info()["workers"]) < 2 and time.monotonic() < deadline:
