@@ -257,7 +257,8 @@ def fabrication_metrics(world, bodies=None):
     for n, t in METRIC_TOLERANCE.items():
         target = getattr(tol, t).target
         v = out[f"{n}_max"]
-        ratio = v / target if target > 0 else (math.inf if v > 0 else 0.0)
+        # a target of 0 met only by 0: any error above it ranks as the largest ratio JSON can hold
+        ratio = v / target if target > 0 else (sys.float_info.max if v > 0 else 0.0)
         if out["worst_metric"] is None or ratio > out["worst_ratio"]:
             out["worst_metric"], out["worst_ratio"] = n, ratio
     return out
@@ -316,7 +317,7 @@ def run_variant(task):
             out["final_json"] = world.save_json()
         if keep["obj"] or keep["thumbnail"]:
             out["final_obj"] = world.export_obj()
-    except Exception as e:  # the scene was refused (schema, a bad value): nothing ran
+    except Exception as e:  # the scene was refused (schema, a bad value: nothing ran), or reading back failed
         out["status"], out["error"] = "error", f"{type(e).__name__}: {e}"
         out["metrics"] = None
     finally:
@@ -612,7 +613,8 @@ def render_png(path, items, columns=None, title=None):
         ax.set_axis_off()
         m = record.get("metrics") or {}
         ratio = m.get("worst_ratio")
-        label = ("" if single else f"#{k + 1} ") + f"{record['name']}\n" + "\n".join(f"{a} = {_short(v)}" for a, v in values.items())
+        label = ("" if single else f"#{k + 1} ") + record["name"]
+        label += "".join(f"\n{a} = {_short(v)}" for a, v in values.items())
         if record["status"] != "ok":
             label += f"\nfailed: {record['error'][:60]}"
         if ratio is not None:
@@ -688,8 +690,9 @@ def main(argv=None):
         print(f"embra-sweep: {e}", file=sys.stderr)
         return 2
     failed = sum(r["status"] != "ok" for r in rows)
-    print(f"embra-sweep: {len(rows)} variants, {failed} failed: {os.path.join(a.out, 'results.csv')}, "
-          f"{os.path.join(a.out, 'contact_sheet.png')}")
+    written = [os.path.join(a.out, name) for name in ("results.csv", "contact_sheet.png")
+               if os.path.isfile(os.path.join(a.out, name))]
+    print(f"embra-sweep: {len(rows)} variants, {failed} failed: {', '.join(written)}")
     return 1 if failed else 0
 
 
