@@ -304,3 +304,16 @@ def test_until_settled_same_bits_as_embra_run_until(client, tmp_path):
         assert read(out / row["name"] / "final.json") == read(ref / "final.json")
         with open(ref / "metrics.jsonl") as f:
             assert json.loads(f.read().splitlines()[-1])["frame"] == row["frames"]
+
+
+def test_the_schema_is_draft_07_and_the_example_follows_it():
+    import jsonschema
+
+    with open(os.path.join(SOURCE, "schemas", "sweep.schema.json")) as f:
+        schema = json.load(f)
+    jsonschema.Draft7Validator.check_schema(schema)  # a valid draft-07 schema itself
+    repository_schema = os.path.join(SOURCE, "schemas", "sweep.schema.json")
+    assert os.path.realpath(sweeps.schema_path()) == os.path.realpath(repository_schema)
+    with open(EXAMPLE) as f:
+        jsonschema.Draft7Validator(schema).validate(json.load(f))
+    assert len(sweeps.Sweep.load(EXAMPLE).variants) == 9
