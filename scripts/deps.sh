@@ -11,6 +11,7 @@ packages=(
   clang-14 libclang-rt-14-dev llvm-14
   python3-jsonschema
   python3-pytest python3-numpy python3-matplotlib
+  python3-distributed python3-dask
   mono-mcs nunit-console libnunit-cil-dev
   abigail-tools
   chromium

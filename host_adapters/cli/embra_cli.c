@@ -6,6 +6,7 @@
  *   embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]
  *             [--allow-outside-paths] [--force]
  *   embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS] [--force]
+ *   embra sweep SWEEP.json [--scheduler ADDRESS] [--workers N] [--out DIR]
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
@@ -30,6 +31,10 @@
  * second (moving pin targets, as a designer would drag them), then held while the form settles.
  * It prints convergence as it goes and writes OBJ files of the shell.
  *
+ * `sweep` is the Python package's design-space sweep on Dask (host_adapters/python/embra/sweeps.py):
+ * it runs the command `embra-sweep` from PATH (the package's console script) with the same arguments,
+ * and exits as it does; without it on PATH, exit 1 and how to get it.
+ *
  * Exit codes: 0 ok, 1 usage (a non-empty DIR without --force too), 2 invalid input, 3 the simulation
  * failed (non-finite state), 4 --until: the world did not come to rest within tolerance. */
 #define _POSIX_C_SOURCE 200809L
@@ -46,6 +51,7 @@
 #include <windows.h>
 /* after windows.h */
 #include <direct.h>
+#include <process.h> /* execvp */
 #include <io.h>
 #include <shellapi.h>
 #else
@@ -289,7 +295,8 @@ static const char kUsage[] =
     "       embra validate SCENE.json [--allow-outside-paths]\n"
     "       embra run SCENE.json [--frames N] [--out DIR] [--every K] [--threads T] [--until settled|tolerance]\n"
     "                 [--allow-outside-paths] [--force]\n"
-    "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS] [--force]\n";
+    "       embra demo tent [--frames N] [--out DIR] [--every K] [--n ROWS] [--force]\n"
+    "       embra sweep SWEEP.json [--scheduler ADDRESS] [--workers N] [--out DIR]\n";
 
 static int usage(void) {
   fputs(kUsage, stderr);
@@ -322,6 +329,8 @@ static int help(void) {
       "          DIR defaults to ./out. OBJ files hold triangles as f lines, a net's edges as l lines.\n"
       "demo tent the paper's Gaudi tent: a triangular cloth under reversed gravity, as OBJ files\n"
       "          (DIR defaults to ./out/tent).\n"
+      "sweep     runs embra-sweep (the Python package's sweeps on Dask: schemas/sweep.schema.json), the\n"
+      "          variants of a scene on a LocalCluster of N workers or the Dask scheduler at ADDRESS.\n"
       "--force   run and demo tent refuse a DIR that holds anything (an earlier run's files are not\n"
       "          replaced silently); --force writes into it, replacing files of the same name.\n"
       "\n"
@@ -1237,6 +1246,22 @@ static int cmd_run(int argc, char** argv) {
   return rc;
 }
 
+/* `embra sweep ARGS`: becomes `embra-sweep ARGS` (argv[0] "sweep" replaced); returns only when that
+ * command cannot be started. */
+static int cmd_sweep(char** argv) {
+  argv[0] = "embra-sweep";
+  fflush(NULL);
+  execvp(argv[0], argv);
+  fprintf(stderr,
+          "embra: sweep runs the command embra-sweep (%s): install the Python package, e.g.\n"
+          "  python3 -m venv --system-site-packages VENV  (Debian's python3-distributed for Dask)\n"
+          "  VENV/bin/pip install --no-build-isolation --no-index host_adapters/python\n"
+          "and put VENV/bin on PATH; or from a clone: PYTHONPATH=host_adapters/python "
+          "EMBRA_LIBRARY=build/libembra.so python3 -m embra.sweeps ...\n",
+          strerror(errno));
+  return EXIT_USAGE;
+}
+
 static int run_main(int argc, char** argv) {
   if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) {
     fprintf(stderr, "embra: %s\n", embra_last_error_message());
@@ -1251,6 +1276,7 @@ static int run_main(int argc, char** argv) {
   if (strcmp(argv[1], "validate") == 0) return cmd_validate(argc - 2, argv + 2);
   if (strcmp(argv[1], "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(argv[1], "demo") == 0 && argc >= 3 && strcmp(argv[2], "tent") == 0) return demo_tent(argc - 3, argv + 3);
+  if (strcmp(argv[1], "sweep") == 0) return cmd_sweep(argv + 1);
   return bad_usage("unknown command '%s'%s", argv[1], " (see embra help)");
 }
 

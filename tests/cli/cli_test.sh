@@ -22,6 +22,16 @@ bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
 "$embra" run scene.json --fram 3 2>&1 | head -1 | grep -q "^embra: unknown option '--fram' for run" && ok || bad "--fram is not named"
 "$embra" frobnicate 2>&1 | head -1 | grep -q "^embra: unknown command 'frobnicate'" && ok || bad "an unknown command is not named"
 "$embra" help | grep -q "^Exit codes:" && ok || bad "embra help must print the help on stdout"
+# `embra sweep` is the command embra-sweep from PATH, its arguments passed as they are.
+mkdir -p "$tmp/bin" "$tmp/nobin"
+printf '#!/bin/sh\nprintf "%%s|" "$0" "$@"; exit 7\n' >"$tmp/bin/embra-sweep"
+chmod +x "$tmp/bin/embra-sweep"
+out=$(PATH="$tmp/bin" "$embra" sweep "a b.json" --workers 2 --out o)
+[ $? -eq 7 ] && [ "$out" = "$tmp/bin/embra-sweep|a b.json|--workers|2|--out|o|" ] && ok ||
+  bad "embra sweep must run embra-sweep with its arguments: '$out'"
+PATH="$tmp/nobin" "$embra" sweep x.json >/dev/null 2>"$tmp/err"; [ $? -eq 1 ] && ok || bad "embra sweep without embra-sweep must exit 1"
+grep -q "^embra: sweep runs the command embra-sweep (No such file or directory)" "$tmp/err" && ok ||
+  bad "embra sweep without embra-sweep must say what to install: $(cat "$tmp/err")"
 
 rows=10
 "$embra" demo tent --frames 90 --every 30 --n $rows --out "$tmp/tent" >"$tmp/log" 2>&1 && ok || bad "demo tent failed: $(cat "$tmp/log")"

@@ -1,7 +1,8 @@
 """A PEP 517 build backend for the package `embra`, with the standard library alone.
 
 pip calls build_wheel (pip install, pip wheel) from pyproject.toml's [build-system]. The wheel holds
-embra/*.py and the built library as embra/libembra.so.<ABI>, where embra/_capi.py looks first, so an
+embra/*.py, the sweep schema (schemas/sweep.schema.json, for embra.sweeps) and the built library
+as embra/libembra.so.<ABI>, where embra/_capi.py looks first, so an
 installed `import embra` needs no environment variable. The library is the one named by the
 config setting `library` (pip --config-settings library=PATH), else $EMBRA_LIBRARY, else the
 repository's build (build/libembra.so.<ABI>, what scripts/build.sh makes). Nothing is downloaded
@@ -69,6 +70,12 @@ def _wheel_file():
     return f"Wheel-Version: 1.0\nGenerator: embra_backend\nRoot-Is-Purelib: false\nTag: {_tag()}\n"
 
 
+def _entry_points():
+    """[project.scripts] as the wheel's console scripts (embra-sweep)."""
+    lines = ["[console_scripts]"] + [f"{name} = {target}" for name, target in _project().get("scripts", {}).items()]
+    return "\n".join(lines) + "\n"
+
+
 def _dist_info(version):
     return f"embra-{version}.dist-info"
 
@@ -79,6 +86,8 @@ def _write_dist_info(folder, version):
         f.write(_metadata(version))
     with open(os.path.join(folder, "WHEEL"), "w") as f:
         f.write(_wheel_file())
+    with open(os.path.join(folder, "entry_points.txt"), "w") as f:
+        f.write(_entry_points())
 
 
 def get_requires_for_build_wheel(config_settings=None):
@@ -95,6 +104,7 @@ def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
     library, abi, version = _library(config_settings)
     files = [(os.path.join(PACKAGE, name), f"embra/{name}") for name in sorted(os.listdir(PACKAGE))
              if name.endswith(".py")]
+    files.append((os.path.join(REPOSITORY, "schemas", "sweep.schema.json"), "embra/sweep.schema.json"))
     files.append((library, f"embra/libembra.so.{abi}"))
     info = _dist_info(version)
     wheel_name = f"embra-{version}-{_tag()}.whl"
@@ -115,6 +125,7 @@ def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
                 add(z, arcname, f.read(), 0o755 if arcname.endswith(f".so.{abi}") else 0o644)
         add(z, f"{info}/METADATA", _metadata(version).encode())
         add(z, f"{info}/WHEEL", _wheel_file().encode())
+        add(z, f"{info}/entry_points.txt", _entry_points().encode())
         record.append(f"{info}/RECORD,,")
         z.writestr(zipfile.ZipInfo(f"{info}/RECORD", date_time=(1980, 1, 1, 0, 0, 0)), "\n".join(record) + "\n")
     return wheel_name

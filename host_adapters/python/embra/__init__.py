@@ -26,6 +26,21 @@ from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_METRICS, PANEL_PINS, SHA
 _lib = _capi.lib
 
 
+def sweep(document, out="sweep_out", **options):
+    """Runs a design-space sweep on Dask (embra.sweeps.sweep: its options and what it writes)."""
+    from .sweeps import sweep as run
+
+    return run(document, out, **options)
+
+
+def __getattr__(name):  # embra.Sweep, embra.SweepError: embra.sweeps imported only when used
+    if name in ("Sweep", "SweepError"):
+        from . import sweeps
+
+        return getattr(sweeps, name)
+    raise AttributeError(f"module 'embra' has no attribute '{name}'")
+
+
 def version():
     """The library's version as MAJOR * 10000 + MINOR * 100 + PATCH."""
     return _lib.embra_version()
@@ -109,7 +124,7 @@ check_abi()  # these bindings and the loaded library must agree before anything 
 
 __version__ = version_string()
 __all__ = [
-    "World", "Body", "as_dict", "version", "version_string", "abi_version", "check_abi", "status_name",
+    "World", "Body", "as_dict", "sweep", "Sweep", "SweepError", "version", "version_string", "abi_version", "check_abi", "status_name",
     "last_error_message", "constraint_arity", "default_solver_def", "form_finding_solver_def", "default_solve_def",
     "Solved", "SOLVE_UNTIL", "default_material", "default_panel_mesh_def",
     "default_tolerances", "default_wind_def", "default_pressure_def", "default_surface_tension_def",

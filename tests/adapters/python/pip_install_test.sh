@@ -46,6 +46,12 @@ print("abi", embra.abi_version() == embra.ABI_VERSION)
 ' 2>&1) || true
 printf '%s\n' "$check" | grep -q "^lib True libembra.so.[0-9]*$" && ok || bad "libembra not loaded from the venv: $check"
 printf '%s\n' "$check" | grep -q "^abi True$" && ok || bad "the bundled library's ABI is not the bindings': $check"
+# The console script of [project.scripts] and the sweep schema it validates against, both in the venv.
+"${clean[@]}" "$venv/bin/embra-sweep" --help 2>&1 | grep -q "^usage: embra-sweep SWEEP" && ok ||
+  bad "the venv has no working embra-sweep command"
+schema=$("${clean[@]}" "$venv/bin/python" -c 'import embra.sweeps as s, os, sys
+print(os.path.realpath(s.schema_path()).startswith(os.path.realpath(sys.prefix) + os.sep))' 2>&1) || true
+[ "$schema" = "True" ] && ok || bad "the sweep schema is not installed beside embra/sweeps.py: $schema"
 version=$("${clean[@]}" "$venv/bin/python" -m pip show embra 2>/dev/null | sed -n 's/^Version: //p')
 lib_version=$("${clean[@]}" "$venv/bin/python" -c 'import embra; print(embra.version_string())')
 [ -n "$version" ] && [ "$version" = "$lib_version" ] && ok || bad "pip's version '$version' is not the library's '$lib_version'"
