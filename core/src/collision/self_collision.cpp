@@ -500,6 +500,7 @@ struct Scratch {
   std::vector<int32_t> left, changed_tris, changed_edges;
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
+  std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
   // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
   std::vector<std::vector<int32_t>> part_cand, part_pairs;
   std::vector<std::vector<SelfContact>> part_contacts;
@@ -528,6 +529,16 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
   for (const std::vector<T>& list : parts) out.insert(out.end(), list.begin(), list.end());
 }
 
+/// Builds each grid of its boxes, the grids at once on the pool's threads (each built by one thread,
+/// so the same at any thread count; on 2 threads the first two on one, the third on the other).
+void build_grids(ThreadPool& pool, std::initializer_list<std::pair<Grid*, const std::vector<Box>*>> grids,
+                 double cell) {
+  const auto* g = grids.begin();
+  pool.run(0, grids.size(), 1, 1, [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) g[k].first->build(*g[k].second, cell);
+  });
+}
+
 // Items per thread below which a detection loop is not split.
 constexpr size_t kPairGrain = 256;     // primitives queried against a grid
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
@@ -552,6 +563,24 @@ bool orient_normal(Vec3 primary, const Vec3& fallback, const Vec3& side, Vec3& n
     return true;
   }
   return false;
+}
+
+/// Whether p is nearer than `limit` to one of `points`: then so is anything holding that point (an
+/// upper bound on a distance, without the exact one). Its rounding only ever keeps a pair more.
+bool near_any(const Vec3& p, std::initializer_list<Vec3> points, double limit) {
+  const double l2 = limit * limit;
+  for (const Vec3& q : points)
+    if ((p - q).squaredNorm() < l2) return true;
+  return false;
+}
+
+/// Whether the bounding boxes of two point sets are at least `gap` apart (by a margin well above
+/// the rounding): then so are any two primitives spanned by them (a lower bound on a distance,
+/// without the exact one).
+bool apart(std::initializer_list<Vec3> a, std::initializer_list<Vec3> b, double gap) {
+  const Box ba = box_of(a, 0.0), bb = box_of(b, 0.0);
+  const Vec3 sep = (bb.lo - ba.hi).cwiseMax(ba.lo - bb.hi).cwiseMax(0.0);
+  return sep.squaredNorm() > gap * gap * (1.0 + 1e-9);
 }
 
 double mean_mu(std::span<const double> mu, const int32_t ids[4]) {
@@ -705,9 +734,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
       // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
       ix.cell = mean_extent(ix.tri_boxes);
-      ix.tri_grid.build(ix.tri_boxes, ix.cell);
-      ix.edge_grid.build(ix.edge_boxes, ix.cell);
-      ix.point_grid.build(ix.point_boxes, ix.cell);
+      build_grids(*in.pool,
+                  {{&ix.tri_grid, &ix.tri_boxes}, {&ix.point_grid, &ix.point_boxes}, {&ix.edge_grid, &ix.edge_boxes}},
+                  ix.cell);
       for (int32_t t : ix.moved_tris) ix.tri_moved[t] = 0;
       for (int32_t e : ix.moved_edges) ix.edge_moved[e] = 0;
       for (int32_t k : ix.moved_points) ix.point_moved[k] = 0;
@@ -720,9 +749,11 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       moved_boxes(ix.moved_tris, ix.tri_boxes, ix.moved_tri_boxes);
       moved_boxes(ix.moved_edges, ix.edge_boxes, ix.moved_edge_boxes);
       moved_boxes(ix.moved_points, ix.point_boxes, ix.moved_point_boxes);
-      ix.moved_tri_grid.build(ix.moved_tri_boxes, ix.cell);
-      ix.moved_edge_grid.build(ix.moved_edge_boxes, ix.cell);
-      ix.moved_point_grid.build(ix.moved_point_boxes, ix.cell);
+      build_grids(*in.pool,
+                  {{&ix.moved_tri_grid, &ix.moved_tri_boxes},
+                   {&ix.moved_point_grid, &ix.moved_point_boxes},
+                   {&ix.moved_edge_grid, &ix.moved_edge_boxes}},
+                  ix.cell);
     }
     // The kept pairs: neither side holds a particle with a new region.
     auto keep = [](std::vector<int32_t>& pairs, auto&& stays) {
@@ -758,11 +789,15 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) return;
       const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
       double bary[3];
-      if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
-          thk + 2.0 * (ix.reach[p] + reach({v[0], v[1], v[2]})))
+      // A vertex nearer than the limit puts the triangle nearer too (the exact distance only when
+      // none is: regions that overlap seldom leave a pair beyond it).
+      const double limit = thk + 2.0 * (ix.reach[p] + reach({v[0], v[1], v[2]}));
+      if (!near_any(x1[p], {x1[v[0]], x1[v[1]], x1[v[2]]}, limit) &&
+          point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >= limit)
         return;
       const BodyInfo& b = in.bodies[s.tri_body[t]];
       if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
+          !apart({rest_of(b, p)}, {rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2])}, thk) &&
           point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
         return;
       pairs.insert(pairs.end(), {p, t});
@@ -774,11 +809,15 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) return;
       const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
       double ps, pt;
-      if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
+      const double limit = thk + 2.0 * (reach({a0, a1}) + reach({b0, b1}));
+      if (!near_any(x1[a0], {x1[b0], x1[b1]}, limit) && !near_any(x1[a1], {x1[b0], x1[b1]}, limit) &&
+          edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= limit)
         return;
       if (s.edge_body[ea] == s.edge_body[eb]) {
         const BodyInfo& b = in.bodies[s.edge_body[ea]];
-        if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk) return;
+        if (!apart({rest_of(b, a0), rest_of(b, a1)}, {rest_of(b, b0), rest_of(b, b1)}, thk) &&
+            edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
+          return;
       }
       pairs.insert(pairs.end(), {ea, eb});
     };
@@ -816,6 +855,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
   // stays more than its thickness apart throughout the substep.
   s.swept_point.resize(x1.size());
+  s.motion.resize(x1.size());
   const auto each = [&](size_t n, auto&& f) {  // independent items, split over the pool's threads
     in.pool->run(0, n, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
       for (size_t k = begin; k < end; ++k) f(k);
@@ -824,7 +864,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   each(s.points.size(), [&](size_t k) {
     const int32_t i = s.points[k];
     s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+    s.motion[i] = (x1[i] - x0[i]).norm();
   });
+  const std::vector<double>& m = s.motion;
   auto swept = [&](std::initializer_list<int32_t> ids) {
     Box b = s.swept_point[*ids.begin()];
     for (int32_t i : ids) {
@@ -847,9 +889,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
            double bary[3];
            const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
-           const double motion =
-               (x1[p] - x0[p]).norm() +
-               std::max({(x1[v[0]] - x0[v[0]]).norm(), (x1[v[1]] - x0[v[1]]).norm(), (x1[v[2]] - x0[v[2]]).norm()});
+           const double motion = m[p] + std::max({m[v[0]], m[v[1]], m[v[2]]});
            if (d0 >= thk + motion) return;
            double toi;
            const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
@@ -887,8 +927,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
            double sa, tb;
            const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
-           const double motion = std::max((x1[a0] - x0[a0]).norm(), (x1[a1] - x0[a1]).norm()) +
-                                 std::max((x1[b0] - x0[b0]).norm(), (x1[b1] - x0[b1]).norm());
+           const double motion = std::max(m[a0], m[a1]) + std::max(m[b0], m[b1]);
            if (d0 >= thk + motion) return;
            const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
            Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
