@@ -152,9 +152,9 @@ class Grid {
   std::span<const Box> boxes_;
   double inv_cell_ = 1.0;
   size_t mask_ = 0;
-  /// A box in a bucket: its bounds rounded outward to floats (a bucket's scan reads half the bytes),
-  /// and its index.
   static constexpr int32_t kFar = std::numeric_limits<int32_t>::min();
+  /// A box in a bucket: its bounds rounded outward to floats (a bucket's scan reads half the bytes),
+  /// its lowest cell and its index.
   struct Entry {
     float lo[3], hi[3];
     int32_t low[3];  // the box's lowest cell, or kFar in low[0] when a coordinate does not fit
