@@ -3,7 +3,10 @@
 // ground plane, so the layers land on each other; thickness half the grid spacing; embra's default
 // solver settings (embra::Settings{}: 16 substeps x 1 iteration, tethers) with self-collision on (or
 // off, for the reference). Times 30 frames of World::step from the release (the fall, the landing
-// and the upper layer settling on the lower). Linear cost means ms_per_frame x 4 from one n to 2n.
+// and the upper layer settling on the lower). BM_ClothSelfCollision keeps the cloth 1 m square, so its
+// spacing and thickness shrink with n while a substep's motion does not; BM_ClothSelfCollisionSimilar
+// keeps the spacing of n = 64 and widens the cloth, a self-similar scene whose linear cost means
+// ms_per_frame x 4 from one n to 2n.
 #include "embra/core/world.hpp"
 
 #include <benchmark/benchmark.h>
@@ -18,8 +21,9 @@ namespace {
 
 using embra::Vec3;
 
-void build_folded_cloth(embra::World& w, int n) {
-  const double size = 1.0, step = size / (n - 1), radius = 0.06, z0 = 0.05;
+/// An n x n cloth of side `size` (m) and 1 kg per square metre, folded and placed as above.
+void build_folded_cloth(embra::World& w, int n, double size = 1.0) {
+  const double step = size / (n - 1), radius = 0.06, z0 = 0.05;
   std::vector<double> flat, folded;
   const Vec3 u = Vec3(1, 1, 0).normalized(), v = Vec3(-1, 1, 0).normalized();
   for (int j = 0; j < n; ++j)
@@ -46,15 +50,15 @@ void build_folded_cloth(embra::World& w, int n) {
   embra::BodyDesc desc;
   desc.positions = flat;
   desc.triangles = tris;
-  desc.material.mass = 1.0;
+  desc.material.mass = size * size;
   desc.material.thickness = 0.5 * step;
   const embra::Id body = w.create_body(desc);
   w.set_positions(w.body(body).first_particle, folded);
   w.create_collider(embra::ColliderDesc{});  // the ground plane z = 0
 }
 
-void BM_ClothSelfCollision(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
+/// Times 30 frames of the folded cloth; `size` is the cloth's side for n (m).
+void run_folded_cloth(benchmark::State& state, int n, double size) {
   constexpr int kFrames = 30;
   double seconds = 0.0;
   int64_t contacts = 0;
@@ -63,7 +67,7 @@ void BM_ClothSelfCollision(benchmark::State& state) {
     s.self_collision = static_cast<int32_t>(state.range(1));
     s.threads = static_cast<int32_t>(state.range(2));
     embra::World w(s);
-    build_folded_cloth(w, n);
+    build_folded_cloth(w, n, size);
     const auto t0 = std::chrono::steady_clock::now();
     for (int f = 0; f < kFrames; ++f) {
       w.step();
@@ -80,6 +84,18 @@ void BM_ClothSelfCollision(benchmark::State& state) {
   state.SetLabel(state.range(1) ? "self-collision on" : "self-collision off");
 }
 
+void BM_ClothSelfCollision(benchmark::State& state) {
+  run_folded_cloth(state, static_cast<int>(state.range(0)), 1.0);
+}
+
+/// The self-similar scene: the grid spacing, thickness, fold and drop of the 64 x 64 cloth (1 m), the
+/// cloth n / 64 times as wide, so a substep moves every particle as far, relative to the spacing and
+/// the thickness, at every n: a linear cost means ms_per_frame x 4 from one n to 2n.
+void BM_ClothSelfCollisionSimilar(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  run_folded_cloth(state, n, (n - 1) / 63.0);
+}
+
 /// Args: {n, self-collision, threads}.
 BENCHMARK(BM_ClothSelfCollision)
     ->ArgNames({"n", "self", "threads"})
@@ -92,6 +108,20 @@ BENCHMARK(BM_ClothSelfCollision)
     ->Args({64, 0, 1})
     ->Args({128, 0, 1})
     ->Args({256, 0, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1);
+
+/// Args: {n, self-collision, threads}.
+BENCHMARK(BM_ClothSelfCollisionSimilar)
+    ->ArgNames({"n", "self", "threads"})
+    ->Args({32, 1, 1})
+    ->Args({32, 1, 2})
+    ->Args({64, 1, 1})
+    ->Args({64, 1, 2})
+    ->Args({128, 1, 1})
+    ->Args({128, 1, 2})
+    ->Args({128, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -19,19 +20,22 @@ constexpr double kMinGap = 1e-6;
 
 /// A particle's region, in which the self-collision candidate pairs stay valid: its swept bounds
 /// grown by kRegionMotion times its motion in the substep plus kRegionThickness times its half
-/// thickness. Larger regions are rebuilt less often but keep more pairs (tuned on the folded-cloth
-/// benchmark, bench/self_collision_bench.cpp).
-constexpr double kRegionMotion = 3.0;
-constexpr double kRegionThickness = 0.25;
+/// thickness. Larger regions are left less often but keep more pairs, each measured again every
+/// substep: on the folded-cloth benchmark (bench/self_collision_bench.cpp, n = 64 and 128) half the
+/// motion cost as little as none or a quarter, and less than 1, 2 or 3 times it; half the half
+/// thickness less than 0.25, 0.35 or 1 times it.
+constexpr double kRegionMotion = 0.5;
+constexpr double kRegionThickness = 0.5;
 /// The broad phase's grids are built again when more than one primitive in kRegrid has moved since
-/// they were built.
-constexpr size_t kRegrid = 4;
+/// they were built (8 measured as fast as 16 and faster than 2 and 4).
+constexpr size_t kRegrid = 8;
 
 struct Box {
   Vec3 lo, hi;
-  bool overlaps(const Box& o) const {
-    return lo.x() <= o.hi.x() && o.lo.x() <= hi.x() && lo.y() <= o.hi.y() && o.lo.y() <= hi.y() && lo.z() <= o.hi.z() &&
-           o.lo.z() <= hi.z();
+  bool overlaps(const Box& o) const {  // all six compared, one branch for the caller: seldom mispredicted
+    return static_cast<bool>(static_cast<int>(lo.x() <= o.hi.x()) & static_cast<int>(o.lo.x() <= hi.x()) &
+                             static_cast<int>(lo.y() <= o.hi.y()) & static_cast<int>(o.lo.y() <= hi.y()) &
+                             static_cast<int>(lo.z() <= o.hi.z()) & static_cast<int>(o.lo.z() <= hi.z()));
   }
   double extent() const { return (hi - lo).maxCoeff(); }
 };
@@ -64,8 +68,7 @@ class Grid {
         big_.push_back(static_cast<int32_t>(i));
         continue;
       }
-      const Entry entry{
-          boxes[i], {coord(boxes[i].lo.x()), coord(boxes[i].lo.y()), coord(boxes[i].lo.z())}, static_cast<int32_t>(i)};
+      const Entry entry = entry_of(boxes[i], static_cast<int32_t>(i));
       visit(boxes[i], [&](size_t bucket, int64_t, int64_t, int64_t) { items_[fill_[bucket]++] = entry; });
     }
   }
@@ -81,14 +84,23 @@ class Grid {
       return;
     }
     const std::array<int64_t, 3> ql = {coord(q.lo.x()), coord(q.lo.y()), coord(q.lo.z())};
+    const Entry qf = entry_of(q, -1);
     visit(q, [&](size_t bucket, int64_t i, int64_t j, int64_t k) {
       for (int32_t e = start_[bucket]; e < start_[bucket + 1]; ++e) {
-        const Entry& b = items_[e];
-        if (!b.box.overlaps(q)) continue;
-        if (std::max(b.low[0], ql[0]) != i || std::max(b.low[1], ql[1]) != j || std::max(b.low[2], ql[2]) != k)
+        const Entry& f = items_[e];
+        if (!f.overlaps(qf)) continue;  // the float boxes hold the double ones: nothing overlapping is missed
+        if (f.low[0] != kFar) {         // the low cell, when it fits in 32 bits
+          if (std::max<int64_t>(f.low[0], ql[0]) != i || std::max<int64_t>(f.low[1], ql[1]) != j ||
+              std::max<int64_t>(f.low[2], ql[2]) != k)
+            continue;
+        }
+        const Box& b = boxes_[f.index];
+        if (!b.overlaps(q)) continue;
+        if (f.low[0] == kFar && (std::max(coord(b.lo.x()), ql[0]) != i || std::max(coord(b.lo.y()), ql[1]) != j ||
+                                 std::max(coord(b.lo.z()), ql[2]) != k))
           continue;
-        if (e > start_[bucket] && b.index == items_[e - 1].index) continue;  // two of its cells share the bucket
-        out.push_back(b.index);
+        if (e > start_[bucket] && f.index == items_[e - 1].index) continue;  // two of its cells share the bucket
+        out.push_back(f.index);
       }
     });
     for (int32_t e : big_)
@@ -125,21 +137,61 @@ class Grid {
     for (int64_t k = k0; k <= k1; ++k)
       for (int64_t j = j0; j <= j1; ++j)
         for (int64_t i = i0; i <= i1; ++i) {
-          uint64_t h = static_cast<uint64_t>(i) * 73856093u ^ static_cast<uint64_t>(j) * 19349663u ^
-                       static_cast<uint64_t>(k) * 83492791u;
-          h *= 0x9E3779B97F4A7C15ull;
-          f(static_cast<size_t>((h >> 20) & mask_), i, j, k);
+          // A block of 4 x 4 x 4 cells hashed together, its cells in consecutive buckets: a query's
+          // cells, and the next primitive's, lie close in memory.
+          const uint64_t bi = static_cast<uint64_t>(i) >> 2, bj = static_cast<uint64_t>(j) >> 2,
+                         bk = static_cast<uint64_t>(k) >> 2;
+          uint64_t h = bi * 73856093u ^ bj * 19349663u ^ bk * 83492791u;
+          h = ((h * 0x9E3779B97F4A7C15ull) >> 20) << 6 |
+              ((static_cast<uint64_t>(i) & 3) | (static_cast<uint64_t>(j) & 3) << 2 |
+               (static_cast<uint64_t>(k) & 3) << 4);
+          f(static_cast<size_t>(h & mask_), i, j, k);
         }
   }
 
   std::span<const Box> boxes_;
   double inv_cell_ = 1.0;
   size_t mask_ = 0;
+  static constexpr int32_t kFar = std::numeric_limits<int32_t>::min();
+  /// A box in a bucket: its bounds rounded outward to floats (a bucket's scan reads half the bytes),
+  /// its lowest cell and its index.
   struct Entry {
-    Box box;
-    std::array<int64_t, 3> low;  // the box's lowest cell
+    float lo[3], hi[3];
+    int32_t low[3];  // the box's lowest cell, or kFar in low[0] when a coordinate does not fit
     int32_t index;
+    bool overlaps(const Entry& o) const {
+      return static_cast<bool>(static_cast<int>(lo[0] <= o.hi[0]) & static_cast<int>(o.lo[0] <= hi[0]) &
+                               static_cast<int>(lo[1] <= o.hi[1]) & static_cast<int>(o.lo[1] <= hi[1]) &
+                               static_cast<int>(lo[2] <= o.hi[2]) & static_cast<int>(o.lo[2] <= hi[2]));
+    }
   };
+  Entry entry_of(const Box& b, int32_t index) const {
+    Entry e{};
+    bool fits = true;
+    for (int a = 0; a < 3; ++a) {
+      e.lo[a] = to_float(b.lo[a], -1.0f);
+      e.hi[a] = to_float(b.hi[a], 1.0f);
+      const int64_t c = coord(b.lo[a]);
+      fits = fits && c > kFar && c <= std::numeric_limits<int32_t>::max();
+      e.low[a] = fits ? static_cast<int32_t>(c) : kFar;
+    }
+    if (!fits) e.low[0] = kFar;
+    e.index = index;
+    return e;
+  }
+  /// v as a float rounded toward `dir` (-1 down, 1 up); NaN stays NaN.
+  static float to_float(double v, float dir) {
+    constexpr float big = std::numeric_limits<float>::max(), inf = std::numeric_limits<float>::infinity();
+    if (std::isnan(v)) return std::numeric_limits<float>::quiet_NaN();
+    if (v > big) return dir < 0.0f ? big : inf;
+    if (v < -big) return dir < 0.0f ? -inf : -big;
+    const float f = static_cast<float>(v);
+    if (dir < 0.0f ? !(static_cast<double>(f) > v) : !(static_cast<double>(f) < v)) return f;
+    // one step toward dir: the next float's bits (f is finite here)
+    if (f == 0.0f) return dir * std::numeric_limits<float>::denorm_min();
+    const uint32_t bits = std::bit_cast<uint32_t>(f);
+    return std::bit_cast<float>((f > 0.0f) == (dir > 0.0f) ? bits + 1 : bits - 1);
+  }
   std::vector<int32_t> start_, fill_, big_;
   std::vector<Entry> items_;  // the boxes of each bucket, copied so a query reads them in sequence
 };
@@ -500,9 +552,11 @@ struct Scratch {
   std::vector<int32_t> left, changed_tris, changed_edges;
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
+  std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
   // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
   std::vector<std::vector<int32_t>> part_cand, part_pairs;
   std::vector<std::vector<SelfContact>> part_contacts;
+  std::vector<std::pair<size_t, size_t>> part_kept;  // keep(): the kept pairs' range of each part
 };
 
 Scratch& scratch() {
@@ -526,6 +580,16 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
     for (size_t k = begin; k < end; ++k) body(k, list, cand);
   });
   for (const std::vector<T>& list : parts) out.insert(out.end(), list.begin(), list.end());
+}
+
+/// Builds each grid of its boxes, the grids at once on the pool's threads (each built by one thread,
+/// so the same at any thread count; on 2 threads the first two on one, the third on the other).
+void build_grids(ThreadPool& pool, std::initializer_list<std::pair<Grid*, const std::vector<Box>*>> grids,
+                 double cell) {
+  const auto* g = grids.begin();
+  pool.run(0, grids.size(), 1, 1, [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) g[k].first->build(*g[k].second, cell);
+  });
 }
 
 // Items per thread below which a detection loop is not split.
@@ -552,6 +616,27 @@ bool orient_normal(Vec3 primary, const Vec3& fallback, const Vec3& side, Vec3& n
     return true;
   }
   return false;
+}
+
+/// Whether p is nearer than `limit` to one of `points`: then so is anything holding that point (an
+/// upper bound on a distance, without the exact one). Its rounding only ever keeps a pair more.
+bool near_any(const Vec3& p, std::initializer_list<Vec3> points, double limit) {
+  const double l2 = limit * limit;
+  for (const Vec3& q : points)
+    if ((p - q).squaredNorm() < l2) return true;
+  return false;
+}
+
+/// Whether the bounding boxes of two point sets are at least `gap` apart (by a margin well above
+/// the rounding): then so are any two primitives spanned by them (a lower bound on a distance,
+/// without the exact one).
+template <size_t A, size_t B>
+bool apart(const std::array<const Vec3*, A>& a, const std::array<const Vec3*, B>& b, double gap) {
+  Vec3 alo = *a[0], ahi = *a[0], blo = *b[0], bhi = *b[0];
+  for (size_t k = 1; k < A; ++k) alo = alo.cwiseMin(*a[k]), ahi = ahi.cwiseMax(*a[k]);
+  for (size_t k = 1; k < B; ++k) blo = blo.cwiseMin(*b[k]), bhi = bhi.cwiseMax(*b[k]);
+  const Vec3 sep = (blo - ahi).cwiseMax(alo - bhi).cwiseMax(0.0);
+  return sep.squaredNorm() > gap * gap * (1.0 + 1e-9);
 }
 
 double mean_mu(std::span<const double> mu, const int32_t ids[4]) {
@@ -677,19 +762,30 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     ix.tri_moved.resize(nt, 0);
     ix.edge_moved.resize(ne, 0);
     ix.point_moved.resize(np, 0);
+    // (boxes and marks split over the threads, then the lists in index order)
+    in.pool->run(0, nt, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t t = begin; t < end; ++t) {
+        const int32_t* v = &s.tris[3 * t];
+        if (!s.changed[v[0]] && !s.changed[v[1]] && !s.changed[v[2]]) continue;
+        ix.tri_boxes[t] = region({v[0], v[1], v[2]});
+        s.tri_changed[t] = 1;
+      }
+    });
+    in.pool->run(0, ne, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t e = begin; e < end; ++e) {
+        const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
+        if (!s.changed[a] && !s.changed[b]) continue;
+        ix.edge_boxes[e] = region({a, b});
+        s.edge_changed[e] = 1;
+      }
+    });
     for (size_t t = 0; t < nt; ++t) {
-      const int32_t* v = &s.tris[3 * t];
-      if (!s.changed[v[0]] && !s.changed[v[1]] && !s.changed[v[2]]) continue;
-      ix.tri_boxes[t] = region({v[0], v[1], v[2]});
-      s.tri_changed[t] = 1;
+      if (!s.tri_changed[t]) continue;
       s.changed_tris.push_back(static_cast<int32_t>(t));
       if (!ix.tri_moved[t]) ix.tri_moved[t] = 1, ix.moved_tris.push_back(static_cast<int32_t>(t));
     }
     for (size_t e = 0; e < ne; ++e) {
-      const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
-      if (!s.changed[a] && !s.changed[b]) continue;
-      ix.edge_boxes[e] = region({a, b});
-      s.edge_changed[e] = 1;
+      if (!s.edge_changed[e]) continue;
       s.changed_edges.push_back(static_cast<int32_t>(e));
       if (!ix.edge_moved[e]) ix.edge_moved[e] = 1, ix.moved_edges.push_back(static_cast<int32_t>(e));
     }
@@ -705,9 +801,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
       // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
       ix.cell = mean_extent(ix.tri_boxes);
-      ix.tri_grid.build(ix.tri_boxes, ix.cell);
-      ix.edge_grid.build(ix.edge_boxes, ix.cell);
-      ix.point_grid.build(ix.point_boxes, ix.cell);
+      build_grids(*in.pool,
+                  {{&ix.tri_grid, &ix.tri_boxes}, {&ix.point_grid, &ix.point_boxes}, {&ix.edge_grid, &ix.edge_boxes}},
+                  ix.cell);
       for (int32_t t : ix.moved_tris) ix.tri_moved[t] = 0;
       for (int32_t e : ix.moved_edges) ix.edge_moved[e] = 0;
       for (int32_t k : ix.moved_points) ix.point_moved[k] = 0;
@@ -720,18 +816,34 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       moved_boxes(ix.moved_tris, ix.tri_boxes, ix.moved_tri_boxes);
       moved_boxes(ix.moved_edges, ix.edge_boxes, ix.moved_edge_boxes);
       moved_boxes(ix.moved_points, ix.point_boxes, ix.moved_point_boxes);
-      ix.moved_tri_grid.build(ix.moved_tri_boxes, ix.cell);
-      ix.moved_edge_grid.build(ix.moved_edge_boxes, ix.cell);
-      ix.moved_point_grid.build(ix.moved_point_boxes, ix.cell);
+      build_grids(*in.pool,
+                  {{&ix.moved_tri_grid, &ix.moved_tri_boxes},
+                   {&ix.moved_point_grid, &ix.moved_point_boxes},
+                   {&ix.moved_edge_grid, &ix.moved_edge_boxes}},
+                  ix.cell);
     }
     // The kept pairs: neither side holds a particle with a new region.
-    auto keep = [](std::vector<int32_t>& pairs, auto&& stays) {
+    // Each thread compacts a part of the list in place, then the parts are moved together in order:
+    // the order one loop gives.
+    auto keep = [&](std::vector<int32_t>& pairs, auto&& stays) {
+      s.part_kept.assign(static_cast<size_t>(in.pool->size()), {0, 0});
+      in.pool->run(0, pairs.size() / 2, 1, kContactGrain, [&](size_t begin, size_t end, int part) {
+        size_t kept = 2 * begin;
+        for (size_t k = 2 * begin; k < 2 * end; k += 2)
+          if (stays(pairs[k], pairs[k + 1])) {
+            pairs[kept++] = pairs[k];
+            pairs[kept++] = pairs[k + 1];
+          }
+        s.part_kept[static_cast<size_t>(part)] = {2 * begin, kept};
+      });
       size_t kept = 0;
-      for (size_t k = 0; k < pairs.size(); k += 2)
-        if (stays(pairs[k], pairs[k + 1])) {
-          pairs[kept++] = pairs[k];
-          pairs[kept++] = pairs[k + 1];
-        }
+      for (const auto& [begin, end] : s.part_kept) {
+        if (kept != begin)  // forward, to an earlier place
+          std::copy(pairs.begin() + static_cast<std::ptrdiff_t>(begin),
+                    pairs.begin() + static_cast<std::ptrdiff_t>(end),
+                    pairs.begin() + static_cast<std::ptrdiff_t>(kept));
+        kept += end - begin;
+      }
       pairs.resize(kept);
     };
     keep(cache.point_triangle, [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
@@ -758,11 +870,15 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (in.w[p] == 0.0 && in.w[v[0]] == 0.0 && in.w[v[1]] == 0.0 && in.w[v[2]] == 0.0) return;
       const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
       double bary[3];
-      if (point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >=
-          thk + 2.0 * (ix.reach[p] + reach({v[0], v[1], v[2]})))
+      // A vertex nearer than the limit puts the triangle nearer too (the exact distance only when
+      // none is: regions that overlap seldom leave a pair beyond it).
+      const double limit = thk + 2.0 * (ix.reach[p] + reach({v[0], v[1], v[2]}));
+      if (!near_any(x1[p], {x1[v[0]], x1[v[1]], x1[v[2]]}, limit) &&
+          point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >= limit)
         return;
       const BodyInfo& b = in.bodies[s.tri_body[t]];
       if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
+          !apart<1, 3>({&rest_of(b, p)}, {&rest_of(b, v[0]), &rest_of(b, v[1]), &rest_of(b, v[2])}, thk) &&
           point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
         return;
       pairs.insert(pairs.end(), {p, t});
@@ -774,11 +890,15 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (in.w[a0] == 0.0 && in.w[a1] == 0.0 && in.w[b0] == 0.0 && in.w[b1] == 0.0) return;
       const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
       double ps, pt;
-      if (edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= thk + 2.0 * (reach({a0, a1}) + reach({b0, b1})))
+      const double limit = thk + 2.0 * (reach({a0, a1}) + reach({b0, b1}));
+      if (!near_any(x1[a0], {x1[b0], x1[b1]}, limit) && !near_any(x1[a1], {x1[b0], x1[b1]}, limit) &&
+          edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= limit)
         return;
       if (s.edge_body[ea] == s.edge_body[eb]) {
         const BodyInfo& b = in.bodies[s.edge_body[ea]];
-        if (edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk) return;
+        if (!apart<2, 2>({&rest_of(b, a0), &rest_of(b, a1)}, {&rest_of(b, b0), &rest_of(b, b1)}, thk) &&
+            edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
+          return;
       }
       pairs.insert(pairs.end(), {ea, eb});
     };
@@ -816,6 +936,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
   // stays more than its thickness apart throughout the substep.
   s.swept_point.resize(x1.size());
+  s.motion.resize(x1.size());
   const auto each = [&](size_t n, auto&& f) {  // independent items, split over the pool's threads
     in.pool->run(0, n, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
       for (size_t k = begin; k < end; ++k) f(k);
@@ -824,7 +945,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   each(s.points.size(), [&](size_t k) {
     const int32_t i = s.points[k];
     s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+    s.motion[i] = (x1[i] - x0[i]).norm();
   });
+  const std::vector<double>& m = s.motion;
   auto swept = [&](std::initializer_list<int32_t> ids) {
     Box b = s.swept_point[*ids.begin()];
     for (int32_t i : ids) {
@@ -847,9 +970,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
            double bary[3];
            const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
-           const double motion =
-               (x1[p] - x0[p]).norm() +
-               std::max({(x1[v[0]] - x0[v[0]]).norm(), (x1[v[1]] - x0[v[1]]).norm(), (x1[v[2]] - x0[v[2]]).norm()});
+           const double motion = m[p] + std::max({m[v[0]], m[v[1]], m[v[2]]});
            if (d0 >= thk + motion) return;
            double toi;
            const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
@@ -887,8 +1008,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
            const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
            double sa, tb;
            const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
-           const double motion = std::max((x1[a0] - x0[a0]).norm(), (x1[a1] - x0[a1]).norm()) +
-                                 std::max((x1[b0] - x0[b0]).norm(), (x1[b1] - x0[b1]).norm());
+           const double motion = std::max(m[a0], m[a1]) + std::max(m[b0], m[b1]);
            if (d0 >= thk + motion) return;
            const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
            Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);

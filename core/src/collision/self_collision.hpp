@@ -8,12 +8,14 @@
 //                 one, and only the pairs of the primitives holding it are dropped and found again
 //                 (each such primitive queried against the others); the hash tables are those of the
 //                 last rebuild, with the primitives moved since in small tables of their own, and are
-//                 rebuilt when a quarter of the primitives have moved. Pairs that cannot come within
+//                 rebuilt when an eighth of the primitives have moved. Pairs that cannot come within
 //                 their thickness while the regions hold (their distance, less what the regions let
 //                 them move) are dropped when the pairs are found. The cell is the mean triangle
 //                 region's extent, so a primitive covers a bounded number of cells and the work grows
 //                 linearly with the particle count. The table is a counting sort into buckets (no node
-//                 allocation, iteration in primitive order): deterministic.
+//                 allocation, iteration in primitive order): deterministic. The loops over particles,
+//                 primitives and pairs are split over the pool's threads and their lists appended in
+//                 part order; the three tables are built at once, each by one thread.
 //   narrow phase  a kept pair becomes a contact when its swept bounds in this substep, grown by the
 //                 half thicknesses, overlap and it could come within the thickness during the
 //                 substep: its distance at the start is below thickness + how far its vertices move.
