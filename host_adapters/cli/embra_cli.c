@@ -51,8 +51,8 @@
 #include <windows.h>
 /* after windows.h */
 #include <direct.h>
-#include <process.h> /* execvp */
 #include <io.h>
+#include <process.h> /* execvp */
 #include <shellapi.h>
 #else
 #include <dirent.h>
