@@ -1065,11 +1065,14 @@ std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<c
 }
 
 /// Lays a distance array's constraints end to end into chains (SolverArray::chain_start): from each
-/// constraint not yet in a chain, in array order, the chain grows at both ends by the constraint
-/// that continues it straightest (over `rest`, the particles' rest positions), within about 26
-/// degrees, that joins no particle the chain already has. On a regular grid the chains are its
-/// rows, columns and diagonals; elsewhere they are whatever straight runs the mesh has, down to
-/// single constraints, which the chain pass projects exactly as the plain pass does.
+/// constraint not yet in a chain, in array order, the chain grows at both ends: through a particle
+/// that two of the array's constraints meet at (a cable, a rope, a polyline of any shape) by the
+/// other one, whatever the angle; through any other particle by the constraint that continues it
+/// straightest (over `rest`, the particles' rest positions), within about 26 degrees; never to a
+/// particle the chain already has. On a regular grid the chains are its rows, columns and
+/// diagonals; a cable is one chain however it curves; elsewhere they are whatever straight runs the
+/// mesh has, down to single constraints, which the chain pass projects exactly as the plain pass
+/// does.
 void build_chains(SolverArray& a, const std::vector<Vec3>& rest) {
   constexpr double kStraight = 0.9;  // cosine: the turn a chain may take at a particle
   const size_t n = a.size();
@@ -1086,11 +1089,14 @@ void build_chains(SolverArray& a, const std::vector<Vec3>& rest) {
     for (;;) {
       const Vec3 dir = (rest[at] - rest[from]).normalized();
       int32_t best = -1;
-      double best_cos = kStraight;
+      // Two constraints meet here: the chain goes on through the other, at any angle (the rest
+      // shape of a hand-built cable may be anything, even all at one point).
+      const bool through = start[at + 1] - start[at] == 2;
+      double best_cos = through ? -std::numeric_limits<double>::infinity() : kStraight;
       for (int32_t j = start[at]; j < start[at + 1]; ++j) {
         const int32_t e = incident[j], q = other(e, at);
         if (used[e] || in_chain[q]) continue;
-        const double c = (rest[q] - rest[at]).normalized().dot(dir);
+        const double c = through ? 0.0 : (rest[q] - rest[at]).normalized().dot(dir);
         if (c > best_cos) best_cos = c, best = e;
       }
       if (best < 0) return;
