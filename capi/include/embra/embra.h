@@ -213,7 +213,8 @@ typedef struct embra_solver_def {
                                   26 degrees a joint) or through particles where only two of a group's
                                   distances meet (a cable or chain, at any angle) are projected a run
                                   at a time in the first iteration of every substep (with realignment
-                                  passes, before the first pass), each run's linearised XPBD system solved
+                                  passes, the cables only, before the first pass), each run's
+                                  linearised XPBD system solved
                                   exactly (tridiagonal, cost linear in its length): a Newton step for
                                   the whole run, so a correction travels the run in one pass instead of
                                   one link per pass. A step that does not lower the run's residual (a
@@ -252,7 +253,7 @@ EMBRA_API embra_solver_def embra_default_solver_def(void);
  * reports it settled but out of tolerance, the distance residual named; a 32 x 32 net of links hung
  * from its corners rests with links stretched 145 %. For the exact shape of a chain, the defaults with
  * realign_passes 2 (and damping): 64 links settle on the discrete catenary to 7e-9 of the span. A
- * 32 x 32 net there still rests 0.3 % stretched (one pass a substep does not converge a net's
+ * 32 x 32 net there still rests with links 2 % long (one pass a substep does not converge a net's
  * long-wavelength modes) and embra_world_solve says so (tests/unit/form_finding_test.cpp). */
 EMBRA_API embra_solver_def embra_form_finding_solver_def(void);
 
