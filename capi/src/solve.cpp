@@ -15,6 +15,11 @@ constexpr std::tuple kSolveCopies{Copy{&embra_solve_def::max_frames, &embra::Sol
                                   Copy{&embra_solve_def::hold_frames, &embra::SolveSettings::hold_frames},
                                   Copy{&embra_solve_def::max_seconds, &embra::SolveSettings::max_seconds}};
 
+static_assert(embra::kResidualTargetLength == EMBRA_SOLVE_RESIDUAL_TARGET_M, "embra.h states the targets");
+static_assert(embra::kResidualTargetAngle == EMBRA_SOLVE_RESIDUAL_TARGET_RAD, "embra.h states the targets");
+static_assert(embra::kResidualTargetVolume == EMBRA_SOLVE_RESIDUAL_TARGET_M3, "embra.h states the targets");
+static_assert(embra::kWorstResidual == EMBRA_SOLVE_WORST_RESIDUAL, "embra.h states the metric's number");
+
 }  // namespace
 
 extern "C" {

@@ -322,7 +322,8 @@ static int help(void) {
       "          --threads T steps on T threads (0: one per core; default: the scene's solver.threads);\n"
       "          the results are the same bits at any T, and final.json keeps the scene's own setting.\n"
       "          --until settled|tolerance steps until the world is at rest (and, with tolerance, every\n"
-      "          panel mesh within its tolerance targets) or N frames have passed, with embra_world_solve,\n"
+      "          panel mesh within its tolerance targets and every kind's constraint residual within\n"
+      "          EMBRA_SOLVE_RESIDUAL_TARGET_*) or N frames have passed, with embra_world_solve,\n"
       "          and says why it stopped: at rest within or out of tolerance (the worst metric and where),\n"
       "          or still moving, oscillating (with its period) or drifting. N defaults to 1000 there; the\n"
       "          per-frame lines and frame OBJs are not written, metrics.jsonl holds the last frame.\n"
@@ -978,7 +979,12 @@ static void print_solve_outcome(const embra_solve_result* s, const embra_world* 
   static const char* const metric_names[] = {"planarity", "thickness error", "miter twist", "corner off plane"};
   const char* metric = s->worst_metric >= 0 && s->worst_metric < 4 ? metric_names[s->worst_metric] : "";
   char where[200] = "";
-  if (s->worst_metric >= 0) {
+  if (s->worst_metric == EMBRA_SOLVE_WORST_RESIDUAL) {
+    const char* kind = embra_residual_name(s->worst_element);
+    const char* unit = embra_residual_unit(s->worst_element);
+    snprintf(where, sizeof where, "%s residual %.3e %s (target %.3e)", kind ? kind : "?", s->worst_value,
+             unit ? unit : "", s->worst_target);
+  } else if (s->worst_metric >= 0) {
     embra_tolerances tol;
     embra_world_get_tolerances(world, &tol);
     snprintf(where, sizeof where, "%s %.3e (target %.3e) at %s %d%s of panel mesh body %u", metric, s->worst_value,

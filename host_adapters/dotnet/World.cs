@@ -854,11 +854,14 @@ namespace Embra
 
         /// <summary>
         /// Steps until the world is at rest (SolveUntil.Settled) and, with SolveUntil.Tolerance, every
-        /// panel mesh within its tolerance targets, or def.MaxFrames frames or def.MaxSeconds of wall
-        /// time have passed (embra_world_solve; def null: Library.DefaultSolveDef()). The result says
-        /// why it stopped: Outcome (a Solve value), Frames, Period (s, of an oscillation) and the worst
-        /// fabrication metric (WorstMetric a PanelMetric, or -1 without a panel mesh; WorstBody,
-        /// WorstElement, WorstLayer 0 top / 1 bottom / -1, WorstValue, WorstTarget).
+        /// panel mesh within its tolerance targets and every kind's constraint residual within its
+        /// residual target, or def.MaxFrames frames or def.MaxSeconds of wall time have passed
+        /// (embra_world_solve; def null: Library.DefaultSolveDef()). The result says why it stopped:
+        /// Outcome (a Solve value), Frames, Period (s, of an oscillation) and the worst metric
+        /// (WorstMetric a PanelMetric, EMBRA_SOLVE_WORST_RESIDUAL (16) for a kind's residual above its
+        /// target with WorstElement the kind, or -1 without a panel mesh and with every residual within
+        /// its target; WorstBody, WorstElement, WorstLayer 0 top / 1 bottom / -1, WorstValue,
+        /// WorstTarget).
         /// </summary>
         public SolveResult Solve(SolveDef? def = null)
         {

@@ -163,14 +163,16 @@ static void test_defaults(void) {
   CHECK_INT(s.tethers, 2);
   CHECK_INT(s.threads, 1);
   {
-    /* The form-finding preset: the defaults but for dt 1/15 s, 1 substep and 1 iteration. */
+    /* The form-finding preset: the defaults but for dt 1/15 s, 1 substep, 1 iteration and damping 6/s. */
     embra_solver_def f = embra_form_finding_solver_def(), d = s;
     CHECK_NEAR(f.dt, 1.0 / 15.0, 0.0);
     CHECK_INT(f.substeps, 1);
     CHECK_INT(f.iterations, 1);
+    CHECK_NEAR(f.damping, 6.0, 0.0);
     d.dt = f.dt;
     d.substeps = f.substeps;
     d.iterations = f.iterations;
+    d.damping = f.damping;
     CHECK(memcmp(&d, &f, sizeof d) == 0);
   }
 

@@ -9,6 +9,7 @@
  * refused before any step. */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "capi_test.h"
@@ -359,7 +360,65 @@ static void test_refusals(void) {
   embra_world_destroy(w);
 }
 
+/* A scene's "preset": "form_finding" starts from embra_form_finding_solver_def, its other keys
+ * overriding it; a 16-link chain hung at the preset comes to rest stretched (its links add up to more
+ * than their 1.2 m), and the C door says so: settled out of tolerance, the distance residual named,
+ * in metres, above EMBRA_SOLVE_RESIDUAL_TARGET_M, and equal to the largest |length - rest| of a link. */
+static void test_preset_scene_and_a_stretched_chain(void) {
+  char scene[4096];
+  int n = 0, k;
+  embra_world* w = NULL;
+  embra_solver_def got, want = embra_form_finding_solver_def();
+  embra_solve_result r;
+  double positions[17 * 3], stretch = 0.0, length = 0.0, lo = 1e-6, hi = 3.0, t, radius;
+  for (k = 0; k < 200; ++k) { /* the arc's half angle t: sin(t) / t = span / length = 1 / 1.2 */
+    const double mid = 0.5 * (lo + hi);
+    if (sin(mid) / mid > 1.0 / 1.2)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  t = 0.5 * (lo + hi);
+  radius = 1.2 / (2.0 * t);
+  n += snprintf(scene + n, sizeof scene - (size_t)n,
+                "{\"format\": \"embra-scene\", \"version\": 1, \"solver\": {\"preset\": \"form_finding\", "
+                "\"settle_speed\": 0.002}, \"bodies\": [{\"name\": \"chain\", \"mesh\": {\"vertices\": [");
+  for (k = 0; k <= 16; ++k) { /* a circular arc of 1.2 m through two points 1 m apart */
+    const double a = -t + 2.0 * t * k / 16.0;
+    n += snprintf(scene + n, sizeof scene - (size_t)n, "%s[%.17g, 0, %.17g]", k ? ", " : "", radius * sin(a),
+                  -radius * (cos(a) - cos(t)));
+  }
+  n += snprintf(scene + n, sizeof scene - (size_t)n,
+                "]}, \"generate\": []}], \"constraints\": [{\"kind\": \"distance\", \"particles\": [");
+  for (k = 0; k < 16; ++k) n += snprintf(scene + n, sizeof scene - (size_t)n, "%s[%d, %d]", k ? ", " : "", k, k + 1);
+  n += snprintf(scene + n, sizeof scene - (size_t)n, "], \"rest\": [");
+  for (k = 0; k < 16; ++k) n += snprintf(scene + n, sizeof scene - (size_t)n, "%s0.075", k ? ", " : "");
+  snprintf(scene + n, sizeof scene - (size_t)n,
+           "]}], \"pins\": [{\"particle\": {\"body\": \"chain\", \"vertex\": 0}}, "
+           "{\"particle\": {\"body\": \"chain\", \"vertex\": 16}}]}");
+  CHECK_OK(embra_world_load_json(&w, scene, (int64_t)strlen(scene), NULL));
+  CHECK_OK(embra_world_get_solver(w, &got));
+  want.settle_speed = 0.002;
+  CHECK(memcmp(&got, &want, sizeof got) == 0);
+  CHECK_OK(embra_world_solve(w, NULL, &r));
+  CHECK_INT(r.outcome, EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE);
+  CHECK_INT(r.worst_metric, EMBRA_SOLVE_WORST_RESIDUAL);
+  CHECK_INT(r.worst_element, EMBRA_CONSTRAINT_DISTANCE);
+  CHECK_NEAR(r.worst_target, EMBRA_SOLVE_RESIDUAL_TARGET_M, 0.0);
+  CHECK_OK(embra_world_get_positions(w, positions, 3 * 17, 0, 17));
+  for (k = 0; k < 16; ++k) {
+    const double dx = positions[3 * k + 3] - positions[3 * k], dy = positions[3 * k + 4] - positions[3 * k + 1],
+                 dz = positions[3 * k + 5] - positions[3 * k + 2], l = sqrt(dx * dx + dy * dy + dz * dz);
+    length += l;
+    if (fabs(l - 0.075) > stretch) stretch = fabs(l - 0.075);
+  }
+  CHECK(length > 1.05 * 1.2);
+  CHECK_NEAR(r.worst_value, stretch, 1e-9 * stretch);
+  embra_world_destroy(w);
+}
+
 int main(void) {
+  RUN(test_preset_scene_and_a_stretched_chain);
   RUN(test_pendulum_oscillates);
   RUN(test_chain_settles);
   RUN(test_panel_out_of_tolerance);

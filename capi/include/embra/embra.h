@@ -210,21 +210,25 @@ typedef struct embra_solver_def {
   int32_t chain_solve;         /* 0 or 1; default 1. 1: distance constraints that lie end to end in
                                   straight runs over the bodies' rest shapes (a cloth grid's rows,
                                   columns and diagonals; any mesh's straight edge runs, within about
-                                  26 degrees a joint) are projected a run at a time in the first
-                                  iteration of every substep, each run's linearised XPBD system solved
+                                  26 degrees a joint) or through particles where only two of a group's
+                                  distances meet (a cable or chain, at any angle) are projected a run
+                                  at a time in the first iteration of every substep (with realignment
+                                  passes, the cables only, before the first pass), each run's
+                                  linearised XPBD system solved
                                   exactly (tridiagonal, cost linear in its length): a Newton step for
                                   the whole run, so a correction travels the run in one pass instead of
                                   one link per pass. A step that does not lower the run's residual (a
                                   run folded over, rest lengths cut to a fraction) is dropped for
-                                  one-at-a-time projection. Later iterations and realignment passes
+                                  one-at-a-time projection. Later iterations and the realignment passes
                                   (realign_passes > 0) project one constraint at a time: repeated
                                   Newton steps in one substep leave a taut structure sliding along its
                                   constraints (a 64-link catenary at 2 substeps x 40 iterations kept
                                   2 cm/s against damping 20/s). Measured: the 128 x 128 hanging cloth
                                   after 200 frames at 16 substeps, 37 % -> 0.60 % max edge strain
                                   (bench/README.md); a 64-link catenary at 20 x 1 settles 2,000 times
-                                  closer to the exact discrete catenary. 0: one constraint at a time
-                                  throughout. */
+                                  closer to the exact discrete catenary, and with 2 realignment passes
+                                  on it to 3e-9 of the span (3.6e-3 with one constraint at a time).
+                                  0: one constraint at a time throughout. */
   int32_t threads;             /* threads the solver uses, the caller's included, [0,
                                   EMBRA_MAX_THREADS]; default 1.
                                   0: one per core of the machine. Each colour of constraints (and of
@@ -236,11 +240,21 @@ typedef struct embra_solver_def {
 } embra_solver_def;
 
 EMBRA_API embra_solver_def embra_default_solver_def(void);
-/* The form-finding preset: the defaults with dt 1/15 s, 1 substep and 1 iteration, for the shape a
- * structure comes to rest in rather than the motion on the way (large steps; the chain solve and
- * the tethers keep the cloth inextensible). The 128 x 128 cloth hanging from two corners with
- * damping 6/s is at rest (max speed under 1 mm/s, strain under 1 %, held 30 frames) after 44 frames,
- * 0.19 s on 2 threads, against 185 frames and 5.3 s on 1 thread at the defaults (BM_ClothToRest). */
+/* The form-finding preset: the defaults with dt 1/15 s, 1 substep, 1 iteration and damping 6/s, for
+ * the shape a structure comes to rest in rather than the motion on the way: every scene built with
+ * it comes to rest (embra_world_solve says whether within tolerance). Large steps: the chain solve and
+ * the tethers keep a cloth near inextensible. The 128 x 128 cloth hanging from two corners is at rest
+ * (max speed under 1 mm/s, strain under 1 %, held 30 frames) after 44 frames, 0.19 s on 2 threads,
+ * against 185 frames and 5.3 s on 1 thread at the defaults (BM_ClothToRest).
+ * What it does not do: settle a structure on its exact equilibrium where a substep's fall g h^2
+ * (4.4 cm at 1/15 s) is not small against its links, and tension makes the projections' dropped
+ * geometric stiffness large (h^2 T / (m l) >> 1): a chain of 16 links of 7.5 cm built by hand comes
+ * to rest stretched (its middle far below where 1.2 m of chain can reach) and embra_world_solve
+ * reports it settled but out of tolerance, the distance residual named; a 32 x 32 net of links hung
+ * from its corners rests with links stretched 145 %. For the exact shape of a chain, the defaults with
+ * realign_passes 2 (and damping): 64 links settle on the discrete catenary to 7e-9 of the span. A
+ * 32 x 32 net there still rests with links 2 % long (one pass a substep does not converge a net's
+ * long-wavelength modes) and embra_world_solve says so (tests/unit/form_finding_test.cpp). */
 EMBRA_API embra_solver_def embra_form_finding_solver_def(void);
 
 /* Creates an empty world with a default group (order 0, weight 1) and a contact group
@@ -769,7 +783,11 @@ EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_gr
  * embra_world_solve steps frames (scene actions applied, as embra_world_step) until the world is at
  * rest for hold_frames frames in a row (max_speed <= settle_speed) and, with
  * EMBRA_SOLVE_UNTIL_TOLERANCE, every panel mesh's planarity (both layers), corner distance,
- * thickness and miter are at or below the world's tolerance targets; or until max_frames frames or
+ * thickness and miter are at or below the world's tolerance targets and every kind's largest
+ * constraint residual of the last step (embra_world_get_residuals: |C + compliance/h^2 * lambda|,
+ * in the kind's unit) is at or below EMBRA_SOLVE_RESIDUAL_TARGET_M, _RAD or _M3 by that unit (a
+ * stretched inextensible chain, a pin off its target or a compliant constraint whose step has not
+ * converged is out of tolerance, however still it stands); or until max_frames frames or
  * max_seconds of wall time. At rest but out of tolerance, it steps on while the worst of those
  * metrics (value over target) still falls by 1 % every hold_frames frames. Still moving at the end,
  * the motion is told apart as oscillating (back and forth with a period: the paper's "oscillates
@@ -785,8 +803,16 @@ EMBRA_API embra_status embra_group_get_report(const embra_world* world, embra_gr
 
 enum {
   EMBRA_SOLVE_UNTIL_SETTLED = 0,  /* at rest */
-  EMBRA_SOLVE_UNTIL_TOLERANCE = 1 /* at rest and every panel mesh within its tolerance targets */
+  EMBRA_SOLVE_UNTIL_TOLERANCE = 1 /* at rest, every panel mesh within its tolerance targets and every
+                                     kind's residual within its residual target */
 };
+
+/* The residual targets of "within tolerance", by the unit of a kind's residual (embra_residual_unit). */
+#define EMBRA_SOLVE_RESIDUAL_TARGET_M 1e-4   /* m (lengths, pins, contacts): 0.1 mm */
+#define EMBRA_SOLVE_RESIDUAL_TARGET_RAD 1e-3 /* rad (angles) */
+#define EMBRA_SOLVE_RESIDUAL_TARGET_M3 1e-9  /* m^3 (volumes): a cube of 1 mm */
+/* embra_solve_result.worst_metric for a kind's constraint residual above its target. */
+#define EMBRA_SOLVE_WORST_RESIDUAL 16
 
 #define EMBRA_SOLVE_DEF_VERSION 1
 typedef struct embra_solve_def {
@@ -799,7 +825,7 @@ typedef struct embra_solve_def {
 } embra_solve_def;
 
 enum {
-  EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE = 0, /* at rest, every panel mesh within its targets (or none) */
+  EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE = 0, /* at rest, every panel mesh and residual within its targets */
   EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE = 1, /* at rest, worst_* above its target: no solution nearby */
   EMBRA_SOLVE_OSCILLATING = 2,              /* still moving back and forth, with `period` */
   EMBRA_SOLVE_DRIFTING = 3                  /* still moving, no period */
@@ -810,8 +836,11 @@ typedef struct embra_solve_result {
   int32_t frames;           /* frames stepped by the call */
   double period;            /* s, EMBRA_SOLVE_OSCILLATING: the motion's period; else 0 */
   int32_t worst_metric;     /* the metric furthest above its target at the end (value / target), as
-                               EMBRA_PANEL_METRIC_PLANARITY, _CORNER_DISTANCE, _THICKNESS or _MITER;
-                               -1 when the world has no panel mesh */
+                               EMBRA_PANEL_METRIC_PLANARITY, _CORNER_DISTANCE, _THICKNESS or _MITER,
+                               or EMBRA_SOLVE_WORST_RESIDUAL (a kind's residual above its target:
+                               worst_element is the kind, EMBRA_CONSTRAINT_* or EMBRA_RESIDUAL_PINS /
+                               _CONTACTS; worst_body none); -1 when the world has no panel mesh and
+                               every residual is within its target */
   int32_t worst_layer;      /* 0 top, 1 bottom (planarity, corner distance); -1 otherwise */
   embra_body_id worst_body; /* the panel mesh */
   int32_t worst_element;    /* panel (planarity, corner distance, thickness) or joint (miter: edge of

@@ -994,6 +994,8 @@ class Builder {
   std::unique_ptr<World> build() {
     Settings s;
     if (doc_.contains("solver")) {
+      // "preset": "form_finding" (the schema's only value) starts from the preset; the keys override it.
+      if (doc_["solver"].contains("preset")) s = form_finding_settings();
       read_rows(kSolverRows, doc_["solver"], s);
     }
     auto world = guard("/solver", [&] { return std::make_unique<World>(s); });

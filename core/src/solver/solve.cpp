@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string_view>
 #include <vector>
 
 namespace embra {
@@ -82,6 +83,13 @@ double period_of(const std::vector<double>& s) {
 
 }  // namespace
 
+double residual_target(int kind) {
+  if (kind < 0 || kind >= kResidualKinds) invalid("residual_target: no such residual kind");
+  if (kind >= kKindCount) return kResidualTargetLength;  // pins, contacts: m
+  const std::string_view unit = kKinds[kind].unit;
+  return unit == "rad" ? kResidualTargetAngle : unit == "m^3" ? kResidualTargetVolume : kResidualTargetLength;
+}
+
 WorstMetric worst_metric(const World& world, const Tolerances& tolerances) {
   WorstMetric worst;
   double worst_ratio = -1.0;
@@ -104,6 +112,21 @@ WorstMetric worst_metric(const World& world, const Tolerances& tolerances) {
     consider(l, PanelMetric::corner_distance, 1, e.corner_distance_bottom, tolerances.planarity_distance.target);
     consider(l, PanelMetric::thickness, -1, e.thickness, tolerances.thickness.target);
     consider(l, PanelMetric::miter, -1, e.miter, tolerances.miter.target);
+  }
+  // The constraints' residuals, each kind in its own unit against its target: only above it, so that
+  // a world within tolerance names its panel metric closest to its target (or none).
+  const StepReport& report = world.report();
+  for (int k = 0; k < kResidualKinds; ++k) {
+    const KindResidual& r = report.by_kind[k];
+    const double target = residual_target(k);
+    if (r.count == 0 || !(r.max > target)) continue;
+    const double ratio = r.max / target;
+    if (ratio > worst_ratio) {
+      worst_ratio = ratio;
+      // The C numbering of the residual kinds: the constraint kinds, then -1 pins, -2 contacts.
+      const int32_t kind = k < kKindCount ? k : (k == kResidualPins ? -1 : -2);
+      worst = WorstMetric{kWorstResidual, Id{}, kind, -1, r.max, target};
+    }
   }
   return worst;
 }

@@ -228,8 +228,9 @@ void World::project_group(Group& g, double h, bool first) {
   else
     tether_runs_pass(*pool_, g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
-  // Chains in a group's first projection of a substep only (Settings::chain_solve): see chain_pass.
-  if (distance.chain_start.empty() || !first || settings_.realign_passes > 0)
+  // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
+  // passes, before the first of them): see chain_pass.
+  if (distance.chain_start.empty() || !first)
     project_pass(*pool_, k.distance, distance, inv_h2, x, w);
   else
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
@@ -520,7 +521,7 @@ void World::solve(double h, const StepControl& control) {
       for (int32_t slot : order_) {
         Group& g = groups_[slot];
         // The group's first projection in the substep takes the chain solve's turn (chain_pass).
-        for (int k = 0; k < g.desc.weight; ++k) project_group(g, h, it == 0 && k == 0);
+        for (int k = 0; k < g.desc.weight; ++k) project_group(g, h, pass == 0 && it == 0 && k == 0);
       }
       if (rho > 0.0) chebyshev_step(it, rho, omega);
     }

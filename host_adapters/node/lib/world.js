@@ -1035,7 +1035,13 @@ class World {
       outcome: SOLVE_OUTCOMES[r.outcome], settled: r.outcome <= capi.SOLVE_SETTLED_OUT_OF_TOLERANCE,
       frames: r.frames, period: r.period, worst: null,
     };
-    if (r.worst_metric >= 0) {
+    if (r.worst_metric === capi.SOLVE_WORST_RESIDUAL) {
+      // A kind's constraint residual above its target (embra.h EMBRA_SOLVE_RESIDUAL_TARGET_*).
+      out.worst = {
+        metric: 'residual', kind: lib.embra_residual_name(r.worst_element),
+        unit: lib.embra_residual_unit(r.worst_element), value: r.worst_value, target: r.worst_target,
+      };
+    } else if (r.worst_metric >= 0) {
       out.worst = {
         metric: METRIC_NAMES[r.worst_metric], body: new BodyId(r.worst_body.index, r.worst_body.generation),
         element: r.worst_element, layer: r.worst_layer === 0 ? 'top' : r.worst_layer === 1 ? 'bottom' : null,

@@ -965,9 +965,11 @@ class World:
 class Solved:
     """What World.solve found. outcome: "settled_within_tolerance", "settled_out_of_tolerance",
     "oscillating" or "drifting"; frames: stepped by the call; period: s, for an oscillation (else 0);
-    worst: None without a panel mesh, else a dict of the metric furthest above its target (value /
-    target): metric (a PANEL_METRICS name), body (BodyId), element (panel, or joint for "miter"), layer
-    ("top", "bottom" or None), value and target (1 - n1.n2 for planarity, else m)."""
+    worst: None without a panel mesh (and every residual within its target), else a dict of the metric
+    furthest above its target (value / target): metric (a PANEL_METRICS name), body (BodyId), element
+    (panel, or joint for "miter"), layer ("top", "bottom" or None), value and target (1 - n1.n2 for
+    planarity, else m); or, for a kind's constraint residual above its target (embra.h
+    EMBRA_SOLVE_RESIDUAL_TARGET_*), metric "residual", kind (its name), unit, value and target."""
 
     def __init__(self, r):
         self.outcome = SOLVE_OUTCOMES[r.outcome]
@@ -975,7 +977,11 @@ class Solved:
         self.period = r.period
         self.settled = r.outcome <= _capi.SOLVE_SETTLED_OUT_OF_TOLERANCE
         self.worst = None
-        if r.worst_metric >= 0:
+        if r.worst_metric == _capi.SOLVE_WORST_RESIDUAL:
+            self.worst = {"metric": "residual", "kind": lib.embra_residual_name(r.worst_element).decode(),
+                          "unit": lib.embra_residual_unit(r.worst_element).decode(),
+                          "value": r.worst_value, "target": r.worst_target}
+        elif r.worst_metric >= 0:
             names = {v: k for k, v in PANEL_METRICS.items()}
             self.worst = {"metric": names[r.worst_metric], "body": BodyId(r.worst_body.index, r.worst_body.generation),
                           "element": r.worst_element, "layer": {0: "top", 1: "bottom"}.get(r.worst_layer),
@@ -985,7 +991,10 @@ class Solved:
         text = f"Solved({self.outcome}, frames={self.frames}"
         if self.outcome == "oscillating":
             text += f", period={self.period:.6g} s"
-        if self.worst is not None:
+        if self.worst is not None and self.worst["metric"] == "residual":
+            w = self.worst
+            text += f", worst={w['kind']} residual {w['value']:.3e} {w['unit']} (target {w['target']:.3e})"
+        elif self.worst is not None:
             w = self.worst
             layer = f" {w['layer']}" if w["layer"] else ""
             text += (f", worst={w['metric']} {w['value']:.3e} (target {w['target']:.3e}) at "

@@ -478,13 +478,15 @@ struct PanelLayout {
 /// "scalar". All give the same bits; the environment variable EMBRA_KERNELS forces one.
 const char* solver_kernels();
 
-/// The form-finding preset (embra_form_finding_solver_def): the defaults with dt 1/15 s, 1 substep,
-/// 1 iteration; for the shape a structure comes to rest in rather than the motion on the way.
+/// The form-finding preset (embra_form_finding_solver_def, which states what it reaches): the
+/// defaults with dt 1/15 s, 1 substep, 1 iteration and velocity damping 6/s; for the shape a
+/// structure comes to rest in rather than the motion on the way.
 inline Settings form_finding_settings() {
   Settings s;
   s.dt = 1.0 / 15.0;
   s.substeps = 1;
   s.iterations = 1;
+  s.damping = 6.0;
   return s;
 }
 
