@@ -25,9 +25,9 @@ namespace embra::io {
 
 namespace {
 
+#ifdef _WIN32
 const char* const kInvalidUtf8 = "is not valid UTF-8 (a path is UTF-8 text)";
 
-#ifdef _WIN32
 /// UTF-8 to UTF-16; false on bytes that are not UTF-8.
 bool widen(const std::string& utf8, std::wstring& out) {
   out.clear();
