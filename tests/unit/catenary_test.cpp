@@ -29,6 +29,7 @@
 // The bias is XPBD's, not the physics': XPBD drops the term g = M (x - x~) - grad C^T lambda
 // (Macklin et al. 2016, eq. 11). With Settings::realign_passes the solver restores it, and the
 // chain settles onto the exact discrete catenary directly (the last tests below).
+#include "discrete_catenary.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -46,42 +47,10 @@ constexpr double kMass = 0.1;
 constexpr double kG = 9.81;
 const Vec3 kLeft(-0.5, 0.0, 0.0);  // centred on the origin: the coordinates' rounding is smallest there
 
-struct DiscreteCatenary {
-  std::vector<Vec3> nodes;  // N + 1, from the left pin to the right pin
-  double w_over_h = 0.0;    // W / H
-  std::vector<double> cos_phi;
-};
-
-/// The exact discrete catenary (see the file comment): r = W / H solves
-/// f(r) = sum_k l / sqrt(1 + r^2 c_k^2) - S = 0, c_k = (N + 1) / 2 - k; f falls from L - S > 0 at
-/// r = 0 towards -S, so bisection brackets the root, and is run to the last bit.
+/// The exact discrete catenary of this chain (discrete_catenary.hpp; the file comment derives it).
+using test::DiscreteCatenary;
 DiscreteCatenary exact_discrete(int n) {
-  const double l = kLength / n;
-  auto c = [n](int k) { return (n + 1) / 2.0 - k; };
-  auto f = [&](double r) {
-    double s = 0.0;
-    for (int k = 1; k <= n; ++k) s += l / std::sqrt(1.0 + r * r * c(k) * c(k));
-    return s - kSpan;
-  };
-  double lo = 0.0, hi = 1.0;
-  while (f(hi) > 0.0) hi *= 2.0;
-  for (int i = 0; i < 2000 && lo < hi; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    (f(mid) > 0.0 ? lo : hi) = mid;
-  }
-  DiscreteCatenary out;
-  out.w_over_h = 0.5 * (lo + hi);
-  const double r = out.w_over_h;
-  Vec3 x = kLeft;
-  out.nodes.push_back(x);
-  for (int k = 1; k <= n; ++k) {
-    const double q = 1.0 / std::sqrt(1.0 + r * r * c(k) * c(k));
-    out.cos_phi.push_back(q);
-    x += Vec3(l * q, 0.0, -l * r * c(k) * q);
-    out.nodes.push_back(x);
-  }
-  return out;
+  return test::discrete_catenary(n, kSpan, kLength, kLeft);
 }
 
 /// The continuous catenary y = a cosh(x / a) through the pins: L = 2 a sinh(b / a), b = S / 2.

@@ -4,8 +4,8 @@
 // (k = 1..N) makes the angle phi_k with the horizontal where tan(phi_k) = (W / H) ((N + 1) / 2 - k);
 // r = W / H follows from the span, sum_k l cos(phi_k) = S, by bisection (f(r) = sum_k l / sqrt(1 +
 // r^2 c_k^2) - S falls from L - S > 0 at r = 0 towards -S), run to the last bit. The nodes are the
-// running sums of (l cos(phi_k), -l sin(phi_k)) from the left pin. (catenary_test.cpp derives the
-// same and checks it against the continuous catenary.)
+// running sums of (l cos(phi_k), -l sin(phi_k)) from the left pin. (catenary_test.cpp checks it
+// against the continuous catenary.)
 #pragma once
 
 #include "embra/core/world.hpp"
@@ -16,8 +16,9 @@
 namespace embra::test {
 
 struct DiscreteCatenary {
-  std::vector<Vec3> nodes;  // N + 1, from the left pin to the right pin
-  double w_over_h = 0.0;    // W / H
+  std::vector<Vec3> nodes;      // N + 1, from the left pin to the right pin
+  double w_over_h = 0.0;        // W / H
+  std::vector<double> cos_phi;  // per link k = 1..N: cos(phi_k)
 };
 
 inline DiscreteCatenary discrete_catenary(int n, double span, double length, const Vec3& left) {
@@ -42,6 +43,7 @@ inline DiscreteCatenary discrete_catenary(int n, double span, double length, con
   out.nodes.push_back(x);
   for (int k = 1; k <= n; ++k) {
     const double q = 1.0 / std::sqrt(1.0 + r * r * c(k) * c(k));
+    out.cos_phi.push_back(q);
     x += Vec3(l * q, 0.0, -l * r * c(k) * q);
     out.nodes.push_back(x);
   }
