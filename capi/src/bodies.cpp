@@ -125,4 +125,24 @@ embra_status embra_body_get_material(const embra_world* world, embra_body_id bod
   });
 }
 
+embra_status embra_body_set_masses(embra_world* world, embra_body_id body, const double* masses, int32_t count) {
+  return guard("embra_body_set_masses", world, [&] {
+    need(masses, "masses");
+    need_count(count, "count");
+    world->world.set_masses(to_id(body), std::span<const double>(masses, static_cast<size_t>(count)));
+  });
+}
+
+embra_status embra_body_get_masses(const embra_world* world, embra_body_id body, double* out, int32_t capacity,
+                                   int32_t* out_count) {
+  return guard("embra_body_get_masses", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<double>& m = world->world.body(to_id(body)).masses;
+    const int32_t n = static_cast<int32_t>(m.size());
+    if (fits(out, capacity, n, "masses")) std::copy(m.begin(), m.end(), out);
+    *out_count = n;
+  });
+}
+
 }  // extern "C"

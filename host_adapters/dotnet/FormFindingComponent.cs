@@ -242,7 +242,7 @@ namespace Embra.Grasshopper
 
     /// <summary>Form finding on a mesh: anchors (movable), goals with weights, gravity; Reset rebuilds
     /// the world from the inputs, Run steps it every solution and schedules the next (Scheduler), and
-    /// changed gravity, compliances, damping and anchors act on the running world (ApplyChanges).
+    /// changed gravity, mass, compliances, damping and anchors act on the running world (ApplyChanges).
     /// Outputs the mesh on its moved vertices, the vertices and the error of every goal and anchor,
     /// for colouring by fabrication tolerance.</summary>
     public sealed class FormFindingComponent : GH_Component, IDisposable
@@ -268,6 +268,7 @@ namespace Embra.Grasshopper
         int[] anchors = new int[0];
         List<Goal> goals = new List<Goal>();
         double[] goalRest = new double[0];
+        double[] massShares = new double[0];  // each vertex's share of the total mass, as built
 
         public FormFindingComponent()
             : base("Embra Form Finding", "Embra", "Finds a form under goals, anchors and gravity (XPBD)", "Embra", "Solve") { }
@@ -434,6 +435,9 @@ namespace Embra.Grasshopper
                 faces = faceList;
                 gravityNow = gravity;
                 massNow = def.Material.Mass;
+                double[] built = next.GetBodyMasses(b.Id);
+                double total = built.Sum();
+                massShares = built.Select(m => m / total).ToArray();
                 stretchNow = def.Material.StretchCompliance;
                 bendNow = def.Material.BendCompliance;
                 dampingNow = solver.Damping;
@@ -446,11 +450,11 @@ namespace Embra.Grasshopper
         }
 
         /// <summary>Inputs changed since the last solution, applied to the running world without a
-        /// reset: gravity (embra_world_set_gravity); stretch and bend compliance and damping (the
-        /// body's material, embra_body_set_material); the anchors (pins destroyed and created, each
-        /// new one holding its vertex where it is now). The total mass, the mesh, the goals, the
-        /// substeps and iterations need a Reset (the C ABI has no per-particle mass edit): a changed
-        /// mass is reported on the component.</summary>
+        /// reset: gravity (embra_world_set_gravity); the total mass (embra_body_set_masses, each
+        /// vertex keeping its share of it, by area as at the build); stretch and bend compliance and
+        /// damping (the body's material, embra_body_set_material); the anchors (pins destroyed and
+        /// created, each new one holding its vertex where it is now). The mesh, the goals, the
+        /// substeps and iterations need a Reset.</summary>
         void ApplyChanges(IGH_DataAccess DA)
         {
             var gravity = Item(DA, InGravity, new Point3d(0, 0, -9.81));
@@ -472,8 +476,15 @@ namespace Embra.Grasshopper
                 bendNow = bend;
                 dampingNow = damping;
             }
-            if (Item(DA, InMass, 1.0) != massNow)
-                AddRuntimeMessage(GH_RuntimeMessageLevel.Remark, "Mass: applied at the next Reset");
+            double mass = Item(DA, InMass, 1.0);
+            if (mass != massNow)
+            {
+                // 0 means "density 1 kg/m^2" only when building; a running world needs the total.
+                if (!(mass > 0.0) || double.IsInfinity(mass))
+                    throw new ArgumentOutOfRangeException("Mass", mass, "Mass: a total mass > 0 kg is needed to change it without a Reset, got " + mass);
+                world.SetBodyMasses(body.Id, massShares.Select(share => share * mass).ToArray());
+                massNow = mass;
+            }
             var anchorList = new List<int>();
             DA.GetDataList(InAnchors, anchorList);
             if (!anchorList.SequenceEqual(anchors))

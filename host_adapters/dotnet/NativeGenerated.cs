@@ -558,6 +558,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_set_rest_scale(IntPtr world, BodyId body, double scale, double scaleU, double scaleV);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_set_material(IntPtr world, BodyId body, ref Material material);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_material(IntPtr world, BodyId body, out Material material);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_body_set_masses(IntPtr world, BodyId body, double[] masses, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_masses(IntPtr world, BodyId body, [Out] double[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_arity(int kind);
         [DllImport(Library, CallingConvention = C)] public static extern ConstraintDef embra_default_constraint_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_add(IntPtr world, ref ConstraintDef def);

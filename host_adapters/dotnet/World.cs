@@ -476,6 +476,25 @@ namespace Embra
             Call(w => Native.embra_body_set_material(w, body, ref material));
         }
 
+        /// <summary>The masses (kg) of a body's particles, one each, 0 = immovable (embra_body_get_masses).</summary>
+        public double[] GetBodyMasses(BodyId body)
+        {
+            int n = 0;
+            Call(w => Native.embra_body_get_masses(w, body, null, 0, out n));
+            var out_ = new double[n];
+            Call(w => Native.embra_body_get_masses(w, body, out_, out_.Length, out n));
+            return out_;
+        }
+
+        /// <summary>Sets the masses (kg) of a body's particles from the next step on, without a rebuild
+        /// (embra_body_set_masses): one per particle of the body, each 0 (immovable) or positive. A
+        /// hard-pinned particle keeps following its pin. Refused, changing nothing, for a wrong count or a
+        /// negative or non-finite mass.</summary>
+        public void SetBodyMasses(BodyId body, double[] masses)
+        {
+            Call(w => Native.embra_body_set_masses(w, body, masses, masses == null ? 0 : masses.Length));
+        }
+
         public void SetRestScale(BodyId body, double scale, double scaleU = 1.0, double scaleV = 1.0)
         {
             Call(w => Native.embra_body_set_rest_scale(w, body, scale, scaleU, scaleV));

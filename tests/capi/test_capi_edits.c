@@ -416,11 +416,324 @@ static void test_refusals(void) {
   embra_world_destroy(w);
 }
 
+/* A net of n x n particles 0.1 m apart at z = 0, edges along the grid (compliance c), the rest
+ * 0.01 kg each: its four corners immovable (mass 0), or with `flap` its first row (y = 0), so
+ * it swings down from that edge. */
+#define NET 9
+static embra_world* net_world(double c, int flap, embra_body_id* body) {
+  embra_world* w = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def b = embra_default_body_def();
+  double xyz[3 * NET * NET], masses[NET * NET];
+  int32_t edges[2 * 2 * NET * (NET - 1)], e = 0, i, j, first = 0;
+  for (j = 0; j < NET; ++j)
+    for (i = 0; i < NET; ++i) {
+      const int32_t k = j * NET + i;
+      xyz[3 * k] = 0.1 * i;
+      xyz[3 * k + 1] = 0.1 * j;
+      xyz[3 * k + 2] = 0.0;
+      masses[k] = 0.01;
+      if (i + 1 < NET) {
+        edges[e++] = k;
+        edges[e++] = k + 1;
+      }
+      if (j + 1 < NET) {
+        edges[e++] = k;
+        edges[e++] = k + NET;
+      }
+    }
+  if (flap)
+    for (i = 0; i < NET; ++i) masses[i] = 0.0;
+  else
+    masses[0] = masses[NET - 1] = masses[NET * (NET - 1)] = masses[NET * NET - 1] = 0.0;
+  s.damping = 10.0;
+  s.settle_speed = 1e-7;
+  CHECK_OK(embra_world_create(&w, &s));
+  b.vertex_count = NET * NET;
+  b.positions = xyz;
+  b.masses = masses;
+  b.edges = edges;
+  b.edge_count = e / 2;
+  b.material.stretch_compliance = c;
+  CHECK_OK(embra_body_create(w, &b, body, &first));
+  return w;
+}
+
+/* Steps until at rest: a compliant net's Gauss-Seidel static error keeps its residuals above the
+ * solve's targets, so "settled out of tolerance" is at rest too. */
+static void settle(embra_world* w) {
+  embra_solve_def d = embra_default_solve_def();
+  embra_solve_result r;
+  d.until = EMBRA_SOLVE_UNTIL_SETTLED;
+  d.max_frames = 3000;
+  CHECK_OK(embra_world_solve(w, &d, &r));
+  CHECK(r.outcome == EMBRA_SOLVE_SETTLED_WITHIN_TOLERANCE || r.outcome == EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE);
+}
+
+/* The lowest z of the particles whose x is below (side 0) or above (side 1) the middle column. */
+static double lowest_of_half(const embra_world* w, int side) {
+  double xyz[3 * NET * NET], low = 0.0;
+  int32_t i, j;
+  CHECK_OK(embra_world_get_positions(w, xyz, 3 * NET * NET, 0, NET * NET));
+  for (j = 0; j < NET; ++j)
+    for (i = side ? NET / 2 + 1 : 0; i < (side ? NET : NET / 2); ++i)
+      if (xyz[3 * (j * NET + i) + 2] < low) low = xyz[3 * (j * NET + i) + 2];
+  return low;
+}
+
+static int same_state(const embra_world* a, const embra_world* b, int32_t n) {
+  double pa[3 * NET * NET], pb[3 * NET * NET], va[3 * NET * NET], vb[3 * NET * NET];
+  CHECK_OK(embra_world_get_positions(a, pa, 3 * n, 0, n));
+  CHECK_OK(embra_world_get_positions(b, pb, 3 * n, 0, n));
+  CHECK_OK(embra_world_get_velocities(a, va, 3 * n, 0, n));
+  CHECK_OK(embra_world_get_velocities(b, vb, 3 * n, 0, n));
+  return memcmp(pa, pb, 3 * (size_t)n * sizeof(double)) == 0 && memcmp(va, vb, 3 * (size_t)n * sizeof(double)) == 0;
+}
+
+/* Masses set on a running world: a particle hung on a compliant link (0.002 m/N) settles m g c below
+ * its rest length for each new mass, and set immovable (0) it stays where it is; the edit moves
+ * nothing by itself; a world saved after the edit and loaded again steps on to the same bits. */
+static void test_masses_hang(void) {
+  embra_world *w = NULL, *loaded = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  embra_body_def b = embra_default_body_def();
+  embra_body_id body;
+  const double xyz[6] = {0, 0, 0, 0, 0, -1}, masses[2] = {0.0, 1.0};
+  const int32_t edge[2] = {0, 1};
+  double got[2] = {-1, -1}, heavier[2] = {0.0, 3.5}, still[2] = {0.0, 0.0}, before[6], after[6];
+  int32_t first = 0, n = 0, k;
+  char* saved;
+  s.damping = 6.0;
+  s.settle_speed = 1e-7;
+  CHECK_OK(embra_world_create(&w, &s));
+  b.vertex_count = 2;
+  b.positions = xyz;
+  b.masses = masses;
+  b.edges = edge;
+  b.edge_count = 1;
+  b.material.stretch_compliance = 2e-3;
+  CHECK_OK(embra_body_create(w, &b, &body, &first));
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, 1.0 * kG * 2e-3, 1e-6);
+
+  CHECK_OK(embra_body_get_masses(w, body, NULL, 0, &n));
+  CHECK_INT(n, 2);
+  CHECK_OK(embra_world_get_positions(w, before, 6, 0, 2));
+  CHECK_OK(embra_body_set_masses(w, body, heavier, 2));
+  CHECK_OK(embra_world_get_positions(w, after, 6, 0, 2));
+  CHECK(memcmp(before, after, sizeof before) == 0); /* the edit moves nothing */
+  CHECK_OK(embra_body_get_masses(w, body, got, 2, &n));
+  CHECK_SAME_DOUBLE(got[0], 0.0);
+  CHECK_SAME_DOUBLE(got[1], 3.5);
+
+  /* Saved right after the edit: the loaded world steps as the edited one does, bit for bit. */
+  saved = capi_test_save(w);
+  CHECK(saved != NULL);
+  CHECK_OK(embra_world_load_json(&loaded, saved, (int64_t)strlen(saved), "."));
+  free(saved);
+  for (k = 0; k < 50; ++k) {
+    CHECK_OK(embra_world_step(w));
+    CHECK_OK(embra_world_step(loaded));
+  }
+  CHECK(same_bits(w, loaded));
+  embra_world_destroy(loaded);
+
+  solve_to_rest(w);
+  CHECK_NEAR(-z_of(w, first + 1) - 1.0, 3.5 * kG * 2e-3, 1e-6);
+  printf("  hung on 2e-3 m/N: 3.5 kg settles %.9f m below its rest length (m g c = %.9f m)\n",
+         -z_of(w, first + 1) - 1.0, 3.5 * kG * 2e-3);
+
+  /* Both immovable: the bob stays where it is, however long the world steps. */
+  CHECK_OK(embra_world_get_positions(w, before, 6, 0, 2));
+  CHECK_OK(embra_body_set_masses(w, body, still, 2));
+  for (k = 0; k < 30; ++k) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_positions(w, after, 6, 0, 2));
+  CHECK(memcmp(before, after, sizeof before) == 0);
+  embra_world_destroy(w);
+}
+
+/* A uniform scale of every mass changes no motion: gravity accelerates every mass alike and a hard
+ * link divides its correction by the masses' ratio. A pendulum (a bob on a 1 m link from an
+ * immovable pivot, started level) and a free particle beside it, their masses times 7 after 10
+ * frames, follow the unscaled world's paths for 200 frames (to 1e-9 m: only rounding differs). */
+static void test_masses_uniform_scale(void) {
+  embra_world* w[2] = {NULL, NULL};
+  embra_body_id body[2];
+  const double xyz[9] = {0, 0, 0, 1, 0, 0, 3, 0, 0}, masses[3] = {0.0, 0.4, 0.25};
+  const double scaled[3] = {0.0, 7 * 0.4, 7 * 0.25};
+  const int32_t edge[2] = {0, 1};
+  double pa[9], pb[9], worst = 0.0, fall;
+  int32_t v, k, i;
+  for (v = 0; v < 2; ++v) {
+    embra_solver_def s = embra_default_solver_def();
+    embra_body_def b = embra_default_body_def();
+    s.tethers = 0;
+    CHECK_OK(embra_world_create(&w[v], &s));
+    b.vertex_count = 3;
+    b.positions = xyz;
+    b.masses = masses;
+    b.edges = edge;
+    b.edge_count = 1;
+    CHECK_OK(embra_body_create(w[v], &b, &body[v], NULL));
+  }
+  for (k = 0; k < 210; ++k) {
+    if (k == 10) CHECK_OK(embra_body_set_masses(w[1], body[1], scaled, 3));
+    CHECK_OK(embra_world_step(w[0]));
+    CHECK_OK(embra_world_step(w[1]));
+    CHECK_OK(embra_world_get_positions(w[0], pa, 9, 0, 3));
+    CHECK_OK(embra_world_get_positions(w[1], pb, 9, 0, 3));
+    for (i = 0; i < 9; ++i)
+      if (fabs(pa[i] - pb[i]) > worst) worst = fabs(pa[i] - pb[i]);
+  }
+  CHECK_NEAR(worst, 0.0, 1e-9);
+  fall = -pb[8];
+  CHECK_NEAR(hypot(pb[3], pb[5]), 1.0, 1e-6); /* the link held */
+  CHECK(fall > 3.0);                          /* 3.5 s of free fall: g t^2 / 2 = 60 m */
+  printf("  masses x7: paths within %.3g m of the unscaled world's over 210 frames\n", worst);
+  embra_world_destroy(w[0]);
+  embra_world_destroy(w[1]);
+}
+
+/* A net held at its corners on compliant edges sags symmetrically; its right half made four times
+ * heavier (without a rebuild), that half sags lower than the left, and lower than before. */
+static void test_masses_heavier_half(void) {
+  embra_body_id body;
+  embra_world* w = net_world(0.02, 0, &body);
+  double masses[NET * NET], left, right, left0, right0;
+  int32_t n = 0, i, j;
+  settle(w);
+  left0 = lowest_of_half(w, 0);
+  right0 = lowest_of_half(w, 1);
+  CHECK_NEAR(left0, right0, 1e-4); /* Gauss-Seidel's order is not symmetric: 1.1e-5 m apart */
+  CHECK_OK(embra_body_get_masses(w, body, masses, NET * NET, &n));
+  CHECK_INT(n, NET * NET);
+  for (j = 0; j < NET; ++j)
+    for (i = NET / 2 + 1; i < NET; ++i) masses[j * NET + i] *= 4.0;
+  CHECK_OK(embra_body_set_masses(w, body, masses, NET * NET));
+  settle(w);
+  left = lowest_of_half(w, 0);
+  right = lowest_of_half(w, 1);
+  CHECK(right < left - 0.01);
+  CHECK(right < right0 - 0.01);
+  printf("  net: both halves %.4f m; right half x4: left %.4f m, right %.4f m\n", left0, left, right);
+  embra_world_destroy(w);
+}
+
+/* An inextensible flap hung from its first row: its centre made immovable (0) stays put and
+ * anchors it (automatic tethers attach to it), made movable again it falls; each time the saved and
+ * reloaded world steps to the same bits; a hard-pinned particle given a mass keeps following its
+ * pin, and falls once the pin is gone. */
+static void test_masses_anchors_and_pins(void) {
+  embra_body_id body;
+  embra_world *w = net_world(0.0, 1, &body), *loaded = NULL;
+  embra_pin_def pd = embra_default_pin_def();
+  embra_pin_id pin;
+  double masses[NET * NET], xyz[3 * NET * NET], z_pinned;
+  const int32_t centre = (NET / 2) * NET + NET / 2, held = NET * (NET - 1) + 1;
+  int32_t n = 0, k, round;
+  char* saved;
+  CHECK_OK(embra_body_get_masses(w, body, masses, NET * NET, &n));
+  pd.particle = held;
+  pd.target[0] = 0.1;
+  pd.target[1] = 0.1 * (NET - 1);
+  CHECK_OK(embra_pin_create(w, &pd, &pin));
+  for (round = 0; round < 2; ++round) {
+    masses[centre] = round == 0 ? 0.0 : 0.05; /* the centre an anchor, then free again */
+    masses[held] = round == 0 ? 0.5 : 0.01;
+    CHECK_OK(embra_body_set_masses(w, body, masses, NET * NET));
+    saved = capi_test_save(w);
+    CHECK(saved != NULL);
+    CHECK_OK(embra_world_load_json(&loaded, saved, (int64_t)strlen(saved), "."));
+    free(saved);
+    for (k = 0; k < 60; ++k) {
+      CHECK_OK(embra_world_step(w));
+      CHECK_OK(embra_world_step(loaded));
+    }
+    CAPI_CONTEXT("round %d", round);
+    CHECK(same_state(w, loaded, NET * NET));
+    embra_world_destroy(loaded);
+    loaded = NULL;
+    CHECK_OK(embra_world_get_positions(w, xyz, 3 * NET * NET, 0, NET * NET));
+    CHECK_SAME_DOUBLE(xyz[3 * held + 2], 0.0); /* hard-pinned whatever its mass */
+    if (round == 0) CHECK_SAME_DOUBLE(xyz[3 * centre + 2], 0.0);
+    if (round == 1) CHECK(xyz[3 * centre + 2] < -0.05);
+    printf("  flap, centre %s: centre at z = %.4f m after 60 frames\n", round == 0 ? "immovable" : "0.05 kg",
+           xyz[3 * centre + 2]);
+  }
+  CAPI_CONTEXT("%s", "");
+  CHECK_OK(embra_pin_destroy(w, pin));
+  for (k = 0; k < 30; ++k) CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_get_positions(w, xyz, 3 * NET * NET, 0, NET * NET));
+  z_pinned = xyz[3 * held + 2];
+  CHECK(z_pinned < -0.01);
+  embra_world_destroy(w);
+}
+
+/* Every refusal of embra_body_set_masses and embra_body_get_masses changes nothing: the saved scene
+ * is the same text before and after. */
+static void test_masses_refusals(void) {
+  embra_body_id body, stale;
+  embra_world *w = net_world(1e-3, 0, &body), *other = NULL;
+  embra_solver_def s = embra_default_solver_def();
+  double masses[NET * NET], bad[NET * NET], small[3] = {-7.0, -7.0, -7.0};
+  const double wrong[] = {-1.0, NAN, INFINITY, -INFINITY, 1e-310, 2e300, -1e-300};
+  int32_t n = 0, i, k;
+  char *before, *after;
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_body_get_masses(w, body, masses, NET * NET, &n));
+  before = capi_test_save(w);
+
+  CHECK_STATUS(embra_body_set_masses(NULL, body, masses, NET * NET), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_set_masses(w, body, NULL, NET * NET), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "masses");
+  CHECK_STATUS(embra_body_set_masses(w, body, masses, NET * NET - 1), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "81 particles");
+  CHECK_STATUS(embra_body_set_masses(w, body, masses, NET * NET + 1), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_set_masses(w, body, masses, -1), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_set_masses(w, body, masses, 0), EMBRA_ERROR_INVALID_ARGUMENT);
+  stale = body;
+  stale.index += 3;
+  CHECK_STATUS(embra_body_set_masses(w, stale, masses, NET * NET), EMBRA_ERROR_STALE_ID);
+  stale = body;
+  stale.generation += 1;
+  CHECK_STATUS(embra_body_set_masses(w, stale, masses, NET * NET), EMBRA_ERROR_STALE_ID);
+  CHECK_OK(embra_world_create(&other, &s));
+  CHECK_STATUS(embra_body_set_masses(other, body, masses, NET * NET), EMBRA_ERROR_STALE_ID);
+  embra_world_destroy(other);
+  for (k = 0; k < (int32_t)(sizeof wrong / sizeof wrong[0]); ++k)
+    for (i = 0; i < NET * NET; i += NET * NET - 1) { /* the first and the last particle */
+      memcpy(bad, masses, sizeof bad);
+      bad[i] = wrong[k];
+      CAPI_CONTEXT("masses[%d] = %g", i, wrong[k]);
+      CHECK_STATUS(embra_body_set_masses(w, body, bad, NET * NET), EMBRA_ERROR_INVALID_ARGUMENT);
+      CHECK_CONTAINS(embra_last_error_message(), "mass");
+    }
+  CAPI_CONTEXT("%s", "");
+  CHECK_STATUS(embra_body_get_masses(w, body, small, 3, &n), EMBRA_ERROR_BUFFER_TOO_SMALL);
+  CHECK_SAME_DOUBLE(small[0], -7.0); /* nothing written */
+  CHECK_SAME_DOUBLE(small[2], -7.0);
+  CHECK_STATUS(embra_body_get_masses(w, body, NULL, 0, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_get_masses(w, body, NULL, 5, &n), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_get_masses(w, body, masses, -1, &n), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_body_get_masses(NULL, body, masses, NET * NET, &n), EMBRA_ERROR_INVALID_ARGUMENT);
+
+  after = capi_test_save(w);
+  CHECK(before && after && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+  embra_world_destroy(w);
+}
+
 int main(void) {
   RUN(test_compliance_and_rest);
   RUN(test_disable_move_remove);
   RUN(test_material);
   RUN(test_field);
   RUN(test_refusals);
+  RUN(test_masses_hang);
+  RUN(test_masses_uniform_scale);
+  RUN(test_masses_heavier_half);
+  RUN(test_masses_anchors_and_pins);
+  RUN(test_masses_refusals);
   return capi_test_finish();
 }

@@ -1204,8 +1204,20 @@ void Session::op_edit() {
       call("embra_group_get_enabled" + at + ")", false, [&] { return embra_group_get_enabled(world_, g, &enabled); });
       break;
     }
-    case 6:
-    case 7: {  // a body's material: its own, one setting changed
+    case 7: {  // a body's masses: its own, one changed, at its count or another
+      const embra_body_id b = pick_id(in_, bodies_);
+      int32_t n = 0;
+      embra_body_get_masses(world_, b, nullptr, 0, &n);
+      std::vector<double> masses(static_cast<size_t>(n) + 2, 0.0);
+      embra_body_get_masses(world_, b, masses.data(), n, &n);
+      if (n > 0) masses[in_.u16() % static_cast<size_t>(n)] = in_.chance(2) ? 0.0 : in_.value();
+      const int32_t count = in_.chance(8) ? n + static_cast<int32_t>(in_.u8() % 3) - 1 : n;
+      const double* p = in_.chance(32) ? nullptr : masses.data();
+      call("embra_body_set_masses(count " + std::to_string(count) + ")", true,
+           [&] { return embra_body_set_masses(world_, b, p, count); });
+      break;
+    }
+    case 6: {  // a body's material: its own, one setting changed
       const embra_body_id b = pick_id(in_, bodies_);
       embra_material m = embra_default_material();
       embra_body_get_material(world_, b, &m);

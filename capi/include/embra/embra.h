@@ -412,6 +412,26 @@ EMBRA_API embra_status embra_body_set_rest_scale(embra_world* world, embra_body_
 EMBRA_API embra_status embra_body_set_material(embra_world* world, embra_body_id body, const embra_material* material);
 EMBRA_API embra_status embra_body_get_material(const embra_world* world, embra_body_id body,
                                                embra_material* out_material);
+/* The masses (kg) of the body's particles, from the next step on, without a rebuild: masses[k] is
+ * particle first + k's (embra_body_get_particles), and count must be the body's particle count.
+ * Each mass is 0 or in [EMBRA_MIN_POSITIVE, EMBRA_MAX_ABS_VALUE]: 0 makes the particle immovable,
+ * as a 0 in embra_body_def.masses does (it stays where it is, automatic tethers attach to it); a
+ * positive mass makes an immovable particle free again. A hard-pinned particle keeps following its
+ * pin, its new mass applying once the pin is destroyed; a soft pin, gravity, loads, fields and
+ * every constraint act on the new mass (a heavier particle hangs lower on a compliant link).
+ * Positions and velocities stay as they were. The body's material (its mass and density) is not
+ * changed: it records how the creation masses were computed. Saved by embra_world_save_json as
+ * the body's mesh masses, so a saved and reloaded world steps the same. Refused, changing nothing,
+ * for a NULL masses, a count that is not the body's, or any mass negative, non-finite or in
+ * (0, EMBRA_MIN_POSITIVE). */
+EMBRA_API embra_status embra_body_set_masses(embra_world* world, embra_body_id body, const double* masses,
+                                             int32_t count);
+/* The masses (kg) of the body's particles as embra_body_set_masses takes them (0 = immovable), one
+ * per particle, whether given at creation, computed from the material or set since. Two-call
+ * pattern: out NULL and capacity 0 only write *out_count; capacity in doubles; too small a buffer
+ * is EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. */
+EMBRA_API embra_status embra_body_get_masses(const embra_world* world, embra_body_id body, double* out,
+                                             int32_t capacity, int32_t* out_count);
 
 /* ---------------------------------------------------------------------------------------------
  * Constraints, one at a time or in bulk

@@ -468,6 +468,28 @@ void World::set_material(Id id, const Material& m) {
   solver_dirty_ = true;  // the compliances, and whether its stretch is inextensible (automatic tethers)
 }
 
+void World::set_masses(Id id, std::span<const double> masses) {
+  body(id);
+  BodyInfo& b = bodies_[id.index];
+  if (static_cast<int64_t>(masses.size()) != b.particle_count)
+    invalid("masses has " + std::to_string(masses.size()) + " values; the body has " +
+            std::to_string(b.particle_count) + " particles (one mass each)");
+  for (size_t i = 0; i < masses.size(); ++i) {
+    const double m = masses[i];
+    if (!(m == 0.0 || (m >= limits::kMinPositive && m <= limits::kMaxAbsValue)))
+      check_zero_or_positive(m, "mass " + std::to_string(i) + " (kg, 0 = immovable)");  // throws with why
+  }
+  b.masses.assign(masses.begin(), masses.end());  // saved with the body, so a reloaded world agrees
+  for (int32_t k = 0; k < b.particle_count; ++k) {
+    const int32_t i = b.first_particle + k;
+    inv_mass_[i] = masses[static_cast<size_t>(k)] > 0.0 ? 1.0 / masses[static_cast<size_t>(k)] : 0.0;
+    w_[i] = hard_pin_of_[i] >= 0 ? 0.0 : inv_mass_[i];
+  }
+  // Anchors (immovable particles) decide the automatic tethers and the colouring: rebuilt as a
+  // loaded world builds them.
+  solver_dirty_ = true;
+}
+
 // --- bodies ------------------------------------------------------------------------------------
 
 Id World::create_body(const BodyDesc& d) {

@@ -503,6 +503,8 @@ const PROTOTYPES = {
   embra_body_set_rest_scale: 'embra_status embra_body_set_rest_scale(embra_world *world, embra_body_id body, double scale, double scale_u, double scale_v)',
   embra_body_set_material: 'embra_status embra_body_set_material(embra_world *world, embra_body_id body, const embra_material *material)',
   embra_body_get_material: 'embra_status embra_body_get_material(const embra_world *world, embra_body_id body, _Out_ embra_material *out_material)',
+  embra_body_set_masses: 'embra_status embra_body_set_masses(embra_world *world, embra_body_id body, const double *masses, int32_t count)',
+  embra_body_get_masses: 'embra_status embra_body_get_masses(const embra_world *world, embra_body_id body, double *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_constraint_arity: 'int32_t embra_constraint_arity(embra_constraint_kind kind)',
   embra_default_constraint_def: 'embra_constraint_def embra_default_constraint_def(void)',
   embra_constraint_add: 'embra_status embra_constraint_add(embra_world *world, const embra_constraint_def *def)',

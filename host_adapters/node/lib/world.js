@@ -502,6 +502,28 @@ class World {
     this.#call('embra_body_set_material', toId(body, BodyId, 'body'), m);
   }
 
+  /** The masses (kg) of a body's particles, one each, 0 = immovable (embra_body_get_masses): a Float64Array. */
+  bodyMasses(body) {
+    const b = toId(body, BodyId, 'body');
+    const n = [0];
+    this.#call('embra_body_get_masses', b, null, 0, n);
+    const out = new Float64Array(n[0]);
+    this.#call('embra_body_get_masses', b, out, out.length, n);
+    return out;
+  }
+
+  /**
+   * Sets the masses (kg) of a body's particles from the next step on, without a rebuild
+   * (embra_body_set_masses): one per particle of the body, each 0 (immovable) or positive. A
+   * hard-pinned particle keeps following its pin. Refused, changing nothing, for a wrong count or a
+   * negative or non-finite mass.
+   */
+  setBodyMasses(body, masses) {
+    const data = buf.doublesIn(masses, 'masses');
+    if (data === null) throw new TypeError('masses: required');
+    this.#call('embra_body_set_masses', toId(body, BodyId, 'body'), data, data.length);
+  }
+
   setRestScale(body, scale = 1.0, scaleU = 1.0, scaleV = 1.0) {
     this.#call('embra_body_set_rest_scale', toId(body, BodyId, 'body'), buf.number(scale, 'scale'),
       buf.number(scaleU, 'scaleU'), buf.number(scaleV, 'scaleV'));

@@ -15,14 +15,16 @@ const FIELDS = ['planarity', 'thickness', 'miter'];
  * A drag is a soft pin in the default group, whose soft pins are projected before its welds and
  * panel constraints in every pass, so the panels correct last. Its compliance and its reach (the
  * drag pin's target is kept within DRAG_REACH times the scene's diagonal of the particle, however far
- * the cursor goes) bound its pull: on the POQ drape (docs/live-protocol.md) the panels stay within
- * their tolerances' max during a 150 px drag.
+ * the cursor goes) bound its pull, and its speed (DRAG_SPEED) the momentum the mesh carries into its
+ * panels when it is pulled taut: on the POQ drapes, 4 x 4 and 32 x 32 panels (docs/live-protocol.md),
+ * the panels stay within their tolerances' max during a drag.
  */
 const DRAG_COMPLIANCE = 2e-5; // m/N
 const DRAG_REACH = 0.1; // of the scene's diagonal at load
 const DRAG_BACK_OFF = 0.3; // of a tolerance's max: above it the drags' reach halves each frame
 const DRAG_EASE = 0.2; // of a tolerance's max: below it the drags' reach grows back
 const DRAG_GAIN_START = 0.05; // a new drag's reach, of DRAG_REACH: it grows from there
+const DRAG_SPEED = 0.15; // of the scene's diagonal per second, times the reach's gain: the drag target's top speed
 const MAGIC = 0x464d4245; // 'EBMF' little-endian
 /**
  * A page's coordinates (drag targets, collider positions) are places in the scene: within its
@@ -192,6 +194,7 @@ class Session {
     }
     const diagonal = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     this.dragReach = DRAG_REACH * Math.max(diagonal, 1e-9);
+    this.dragStep = DRAG_SPEED * Math.max(diagonal, 1e-9) * this.dt; // per frame
     const reach = WORKSPACE_REACH * Math.max(diagonal, 1);
     return { min: lo.map((v) => v - reach), max: hi.map((v) => v + reach) };
   }
@@ -234,14 +237,29 @@ class Session {
     this.record = record;
   }
 
-  /** Moves a drag pin's target toward the cursor, at most dragReach from its particle. */
+  /**
+   * Moves a drag pin's target (its lead) toward the cursor: by at most dragStep times dragGain a
+   * frame, and never farther than the reach (dragReach times dragGain) from its particle. The speed
+   * limit is what keeps a fine mesh within tolerance: a mesh dragged fast until it is pulled taut
+   * stops against its panel constraints with the momentum it had, and the impact, not the pull,
+   * opens the panels (on the 32 x 32 drape, docs/live-protocol.md); a back-off (#adaptDrag) slows
+   * the lead and shortens the reach at once.
+   */
   #leadDrag(drag) {
     const at = this.positions.subarray(3 * drag.particle, 3 * drag.particle + 3);
-    const d = drag.target.map((v, k) => v - at[k]);
-    const length = Math.hypot(...d);
+    const within = (p, limit) => {
+      const d = p.map((v, k) => v - at[k]);
+      const length = Math.hypot(...d);
+      return length > limit ? d.map((v, k) => at[k] + (limit / length) * v) : p;
+    };
     const reach = this.dragReach * this.dragGain;
-    const f = length > reach ? reach / length : 1;
-    this.world.setPinTarget(drag.pin, d.map((v, k) => at[k] + f * v));
+    const wanted = within(drag.target, reach);
+    const move = wanted.map((v, k) => v - drag.lead[k]);
+    const length = Math.hypot(...move);
+    const step = this.dragStep * this.dragGain;
+    const f = length > step ? step / length : 1;
+    drag.lead = within(drag.lead.map((v, k) => v + f * move[k]), reach);
+    this.world.setPinTarget(drag.pin, drag.lead);
   }
 
   /**
@@ -379,7 +397,7 @@ class Session {
         const target = this.#point(msg.target, 'target');
         const pin = w.createPin(msg.particle, target, { compliance: DRAG_COMPLIANCE });
         this.releaseDrag(page);
-        this.drags.set(page, { pin, particle: msg.particle, target: [...target] });
+        this.drags.set(page, { pin, particle: msg.particle, target: [...target], lead: [...target] });
         this.dragGain = Math.min(this.dragGain, DRAG_GAIN_START);
         return {};
       }

@@ -605,6 +605,8 @@ PROTOTYPES = {
     "embra_body_set_rest_scale": (c_int32, [c_void_p, BodyId, c_double, c_double, c_double]),
     "embra_body_set_material": (c_int32, [c_void_p, BodyId, POINTER(Material)]),
     "embra_body_get_material": (c_int32, [c_void_p, BodyId, POINTER(Material)]),
+    "embra_body_set_masses": (c_int32, [c_void_p, BodyId, POINTER(c_double), c_int32]),
+    "embra_body_get_masses": (c_int32, [c_void_p, BodyId, POINTER(c_double), c_int32, POINTER(c_int32)]),
     "embra_constraint_arity": (c_int32, [c_int32]),
     "embra_default_constraint_def": (ConstraintDef, []),
     "embra_constraint_add": (c_int32, [c_void_p, POINTER(ConstraintDef)]),

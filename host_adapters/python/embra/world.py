@@ -402,6 +402,29 @@ class World:
         _fill(m, fields, "Material")
         self._call("embra_body_set_material", _id(body, BodyId, "body"), byref(m))
 
+    def body_masses(self, body):
+        """The masses (kg) of a body's particles, one each, 0 = immovable (embra_body_get_masses):
+        numpy (n,) float64, or a flat array('d')."""
+        b = _id(body, BodyId, "body")
+        n = c_int32()
+        self._call("embra_body_get_masses", b, None, 0, byref(n))
+        out, pointer, capacity, keep = buf.doubles_out(n.value, None, "masses", width=1)
+        self._call("embra_body_get_masses", b, pointer, buf.int32(capacity, "capacity"), byref(n))
+        del keep
+        return out
+
+    def set_body_masses(self, body, masses):
+        """Sets the masses (kg) of a body's particles from the next step on, without a rebuild
+        (embra_body_set_masses): one per particle of the body, each 0 (immovable) or positive. A
+        hard-pinned particle keeps following its pin. Refused, changing nothing, for a wrong count or
+        a negative or non-finite mass."""
+        shape = getattr(masses, "shape", None)
+        if shape is not None and len(shape) != 1:
+            raise ValueError(f"masses: expected one mass per particle, a 1-D array, got shape {tuple(shape)}")
+        p, n, keep = buf.doubles_in(masses, "masses")
+        self._call("embra_body_set_masses", _id(body, BodyId, "body"), p, buf.int32(n, "count"))
+        del keep
+
     def set_rest_scale(self, body, scale=1.0, scale_u=1.0, scale_v=1.0):
         self._call("embra_body_set_rest_scale", _id(body, BodyId, "body"), float(scale), float(scale_u),
                    float(scale_v))

@@ -402,10 +402,50 @@ namespace Embra.Tests
                 Assert.AreEqual(5, da.GetList<double>(FormFindingComponent.OutAnchorErrors).Count);
                 Assert.AreEqual(1020, da.Get<int>(FormFindingComponent.OutFrame));
 
-                da.Set(FormFindingComponent.InMass, 1.0).Set(FormFindingComponent.InRun, false);
+                da.Set(FormFindingComponent.InMass, -1.0).Set(FormFindingComponent.InRun, false);
                 c.ComputeData(da);
                 Assert.AreEqual(1, c.RuntimeMessages.Count);
-                Assert.AreEqual(GH_RuntimeMessageLevel.Remark, c.RuntimeMessages[0].Key);
+                Assert.AreEqual(GH_RuntimeMessageLevel.Error, c.RuntimeMessages[0].Key);
+                StringAssert.Contains("Mass", c.RuntimeMessages[0].Value);
+            }
+        }
+
+        /// <summary>A changed total mass acts on the running world (no reset: the frame count goes on),
+        /// each vertex keeping its share of it: the square made twice as heavy while running sags deeper
+        /// and comes to rest where a square built with that mass does (the rest state depends on the
+        /// masses, not on the path).</summary>
+        [Test]
+        public void AChangedMassActsWithoutAReset()
+        {
+            var timer = new ManualScheduler();
+            using (var c = new FormFindingComponent { Scheduler = timer })
+            using (var twice = new FormFindingComponent())
+            {
+                var da = Inputs(Square());
+                c.ComputeData(da);
+                da.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                Run(c, da, timer, 400);
+                double light = Z(da, Centre);
+
+                da.Set(FormFindingComponent.InMass, 1.0);  // built with 0.5 kg
+                Run(c, da, timer, 900);
+                Assert.AreEqual(1300, da.Get<int>(FormFindingComponent.OutFrame));
+                var heavy = da.Get<IMeshLike>(FormFindingComponent.OutMesh).Vertices;
+
+                var reference = Inputs(Square()).Set(FormFindingComponent.InMass, 1.0);
+                var referenceTimer = new ManualScheduler();
+                twice.Scheduler = referenceTimer;
+                twice.ComputeData(reference);
+                reference.Set(FormFindingComponent.InReset, false).Set(FormFindingComponent.InRun, true);
+                Run(twice, reference, referenceTimer, 1300);
+                var expected = reference.Get<IMeshLike>(FormFindingComponent.OutMesh).Vertices;
+                double worst = 0.0;
+                for (int i = 0; i < N * N; ++i)
+                    worst = Math.Max(worst, Math.Abs(heavy[i].Z - expected[i].Z) + Math.Abs(heavy[i].X - expected[i].X) + Math.Abs(heavy[i].Y - expected[i].Y));
+                Console.WriteLine("centre: {0:E6} m at 0.5 kg, {1:E6} m at 1 kg (no reset), {2:E6} m built at 1 kg; worst vertex {3:E2} m apart",
+                                  light, heavy[Centre].Z, expected[Centre].Z, worst);
+                Assert.Less(heavy[Centre].Z, light - 1e-3);
+                Assert.Less(worst, 1e-6);
             }
         }
     }
@@ -2104,6 +2144,53 @@ namespace Embra.Tests
                 m.Mass = 5.0;
                 var e = Assert.Throws<EmbraArgumentException>(() => w.SetMaterial(b.Id, m));
                 StringAssert.Contains("mass", e.Message);
+            }
+        }
+
+        /// <summary>Masses set on a running world: a particle hung on a link of compliance 2e-3 m/N rests
+        /// m g c lower for the new mass; the saved scene differs at that mass only and the world loaded from
+        /// it steps on to the same bits; refusals (count, sign, non-finite, stale body) change nothing.</summary>
+        [Test]
+        public void MassesSetWithoutARebuild()
+        {
+            var s = Library.DefaultSolverDef();
+            s.Damping = 6.0;
+            s.SettleSpeed = 1e-7;
+            s.Tethers = 0;
+            using (var w = new World(s))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Material.StretchCompliance = 2e-3;
+                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, edges: new[] { 0, 1 }, masses: new[] { 0.0, 1.0 }, def: def);
+                Assert.AreEqual(1.0 * G * 2e-3, Drop(w, b), 1e-6);
+                CollectionAssert.AreEqual(new[] { 0.0, 1.0 }, w.GetBodyMasses(b.Id));
+                string before = w.SaveJson();
+                w.SetBodyMasses(b.Id, new[] { 0.0, 3.5 });
+                string saved = w.SaveJson();
+                Assert.IsTrue(OnlyOneNumberDiffers(before, saved));
+                CollectionAssert.AreEqual(new[] { 0.0, 3.5 }, w.GetBodyMasses(b.Id));
+                using (var loaded = World.LoadJson(saved))
+                {
+                    for (int k = 0; k < 40; ++k)
+                    {
+                        w.Step();
+                        loaded.Step();
+                    }
+                    Env.AssertBitIdentical(w.GetPositions(), loaded.GetPositions());
+                    Env.AssertBitIdentical(w.GetVelocities(), loaded.GetVelocities());
+                }
+                Assert.AreEqual(3.5 * G * 2e-3, Drop(w, b), 1e-6);
+
+                string text = w.SaveJson();
+                foreach (var bad in new[] { new[] { 0.0 }, new[] { 0.0, 1.0, 1.0 }, new[] { 0.0, -1.0 }, new[] { 0.0, double.NaN },
+                                            new[] { 0.0, double.PositiveInfinity }, new[] { 0.0, 1e-310 } })
+                    Assert.Throws<EmbraArgumentException>(() => w.SetBodyMasses(b.Id, bad));
+                var refused = Assert.Throws<EmbraArgumentException>(() => w.SetBodyMasses(b.Id, null));
+                StringAssert.Contains("masses", refused.Message);
+                var stale = b.Id;
+                stale.Index += 4;
+                Assert.Throws<EmbraInvalidOperationException>(() => w.SetBodyMasses(stale, new[] { 0.0, 1.0 }));
+                Assert.AreEqual(text, w.SaveJson());
             }
         }
 

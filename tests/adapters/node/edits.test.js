@@ -124,3 +124,54 @@ test('a vortex edited between steps pushes at s exp(-r^2/R^2) r/R', () => {
   assert.equal(w.saveJson(), before);
   w.close();
 });
+
+test('masses set without a rebuild: m g c for the new mass, saved and loaded to the same bits', () => {
+  const w = new embra.World({ settleSpeed: 1e-7, damping: 6.0, tethers: 0 });
+  const b = w.createBody([0, 0, 0, 0, 0, -1], { edges: [0, 1], masses: [0, 1], stretchCompliance: 2e-3 });
+  near(drop(w, b), 1.0 * G * 2e-3, 1e-6, 'm g c');
+  assert.deepEqual(Array.from(w.bodyMasses(b)), [0, 1]);
+  const before = JSON.parse(w.saveJson());
+  w.setBodyMasses(b, [0, 3.5]);
+  const saved = w.saveJson();
+  assert.deepEqual(differences(before, JSON.parse(saved)), ['/bodies/0/mesh/masses/1']);
+  assert.deepEqual(Array.from(w.bodyMasses(b)), [0, 3.5]);
+  const loaded = embra.World.loadJson(saved);
+  for (let k = 0; k < 40; k++) {
+    w.step();
+    loaded.step();
+  }
+  assert.deepEqual(Array.from(loaded.positions()), Array.from(w.positions()));
+  assert.deepEqual(Array.from(loaded.velocities()), Array.from(w.velocities()));
+  loaded.close();
+  near(drop(w, b), 3.5 * G * 2e-3, 1e-6, "m' g c");
+
+  const text = w.saveJson();
+  for (const bad of [[0], [0, 1, 1], [0, -1], [0, NaN], [0, Infinity], [0, 1e-310]]) {
+    assert.throws(() => w.setBodyMasses(b, bad), embra.InvalidArgumentError, JSON.stringify(bad));
+  }
+  assert.throws(() => w.setBodyMasses(b, null), TypeError);
+  assert.throws(() => w.setBodyMasses(b, [0, 'x']), TypeError);
+  assert.throws(() => w.setBodyMasses(new embra.BodyId(5, 1), [0, 1]), embra.StaleIdError);
+  assert.equal(w.saveJson(), text);
+  w.close();
+});
+
+test('a uniform mass scale changes no motion (a pendulum and a free particle, masses x7)', () => {
+  const worlds = [0, 1].map(() => {
+    const w = new embra.World({ tethers: 0 });
+    const b = w.createBody([0, 0, 0, 1, 0, 0, 3, 0, 0], { edges: [0, 1], masses: [0, 0.4, 0.25] });
+    return [w, b];
+  });
+  let worst = 0;
+  let p;
+  for (let frame = 0; frame < 210; frame++) {
+    if (frame === 10) worlds[1][0].setBodyMasses(worlds[1][1], new Float64Array([0, 2.8, 1.75]));
+    for (const [w] of worlds) w.step();
+    const a = worlds[0][0].positions();
+    p = worlds[1][0].positions();
+    for (let i = 0; i < a.length; i++) worst = Math.max(worst, Math.abs(a[i] - p[i]));
+  }
+  assert.ok(worst < 1e-9, `paths ${worst} m apart`);
+  near(Math.hypot(p[3], p[5]), 1.0, 1e-6, 'the link held');
+  for (const [w] of worlds) w.close();
+});

@@ -555,6 +555,11 @@ class World {
   /// and its particles' damping, thickness and friction. Its mass and density are refused: the
   /// particles' masses were set from them at creation.
   void set_material(Id body, const Material& material);
+  /// The masses (kg) of a body's particles, one per particle, from the next step on: 0 makes a
+  /// particle immovable (an anchor, as at creation), else each in [1e-300, 1e300]. A hard-pinned
+  /// particle keeps following its pin; its new mass applies once the pin is gone. The body's
+  /// material (mass, density) stays as it was: it says how the creation masses were computed.
+  void set_masses(Id body, std::span<const double> masses);
 
   // --- pins ------------------------------------------------------------------------------------
   Id create_pin(const PinDesc& desc);
