@@ -148,6 +148,12 @@ BENCHMARK(BM_ClothConfig)
     ->Args({128, 16, 1, 2, 2, 1, 0, 1})
     ->Args({128, 20, 1, 2, 2, 1, 0, 1})
     ->Args({128, 10, 1, 2, 4, 1, 0, 1})
+    // Substeps in proportion to n: the falling cloth's fold crosses as many rows per substep
+    // (docs/decisions.md, 2026-11-26: the 256 x 256 cloth needs substeps that grow with n).
+    ->Args({64, 8, 1, 2, 0, 0, 0, 1})
+    ->Args({128, 8, 1, 2, 0, 0, 0, 1})
+    ->Args({256, 24, 1, 2, 0, 0, 0, 1})
+    ->Args({256, 32, 1, 2, 0, 0, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(1);

@@ -211,7 +211,8 @@ typedef struct embra_solver_def {
                                   straight runs over the bodies' rest shapes (a cloth grid's rows,
                                   columns and diagonals; any mesh's straight edge runs, within about
                                   26 degrees a joint) or through particles where only two of a group's
-                                  distances meet (a cable or chain, at any angle) are projected a run
+                                  distances meet and no third joins their far ends (a cable or chain,
+                                  at any angle; not a triangle's corner) are projected a run
                                   at a time in the first iteration of every substep (with realignment
                                   passes, the cables only, before the first pass), each run's
                                   linearised XPBD system solved

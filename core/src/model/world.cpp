@@ -1091,7 +1091,8 @@ std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<c
 /// Lays a distance array's constraints end to end into chains (SolverArray::chain_start): from each
 /// constraint not yet in a chain, in array order, the chain grows at both ends: through a particle
 /// that two of the array's constraints meet at (a cable, a rope, a polyline of any shape) by the
-/// other one, whatever the angle; through any other particle by the constraint that continues it
+/// other one, whatever the angle, unless a third joins their far ends (a triangle's corner); through
+/// any other particle by the constraint that continues it
 /// straightest (over `rest`, the particles' rest positions), within about 26 degrees; never to a
 /// particle the chain already has. On a regular grid the chains are its rows, columns and
 /// diagonals; a cable is one chain however it curves; elsewhere they are whatever straight runs the
@@ -1111,14 +1112,25 @@ void build_chains(SolverArray& a, const std::vector<Vec3>& rest, bool straight_r
     for (int k = 0; k < 2; ++k) incident[fill[a.ids[2 * i + k]]++] = static_cast<int32_t>(i);
   std::vector<uint8_t> used(n, 0), in_chain(rest.size(), 0);
   auto other = [&](int32_t e, int32_t p) { return a.ids[2 * e] == p ? a.ids[2 * e + 1] : a.ids[2 * e]; };
+  // Whether the two constraints at `at` (a particle of two) end at particles joined by a third.
+  auto closes_triangle = [&](int32_t at) {
+    const int32_t q0 = other(incident[start[at]], at), q1 = other(incident[start[at] + 1], at);
+    for (int32_t j = start[q0]; j < start[q0 + 1]; ++j)
+      if (other(incident[j], q0) == q1) return true;
+    return false;
+  };
   // Grows the chain from `at` (reached from `from`), appending its constraints and particles.
   auto grow = [&](int32_t from, int32_t at, std::vector<int32_t>& edges, std::vector<int32_t>& parts) {
     for (;;) {
       const Vec3 dir = (rest[at] - rest[from]).normalized();
       int32_t best = -1;
       // Two constraints meet here: the chain goes on through the other, at any angle (the rest
-      // shape of a hand-built cable may be anything, even all at one point).
-      const bool through = start[at + 1] - start[at] == 2;
+      // shape of a hand-built cable may be anything, even all at one point), unless a third joins
+      // their far ends: then `at` is a triangle's corner (a cloth grid's free corner), and turning
+      // there joins a row to a column. (Measured on the 128 x 128 acceptance cloth: through the two
+      // free corners, 0.67 % max edge strain after 200 frames and 45 frames above 1 %; not, 0.54 %
+      // and 36.)
+      const bool through = start[at + 1] - start[at] == 2 && !closes_triangle(at);
       if (!through && !straight_runs) return;
       double best_cos = through ? -std::numeric_limits<double>::infinity() : kStraight;
       for (int32_t j = start[at]; j < start[at + 1]; ++j) {
