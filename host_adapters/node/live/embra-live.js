@@ -1,7 +1,7 @@
 #!/usr/bin/env node
 'use strict';
 // embra-live SCENE.json [--port P] [--host H] [--save-dir DIR] [--web DIR] [--allow-origin ORIGIN]...
-//                       [--max-connections N] [--keep-files N]
+//                       [--max-connections N] [--keep-files N] [--threads T]
 //
 // Loads a scene, steps it in real time and serves the page at http://H:P/ (loopback by default):
 // drag the mesh, move colliders, toggle gravity and pins, change group weights and rest scales,
@@ -14,11 +14,12 @@ const path = require('path');
 const { startServer, checkOrigin, DEFAULTS } = require('./server');
 
 const USAGE = 'usage: embra-live SCENE.json [--port P] [--host 127.0.0.1] [--save-dir DIR] [--web DIR]\n' +
-  '                  [--allow-origin ORIGIN]... [--max-connections N] [--keep-files N]\n' +
+  '                  [--allow-origin ORIGIN]... [--max-connections N] [--keep-files N] [--threads T]\n' +
   `  --save-dir DIR         the output folder of save and export (default: the current folder)\n` +
   `  --keep-files N         files of this scene kept there, the oldest deleted beyond (default ${DEFAULTS.keepFiles})\n` +
   `  --allow-origin ORIGIN  another origin whose pages may connect, e.g. http://192.168.1.5:8710 (repeatable)\n` +
-  `  --max-connections N    WebSocket connections at once (default ${DEFAULTS.maxConnections})\n`;
+  `  --max-connections N    WebSocket connections at once (default ${DEFAULTS.maxConnections})\n` +
+  `  --threads T            solver threads, 0 = one per core (default: the scene's solver.threads)\n`;
 
 function usage(message) {
   if (message) process.stderr.write(`embra-live: ${message}\n`);
@@ -54,6 +55,10 @@ function parse(argv) {
     }
     else if (a === '--max-connections') o.maxConnections = count(a, value());
     else if (a === '--keep-files') o.keepFiles = count(a, value());
+    else if (a === '--threads') {
+      o.threads = Number(value());
+      if (!Number.isInteger(o.threads) || o.threads < 0) usage('--threads must be an integer >= 0');
+    }
     else if (a === '-h' || a === '--help') usage();
     else if (a.startsWith('-')) usage(`unknown option ${a}`);
     else if (o.scene === undefined) o.scene = a;

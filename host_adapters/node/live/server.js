@@ -133,7 +133,8 @@ function positiveInteger(value, what) {
 
 /**
  * Starts a live server. options: {scene (path), host ('127.0.0.1'), port (0 = any free one),
- * web (folder of the built page), saveDir (the output folder), allowOrigins (extra origins a page
+ * web (folder of the built page), saveDir (the output folder), threads (solver threads, 0 = one per
+ * core; default the scene's solver.threads), allowOrigins (extra origins a page
  * may come from, e.g. ['http://192.168.1.5:8710']), log (a function taking a line; default
  * stderr), waitForPage (default true: no frame is stepped before the first page connects), and
  * the bounds of DEFAULTS}. Resolves to {url, port, session, limits, connections() (the
@@ -145,7 +146,7 @@ function startServer(options) {
   for (const key of Object.keys(DEFAULTS)) if (options[key] !== undefined) limits[key] = positiveInteger(options[key], key);
   if (limits.heavyMessageCost > limits.messageBurst) throw new RangeError('heavyMessageCost must be at most messageBurst');
   const extraOrigins = (options.allowOrigins || []).map(checkOrigin);
-  const session = new Session(options.scene, { saveDir: options.saveDir, keepFiles: limits.keepFiles });
+  const session = new Session(options.scene, { saveDir: options.saveDir, keepFiles: limits.keepFiles, threads: options.threads });
   const web = options.web || path.join(__dirname, '..', '..', 'web', 'dist');
   const serveStatic = staticHandler(web);
   let gate = { hosts: new Set(), origins: new Set() }; // set once the port is known

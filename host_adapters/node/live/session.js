@@ -84,6 +84,12 @@ class Session {
     this.saveDir = path.resolve(options.saveDir || '.');
     this.keepFiles = options.keepFiles ?? KEEP_FILES;
     if (!Number.isInteger(this.keepFiles) || this.keepFiles < 1) throw new RangeError('keepFiles must be an integer >= 1');
+    // Solver threads: the option (0: one per core), else the scene's own solver.threads. Not every
+    // core by default: where the page renders on the same machine, the solver's barriers wait on
+    // the browser (bench/README.md, the live page's frame rate).
+    this.threads = options.threads;
+    if (this.threads !== undefined && (!Number.isInteger(this.threads) || this.threads < 0))
+      throw new RangeError('threads must be an integer >= 0');
     this.stem = outputStem(this.scenePath);
     this.outputPattern = new RegExp(`^${this.stem}-(\\d{6,})-f\\d+\\.(${OUTPUT_KINDS.join('|')})$`);
     this.seq = 0;
@@ -94,6 +100,7 @@ class Session {
   /** Builds the world from the scene's text; a reset keeps the paused state. */
   #load(paused = false) {
     const world = World.loadJson(this.sceneText, path.dirname(this.scenePath));
+    if (this.threads !== undefined) world.setSolver({ threads: this.threads });
     if (this.world) this.world.close();
     this.world = world;
     this.paused = paused;

@@ -394,3 +394,24 @@ test('the bounds stated in docs/live-protocol.md are the server\'s', () => {
   assert.ok(reach, 'docs/live-protocol.md has no row for the workspace reach');
   assert.equal(Number(reach.split('|')[3].trim()), WORKSPACE_REACH);
 });
+
+test('a session steps on the scene\'s threads or the option\'s, to the same bits', () => {
+  const dir = tempDir('live-threads');
+  const own = new Session(scene, { saveDir: dir }); // poq_drape.json sets no solver.threads: 1
+  const all = new Session(scene, { saveDir: dir, threads: 0 });
+  assert.equal(own.world.solver.threads, 1);
+  assert.equal(all.world.solver.threads, 0);
+  const text = JSON.parse(fs.readFileSync(scene, 'utf8'));
+  text.solver.threads = 2;
+  const path2 = path.join(dir, 'poq_drape_two_threads.json');
+  fs.writeFileSync(path2, JSON.stringify(text));
+  const two = new Session(path2, { saveDir: dir });
+  assert.equal(two.world.solver.threads, 2); // the scene's own setting
+  for (let f = 0; f < 40; ++f) for (const s of [own, all, two]) assert.equal(s.step(), null);
+  const bytes = (s) => Buffer.from(s.world.positions().buffer);
+  assert.ok(bytes(all).equals(bytes(own)));
+  assert.ok(bytes(two).equals(bytes(own)));
+  for (const s of [own, all, two]) s.close();
+  assert.throws(() => new Session(scene, { saveDir: dir, threads: -1 }), RangeError);
+  assert.throws(() => new Session(scene, { saveDir: dir, threads: 1.5 }), RangeError);
+});
