@@ -87,11 +87,14 @@ test('a mouse drag on a panel corner pulls it; the streamed positions and the er
     await page.mouse.move(start.at.x, start.at.y - 10 * k);
     await page.waitForTimeout(30);
   }
-  // The drag lifts it as far as the panels stay within tolerance (tests/web/live_shape.test.mjs).
-  await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.05, [particle, start.z], { timeout: 30000 });
+  // The drag lifts it as far as the panels stay within tolerance, its lead limited in speed
+  // (tests/web/live_shape.test.mjs): 0.05-0.085 m over the Session API, less on a loaded machine
+  // (fewer frames stepped during the mouse's move; under 0.05 m in 30 s once), so 1 cm: the mesh at
+  // rest moves under 1 mm/s.
+  await page.waitForFunction(([i, z]) => embraView.positions[3 * i + 2] > z + 0.01, [particle, start.z], { timeout: 30000 });
   // The world itself moved (the page drew what the server streamed), read while the drag still holds
   // it: once released the corner falls back, and on a loaded machine the server may be frames ahead.
-  const rose = () => live.session.positions[3 * particle + 2] > serverZ + 0.05;
+  const rose = () => live.session.positions[3 * particle + 2] > serverZ + 0.01;
   for (let k = 0; k < 200 && !rose(); k++) await new Promise((resolve) => setTimeout(resolve, 50));
   assert.ok(rose(), `the world's particle at ${live.session.positions[3 * particle + 2]}, from ${serverZ}`);
   await page.mouse.up();
