@@ -35,24 +35,37 @@ static int only_one_number_differs(const char* a, const char* b) {
   return 1;
 }
 
-/* World holding particle `first` fixed at the origin and `first + 1` of mass `m` 1 m below it. */
-static embra_world* hanging_world(double damping, double m, int32_t* first) {
+/* World holding particle `first` fixed at the origin and `first + 1` of mass `m` 1 m below it, one
+ * body; with link_compliance >= 0 the body's one edge joins them, its generated stretch of that
+ * compliance (no automatic tethers). */
+static embra_world* pair_world(double damping, double m, double link_compliance, embra_body_id* body, int32_t* first) {
   embra_world* w = NULL;
   embra_solver_def s = embra_default_solver_def();
   embra_body_def b = embra_default_body_def();
-  embra_body_id body;
+  embra_body_id id;
   const double xyz[6] = {0, 0, 0, 0, 0, -1};
+  const int32_t edge[2] = {0, 1};
   double masses[2];
   masses[0] = 0.0;
   masses[1] = m;
   s.damping = damping;
   s.settle_speed = 1e-7; /* at rest: swinging less than 1e-7 / omega, a few nanometres */
+  if (link_compliance >= 0.0) s.tethers = 0;
   CHECK_OK(embra_world_create(&w, &s));
   b.vertex_count = 2;
   b.positions = xyz;
   b.masses = masses;
-  CHECK_OK(embra_body_create(w, &b, &body, first));
+  if (link_compliance >= 0.0) {
+    b.edges = edge;
+    b.edge_count = 1;
+    b.material.stretch_compliance = link_compliance;
+  }
+  CHECK_OK(embra_body_create(w, &b, body ? body : &id, first));
   return w;
+}
+
+static embra_world* hanging_world(double damping, double m, int32_t* first) {
+  return pair_world(damping, m, -1.0, NULL, first);
 }
 
 static double z_of(const embra_world* w, int32_t particle) {
@@ -224,27 +237,12 @@ static void test_disable_move_remove(void) {
 /* A body's material: its generated stretch follows the material's compliance (rest at m g c, then
  * at the new m g c'); editing the generated constraint itself, or the mass, is refused. */
 static void test_material(void) {
-  embra_world* w = NULL;
-  embra_solver_def s = embra_default_solver_def();
-  embra_body_def b = embra_default_body_def();
   embra_body_id body;
   embra_material mat, got;
   embra_group_id def = {0, 0};
-  const double xyz[6] = {0, 0, 0, 0, 0, -1}, masses[2] = {0.0, 2.0};
-  const int32_t edge[2] = {0, 1};
   int32_t first = 0, count = 0, generated = 0;
   char *saved_before, *saved_after;
-  s.damping = 6.0;
-  s.settle_speed = 1e-7;
-  s.tethers = 0;
-  CHECK_OK(embra_world_create(&w, &s));
-  b.vertex_count = 2;
-  b.positions = xyz;
-  b.masses = masses;
-  b.edges = edge;
-  b.edge_count = 1;
-  b.material.stretch_compliance = 1e-3;
-  CHECK_OK(embra_body_create(w, &b, &body, &first));
+  embra_world* w = pair_world(6.0, 2.0, 1e-3, &body, &first);
   CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, &generated));
   CHECK_INT(count, 1);
   CHECK_INT(generated, 1);
@@ -494,25 +492,12 @@ static int same_state(const embra_world* a, const embra_world* b, int32_t n) {
  * its rest length for each new mass, and set immovable (0) it stays where it is; the edit moves
  * nothing by itself; a world saved after the edit and loaded again steps on to the same bits. */
 static void test_masses_hang(void) {
-  embra_world *w = NULL, *loaded = NULL;
-  embra_solver_def s = embra_default_solver_def();
-  embra_body_def b = embra_default_body_def();
+  embra_world* loaded = NULL;
   embra_body_id body;
-  const double xyz[6] = {0, 0, 0, 0, 0, -1}, masses[2] = {0.0, 1.0};
-  const int32_t edge[2] = {0, 1};
   double got[2] = {-1, -1}, heavier[2] = {0.0, 3.5}, still[2] = {0.0, 0.0}, before[6], after[6];
   int32_t first = 0, n = 0, k;
   char* saved;
-  s.damping = 6.0;
-  s.settle_speed = 1e-7;
-  CHECK_OK(embra_world_create(&w, &s));
-  b.vertex_count = 2;
-  b.positions = xyz;
-  b.masses = masses;
-  b.edges = edge;
-  b.edge_count = 1;
-  b.material.stretch_compliance = 2e-3;
-  CHECK_OK(embra_body_create(w, &b, &body, &first));
+  embra_world* w = pair_world(6.0, 1.0, 2e-3, &body, &first);
   solve_to_rest(w);
   CHECK_NEAR(-z_of(w, first + 1) - 1.0, 1.0 * kG * 2e-3, 1e-6);
 

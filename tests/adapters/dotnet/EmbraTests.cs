@@ -2121,18 +2121,27 @@ namespace Embra.Tests
             }
         }
 
-        [Test]
-        public void AMaterialEditMovesTheGeneratedStretch()
+        /// <summary>A world of one body: an immovable particle at the origin and one of `mass` 1 m below it, on
+        /// the body's edge of stretch compliance `compliance` (damping 6/s, no tethers).</summary>
+        static World HangingPair(double mass, double compliance, out Body b)
         {
             var s = Library.DefaultSolverDef();
             s.Damping = 6.0;
             s.SettleSpeed = 1e-7;
             s.Tethers = 0;
-            using (var w = new World(s))
+            var w = new World(s);
+            var def = Library.DefaultBodyDef();
+            def.Material.StretchCompliance = compliance;
+            b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, edges: new[] { 0, 1 }, masses: new[] { 0.0, mass }, def: def);
+            return w;
+        }
+
+        [Test]
+        public void AMaterialEditMovesTheGeneratedStretch()
+        {
+            Body b;
+            using (var w = HangingPair(2.0, 1e-3, out b))
             {
-                var def = Library.DefaultBodyDef();
-                def.Material.StretchCompliance = 1e-3;
-                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, edges: new[] { 0, 1 }, masses: new[] { 0.0, 2.0 }, def: def);
                 Assert.AreEqual(2.0 * G * 1e-3, Drop(w, b), 1e-6);
                 Assert.Throws<EmbraArgumentException>(() => w.SetConstraintCompliance(default(GroupId), ConstraintKind.Distance, 0, 0.0));
                 var m = w.GetMaterial(b.Id);
@@ -2153,15 +2162,9 @@ namespace Embra.Tests
         [Test]
         public void MassesSetWithoutARebuild()
         {
-            var s = Library.DefaultSolverDef();
-            s.Damping = 6.0;
-            s.SettleSpeed = 1e-7;
-            s.Tethers = 0;
-            using (var w = new World(s))
+            Body b;
+            using (var w = HangingPair(1.0, 2e-3, out b))
             {
-                var def = Library.DefaultBodyDef();
-                def.Material.StretchCompliance = 2e-3;
-                var b = w.CreateBody(new[] { 0.0, 0.0, 0.0, 0.0, 0.0, -1.0 }, edges: new[] { 0, 1 }, masses: new[] { 0.0, 1.0 }, def: def);
                 Assert.AreEqual(1.0 * G * 2e-3, Drop(w, b), 1e-6);
                 CollectionAssert.AreEqual(new[] { 0.0, 1.0 }, w.GetBodyMasses(b.Id));
                 string before = w.SaveJson();
