@@ -2,8 +2,9 @@
 // triangles and edges of every body that has triangles, same body or different bodies (pairs
 // sharing a vertex excluded), kept `thickness` apart (the two sides' half thicknesses added).
 //
-//   broad phase   a spatial hash of regions around the particles (their swept bounds grown by a
-//                 margin), and the candidate pairs it gives, kept from substep to substep while their
+//   broad phase   a spatial hash of regions around the particles (their swept bounds stretched
+//                 ahead along their motion, where they go on to in the next substeps, and grown by
+//                 a margin), and the candidate pairs it gives, kept from substep to substep while their
 //                 particles stay inside their regions. A particle that leaves its region gets a new
 //                 one, and only the pairs of the primitives holding it are dropped and found again
 //                 (each such primitive queried against the others); the hash tables are those of the
