@@ -1,6 +1,9 @@
 // Constraints added by the host, one or a batch at a time.
 #include "guard.hpp"
 
+#include <iterator>
+#include <string>
+
 using namespace embra::capi;
 
 // The C values cast to core enums here are pinned to them in enum_pins_generated.hpp.
@@ -26,6 +29,11 @@ embra_status embra_constraint_add(embra_world* world, const embra_constraint_def
     need_version(def->version, EMBRA_CONSTRAINT_DEF_VERSION, "embra_constraint_def");
     const int32_t n = embra_constraint_arity(def->kind);
     if (n == 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "unknown constraint kind " + num(def->kind));
+    if (n > static_cast<int32_t>(std::size(def->particles)))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(embra::kind_name(static_cast<embra::Kind>(def->kind))) +
+                                               " takes " + num(n) + " particles and embra_constraint_def holds " +
+                                               num(static_cast<int64_t>(std::size(def->particles))) +
+                                               ": add it with embra_constraints_add");
     need_flag(def->rest_from_current, "def.rest_from_current");
     embra::ConstraintDesc d;
     d.kind = static_cast<embra::Kind>(def->kind);
@@ -80,9 +88,15 @@ embra_status embra_constraint_get(const embra_world* world, embra_group_id group
     need(out_def, "out_def");
     const embra::ConstraintInfo c = world->world.constraint(to_id(group), static_cast<embra::Kind>(kind), index);
     embra_constraint_def d = embra_default_constraint_def();
+    const int32_t n = embra_constraint_arity(kind);
+    if (n > static_cast<int32_t>(std::size(d.particles)))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, std::string(embra::kind_name(static_cast<embra::Kind>(kind))) + " takes " +
+                                               num(n) + " particles and embra_constraint_def holds " +
+                                               num(static_cast<int64_t>(std::size(d.particles))) +
+                                               ": embra_world_save_json lists them");
     d.kind = kind;
     d.group = group;
-    for (int k = 0; k < 4; ++k) d.particles[k] = c.particles[k];
+    for (size_t k = 0; k < std::size(d.particles); ++k) d.particles[k] = c.particles[k];
     d.rest_from_current = 0;
     d.rest = c.rest;
     d.compliance = c.compliance;

@@ -19,7 +19,8 @@ static_assert(static_cast<int>(embra::Kind::tether) == 5, "embra::Kind::tether i
 static_assert(static_cast<int>(embra::Kind::planarity) == 6, "embra::Kind::planarity is EMBRA_CONSTRAINT_PLANARITY = 6");
 static_assert(static_cast<int>(embra::Kind::plane_offset) == 7, "embra::Kind::plane_offset is EMBRA_CONSTRAINT_PLANE_OFFSET = 7");
 static_assert(static_cast<int>(embra::Kind::equal_length) == 8, "embra::Kind::equal_length is EMBRA_CONSTRAINT_EQUAL_LENGTH = 8");
-static_assert(embra::kKindCount == 9, "embra::Kind and the 9 EMBRA_CONSTRAINT_* values differ");
+static_assert(static_cast<int>(embra::Kind::conical) == 9, "embra::Kind::conical is EMBRA_CONSTRAINT_CONICAL = 9");
+static_assert(embra::kKindCount == 10, "embra::Kind and the 10 EMBRA_CONSTRAINT_* values differ");
 
 static_assert(static_cast<int>(embra::ColliderShape::plane) == 0, "embra::ColliderShape::plane is EMBRA_COLLIDER_PLANE = 0");
 static_assert(static_cast<int>(embra::ColliderShape::sphere) == 1, "embra::ColliderShape::sphere is EMBRA_COLLIDER_SPHERE = 1");

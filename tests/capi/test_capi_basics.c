@@ -242,7 +242,8 @@ static void test_constraint_arity(void) {
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_PLANARITY), 4);
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_PLANE_OFFSET), 4);
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_EQUAL_LENGTH), 4);
-  CHECK_INT(embra_constraint_arity(9), 0);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_CONICAL), 5);
+  CHECK_INT(embra_constraint_arity(10), 0);
   CHECK_INT(embra_constraint_arity(INT32_MAX), 0);
   CHECK_INT(embra_constraint_arity(INT32_MIN), 0);
 }

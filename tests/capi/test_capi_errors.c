@@ -913,7 +913,7 @@ static void test_constraint_add(void) {
   {
     scene s;
     CHECK(scene_build(&s));
-    for (kind = 0; embra_constraint_arity(kind) > 0; ++kind) {
+    for (kind = 0; embra_constraint_arity(kind) > 0 && embra_constraint_arity(kind) <= 4; ++kind) {
       CAPI_CONTEXT("kind %d", kind);
       d = good_constraint(kind);
       CHECK_OK(embra_constraint_add(s.w, &d));
@@ -942,6 +942,12 @@ static void test_constraint_add(void) {
 
   for (kind = 0; embra_constraint_arity(kind) > 0; ++kind) {
     const int32_t n = embra_constraint_arity(kind);
+    if (n > 4) { /* more particles than the def holds: embra_constraints_add (test_constraints_add) */
+      CAPI_CONTEXT("kind %d, one at a time", kind);
+      d = good_constraint(kind);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "embra_constraints_add", embra_constraint_add(W, &d));
+      continue;
+    }
     for (slot = 0; slot < n; ++slot) {
       /* Equal length's two edges may share a particle (slots 1 and 2, 3 and 0); one edge may not. */
       const int shared_edges = kind == EMBRA_CONSTRAINT_EQUAL_LENGTH && slot % 2 == 1;
@@ -1062,6 +1068,36 @@ static void test_constraints_add(void) {
     GOOD_BATCH();
     CHECK_OK(embra_constraints_add(s.w, &d));
     embra_world_destroy(s.w);
+  }
+  {
+    /* A conical vertex: the cloth's middle particle and its four neighbours round it (its five
+     * particles do not fit embra_constraint_def). */
+    const int32_t c = g_ref.cloth;
+    int32_t cone[5];
+    double cone_rest = 0.0;
+    scene s;
+    CAPI_CONTEXT("conical");
+    d = embra_default_constraint_batch_def();
+    d.kind = EMBRA_CONSTRAINT_CONICAL;
+    d.count = 1;
+    d.particles = cone;
+    cone[0] = c + 4, cone[1] = c + 5, cone[2] = c + 7, cone[3] = c + 3, cone[4] = c + 1;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_constraints_add(s.w, &d));
+    embra_world_destroy(s.w);
+    cone[4] = g_ref.n;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_constraints_add(W, &d));
+    cone[4] = c + 5;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_constraints_add(W, &d));
+    cone[4] = c + 1;
+    d.rest = &cone_rest;
+    cone_rest = 6.3; /* beyond 2 pi */
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraints_add(W, &d));
+    for (i = 0; i < 3; ++i) {
+      CAPI_CONTEXT("conical, %s", bad_name(i));
+      cone_rest = bad_value(i);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_constraints_add(W, &d));
+    }
   }
   GOOD_BATCH();
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_constraints_add(W, NULL));

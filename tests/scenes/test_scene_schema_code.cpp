@@ -10,6 +10,7 @@
 //     core/include/embra/core/limits.hpp and its EMBRA_MAX_* / EMBRA_MIN_* macro in embra.h; and
 //     every non-integer "minimum" or "maximum" anywhere in the schemas is one of those constants,
 //     so a bound typed as a copy cannot drift.
+#include "embra/core/kinds.hpp"
 #include "embra/core/limits.hpp"
 #include "embra/embra.h"
 #include "embra/io/scene.hpp"
@@ -185,6 +186,13 @@ int limit_checks(const std::string& dir) {
   for (const char* at : {"panel_mesh/then/properties/quads/maxItems", "panel_mesh/else/properties/quads/maxItems"})
     same(static_cast<double>(integer_at(scene, d + at)), static_cast<double>(limits::kMaxParticles / 8),
          EMBRA_MAX_PARTICLES / 8, std::string(at) + " (8 particles per panel)");
+  // A constraint's operands: as many as the kinds take, the fewest to the most.
+  int fewest = 1 << 30, most = 0;
+  for (const embra::KindInfo& k : embra::kKinds) fewest = std::min(fewest, k.arity), most = std::max(most, k.arity);
+  check(integer_at(scene, d + "constraint_batch/properties/particles/items/minItems") == fewest,
+        "constraint operands minItems = the smallest arity " + std::to_string(fewest));
+  check(integer_at(scene, d + "constraint_batch/properties/particles/items/maxItems") == most,
+        "constraint operands maxItems = the largest arity " + std::to_string(most));
   // What a schema cannot express is stated in its descriptions, with the same numbers.
   const auto says = [&](const std::string& pointer, int64_t value, const char* macro) {
     const std::string text = text_at(scene, pointer);

@@ -220,6 +220,33 @@ TEST(ConstraintMath, EqualLengthValueAndGradient) {
   EXPECT_FALSE(eval_equal_length(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 2, 3), Vec3(1, 2, 3)).valid);
 }
 
+// A vertex and its four neighbours: C = a12 - a23 + a34 - a41, the angles at x0.
+TEST(ConstraintMath, ConicalValueAndGradient) {
+  Rng rng(9);
+  auto angle = [](const Vec3& c, const Vec3& a, const Vec3& b) {
+    return std::acos(std::clamp((a - c).normalized().dot((b - c).normalized()), -1.0, 1.0));
+  };
+  for (int i = 0; i < kConfigs; ++i) {
+    Points<5> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const double expected =
+        angle(x[0], x[1], x[2]) - angle(x[0], x[2], x[3]) + angle(x[0], x[3], x[4]) - angle(x[0], x[4], x[1]);
+    EXPECT_NEAR(eval_conical(x[0], x[1], x[2], x[3], x[4]).value, expected, 1e-12);
+    check_gradient<5>([](const Points<5>& p) { return eval_conical(p[0], p[1], p[2], p[3], p[4]); }, x, "conical", i);
+  }
+  // A vertex of a flat grid: four right angles, conical. A pyramid's apex over a rhombus (a
+  // symmetric vertex): a12 = a34 and a23 = a41, conical; with x2 moved off it, not.
+  const Vec3 o(0, 0, 0);
+  EXPECT_NEAR(eval_conical(o, Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(-1, 0, 0), Vec3(0, -1, 0)).value, 0.0, 1e-15);
+  const Vec3 top(0, 0, 1), a(2, 0, 0), b(0, 1, 0), c(-2, 0, 0), d(0, -1, 0);
+  EXPECT_NEAR(eval_conical(top, a, b, c, d).value, 0.0, 1e-15);
+  const Vec3 b2(1, 1, 0);  // x2 moved off the symmetric places: not conical
+  EXPECT_NEAR(eval_conical(top, a, b2, c, d).value,
+              angle(top, a, b2) - angle(top, b2, c) + angle(top, c, d) - angle(top, d, a), 1e-15);
+  EXPECT_GT(std::abs(eval_conical(top, a, b2, c, d).value), 1e-3);
+  EXPECT_FALSE(eval_conical(o, o, Vec3(0, 1, 0), Vec3(-1, 0, 0), Vec3(0, -1, 0)).valid);              // a zero edge
+  EXPECT_FALSE(eval_conical(o, Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(-1, 0, 0), Vec3(0, -1, 0)).valid);  // in line
+}
+
 TEST(ConstraintMath, WrapAngle) {
   constexpr double pi = std::numbers::pi;
   EXPECT_NEAR(wrap_angle(0.25), 0.25, 1e-16);

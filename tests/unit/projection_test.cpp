@@ -66,6 +66,15 @@ std::vector<Vec3> random_config(Kind kind, Rng& rng) {
             std::abs(eval_equal_length(x[0], x[1], x[2], x[3]).value) > 0.05)
           return x;
         break;
+      case Kind::conical: {  // four edges of some length, no two neighbours near one line, not conical
+        bool shaped = std::abs(eval_conical(x[0], x[1], x[2], x[3], x[4]).value) > 0.05;
+        for (int k = 1; k <= 4 && shaped; ++k) {
+          const Vec3 u = x[k] - x[0], v = x[k % 4 + 1] - x[0];
+          shaped = u.norm() > 0.3 && u.normalized().cross(v.normalized()).norm() > 0.3;
+        }
+        if (shaped) return x;
+        break;
+      }
     }
   }
 }
@@ -100,6 +109,8 @@ double rest_of(Kind kind, const std::vector<Vec3>& x) {
       return eval_plane_offset(x[0], x[1], x[2], x[3]).value;
     case Kind::equal_length:
       return eval_equal_length(x[0], x[1], x[2], x[3]).value;
+    case Kind::conical:
+      return eval_conical(x[0], x[1], x[2], x[3], x[4]).value;
   }
   return 0.0;
 }

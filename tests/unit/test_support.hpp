@@ -131,6 +131,8 @@ inline double deviation(Kind kind, const std::vector<Vec3>& x, const int32_t* p,
       return eval_plane_offset(x[p[0]], x[p[1]], x[p[2]], x[p[3]]).value - rest;
     case Kind::equal_length:
       return eval_equal_length(x[p[0]], x[p[1]], x[p[2]], x[p[3]]).value - rest;
+    case Kind::conical:
+      return eval_conical(x[p[0]], x[p[1]], x[p[2]], x[p[3]], x[p[4]]).value - rest;
   }
   return 0.0;
 }

@@ -306,8 +306,8 @@ EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra
  * `iterations` times. Put collisions last so they take precedence (the contact group's order is
  * 1000); give a group a higher weight to make it win over the others. Within one group the kinds
  * go in a fixed order: soft pins, welds, bending (edge angle, dihedral), tethers, stretch
- * (distance), volume, equal lengths, panels (planarity, offsets), contacts; a later kind has the
- * final word.
+ * (distance), volume, equal lengths, conical vertices, panels (planarity, offsets), contacts; a
+ * later kind has the final word.
  * ------------------------------------------------------------------------------------------- */
 
 #define EMBRA_GROUP_DEF_VERSION 1
@@ -455,10 +455,19 @@ enum {
   EMBRA_CONSTRAINT_PLANE_OFFSET = 7, /* 4 particles: signed distance of x0 from the plane through
                                         x1, x2, x3 = rest (m; positive on the side of the normal
                                         (x2 - x1) x (x3 - x1)). x0 may slide along the plane */
-  EMBRA_CONSTRAINT_EQUAL_LENGTH = 8  /* 4 particles, two edges x0-x1 and x2-x3: |x0 - x1| - |x2 - x3|
+  EMBRA_CONSTRAINT_EQUAL_LENGTH = 8, /* 4 particles, two edges x0-x1 and x2-x3: |x0 - x1| - |x2 - x3|
                                         = rest (m; 0 = equal). The edges may share a particle (x1 =
                                         x2); an edge may not join a particle to itself. A set of
                                         edges held equal (gridshells): pair each with the next */
+  EMBRA_CONSTRAINT_CONICAL = 9       /* 5 particles, a vertex x0 of valence four and its neighbours
+                                        x1 x2 x3 x4 in order round it: a12 - a23 + a34 - a41 = rest
+                                        (rad, [-2 pi, 2 pi]; 0 = conical), a_ij the angle at x0
+                                        between x_i - x0 and x_j - x0. With every face planar
+                                        (EMBRA_CONSTRAINT_PLANARITY), a mesh conical at its inner
+                                        vertices has exact face offsets: embra_panel_mesh_create
+                                        builds it panels of constant thickness with planar joints.
+                                        Added with embra_constraints_add (embra_constraint_def
+                                        holds four particles) */
 };
 /* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
 EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);
@@ -468,7 +477,8 @@ typedef struct embra_constraint_def {
   int32_t version; /* EMBRA_CONSTRAINT_DEF_VERSION */
   embra_constraint_kind kind;
   embra_group_id group;      /* {0,0} = default group */
-  int32_t particles[4];      /* the first embra_constraint_arity(kind) are used */
+  int32_t particles[4];      /* the first embra_constraint_arity(kind) are used: a kind of more
+                                (EMBRA_CONSTRAINT_CONICAL) is added with embra_constraints_add */
   int32_t rest_from_current; /* 1 (default): measure rest from current positions; 0: use rest */
   int32_t reserved0;
   double rest;       /* rest value in the kind's unit, when rest_from_current is 0 */
@@ -510,7 +520,8 @@ EMBRA_API embra_status embra_group_get_constraint_count(const embra_world* world
                                                         embra_constraint_kind kind, int32_t* out_count,
                                                         int32_t* out_generated);
 /* One constraint as embra_constraint_add would take it: kind, group, particles (-1 past the arity),
- * rest (before any body's rest scale) with rest_from_current 0, and compliance. */
+ * rest (before any body's rest scale) with rest_from_current 0, and compliance. Refused for a kind of
+ * more particles than the def holds (EMBRA_CONSTRAINT_CONICAL: embra_world_save_json lists them). */
 EMBRA_API embra_status embra_constraint_get(const embra_world* world, embra_group_id group, embra_constraint_kind kind,
                                             int32_t index, embra_constraint_def* out_def);
 /* Compliance >= 0 and finite, in the kind's unit per newton. */
@@ -719,7 +730,8 @@ typedef struct embra_constraint_residual {
                            (embra_group_get_residuals); -1 for a pin */
   embra_group_id group; /* its group */
   embra_pin_id pin;     /* the soft pin; {0, 0} otherwise */
-  int32_t particles[4]; /* its particles; -1 past the kind's arity */
+  int32_t particles[4]; /* its particles (the first four of a conical vertex's five: the vertex and
+                           its first three neighbours); -1 past the kind's arity */
   double residual;      /* |C + compliance/h^2 * lambda| in the kind's unit (embra_residual_unit) */
   double violation;     /* |C|, in the same unit (a tether: how far overstretched) */
   double force;         /* |lambda| / h^2 */

@@ -181,6 +181,24 @@ struct KindTraits<Kind::equal_length> : KindDefaults {
   static double scaled_rest(const ConstraintArray& a, size_t i, const BodyInfo& b) { return a.rest[i] * b.rest_scale; }
 };
 
+/// The conical vertex condition: a sum of four angles in [0, pi] with alternating signs, so its
+/// value (and rest) is in [-2 pi, 2 pi]; angles do not scale with the body.
+template <>
+struct KindTraits<Kind::conical> : KindDefaults {
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_conical(x[p[0]], x[p[1]], x[p[2]], x[p[3]], x[p[4]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    const auto e = evaluate(p, x);
+    if (!e.valid)
+      invalid(name + " is degenerate: an edge has zero length or two neighbours are in line with the vertex");
+    return e.value;
+  }
+  static void check_rest(double rest, const std::string& name) {
+    if (!(std::abs(rest) <= 2.0 * std::numbers::pi)) invalid(name + " rest angle must be in [-2 pi, 2 pi]");
+  }
+};
+
 /// Whether any two operand slots of kind K may hold the same particle (KindTraits<K>::may_share).
 template <Kind K>
 constexpr bool shares_operands() {

@@ -4,8 +4,10 @@
 #include "common/check.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -447,7 +449,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     area[q] = 0.5 * n.norm();
     face_normal[q] = n.normalized();
   }
-  std::vector<Vec3> offset(nv, Vec3::Zero());  // bottom - top per mesh vertex
+  std::vector<Vec3> offset(nv, Vec3::Zero());    // bottom - top per mesh vertex
+  std::vector<std::vector<Vec3>> free_dirs(nv);  // the directions its faces leave an offset free in
   for (int64_t v = 0; v < nv; ++v) {
     if (around[v].empty()) continue;
     // n_f . y = -thickness for every face f, in the least-squares sense; where the faces do not
@@ -462,9 +465,69 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     }
     const Vec3 y0 = -d.thickness * mean.normalized();
     const Eigen::VectorXd r = Eigen::VectorXd::Constant(m, -d.thickness) - normals * y0;
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normals, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normals, Eigen::ComputeThinU | Eigen::ComputeFullV);
     svd.setThreshold(1e-9);
     offset[v] = y0 + svd.solve(r);
+    for (Eigen::Index k = svd.rank(); k < 3; ++k) free_dirs[v].push_back(svd.matrixV().col(k));
+  }
+
+  // --- boundary joints planar: the offsets moved along what their faces leave free ---
+  // A boundary edge (a, b) of face f: both bottom corners lie on f's offset plane, so its joint
+  // face (a, b and their bottom corners) is planar exactly when the bottom edge is parallel to the
+  // top one: (y_b - y_a) . m = 0 with m = n_f x (b - a), linear in the offsets. Each offset may move
+  // along its free directions (a line for a vertex on two faces, a plane for one on one face); the
+  // moves are the least-norm least-squares solution of these equations, exact when no boundary
+  // vertex is on three faces or more (inner joints are planar wherever the faces round each vertex
+  // decide its offset: a planar quad mesh conical at its inner vertices).
+  {
+    std::vector<std::array<int32_t, 3>> edges;  // (a, b, face) of each boundary edge
+    for (int64_t q = 0; q < np; ++q) {
+      const int32_t* v = &d.quads[4 * q];
+      for (int k = 0; k < 4; ++k)
+        if (undirected[edge_key(v[k], v[(k + 1) % 4])] == 1)
+          edges.push_back({v[k], v[(k + 1) % 4], static_cast<int32_t>(q)});
+    }
+    std::vector<int32_t> column(nv, -1);  // the first unknown of each vertex's moves
+    Eigen::Index unknowns = 0;
+    for (const auto& e : edges)
+      for (int32_t v : {e[0], e[1]})
+        if (column[v] < 0 && !free_dirs[v].empty()) {
+          column[v] = static_cast<int32_t>(unknowns);
+          unknowns += static_cast<Eigen::Index>(free_dirs[v].size());
+        }
+    if (unknowns > 0) {
+      // Least norm: step = A^T (A A^T + eps I)^-1 rhs, A sparse (a row per edge, its two vertices'
+      // directions); eps (1e-12 of A A^T's largest diagonal) keeps it defined where the equations
+      // cannot all hold, and then gives their least-squares solution to that order.
+      std::vector<Eigen::Triplet<double>> entries;
+      const auto rows = static_cast<Eigen::Index>(edges.size());
+      Eigen::VectorXd rhs(rows);
+      for (size_t i = 0; i < edges.size(); ++i) {
+        const auto& [va, vb, f] = edges[i];
+        const Vec3 m = face_normal[f].cross((P(vb) - P(va)).normalized());
+        const auto row = static_cast<Eigen::Index>(i);
+        rhs(row) = -(offset[vb] - offset[va]).dot(m);
+        for (size_t k = 0; k < free_dirs[vb].size(); ++k)
+          entries.emplace_back(row, column[vb] + static_cast<Eigen::Index>(k), free_dirs[vb][k].dot(m));
+        for (size_t k = 0; k < free_dirs[va].size(); ++k)
+          entries.emplace_back(row, column[va] + static_cast<Eigen::Index>(k), -free_dirs[va][k].dot(m));
+      }
+      Eigen::SparseMatrix<double> a(rows, unknowns);
+      a.setFromTriplets(entries.begin(), entries.end());
+      Eigen::SparseMatrix<double> aat = a * a.transpose();
+      double largest = 0.0;
+      for (Eigen::Index i = 0; i < rows; ++i) largest = std::max(largest, aat.coeff(i, i));
+      Eigen::SparseMatrix<double> eps(rows, rows);
+      eps.setIdentity();
+      aat += (1e-12 * largest) * eps;
+      const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(aat);
+      Eigen::VectorXd step = Eigen::VectorXd::Zero(unknowns);
+      if (largest > 0.0 && ldlt.info() == Eigen::Success) step = a.transpose() * ldlt.solve(rhs);
+      if (!step.allFinite()) step.setZero();
+      for (int64_t v = 0; v < nv; ++v)
+        for (size_t k = 0; column[v] >= 0 && k < free_dirs[v].size(); ++k)
+          offset[v] += step(column[v] + static_cast<Eigen::Index>(k)) * free_dirs[v][k];
+    }
   }
 
   // --- particles ---

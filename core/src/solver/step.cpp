@@ -161,6 +161,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
     add_corrections<Kind::planarity>(g.solve[static_cast<int>(Kind::planarity)], x_, w_, corr);
     add_corrections<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], x_, w_, corr);
     add_corrections<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], x_, w_, corr);
+    add_corrections<Kind::conical>(g.solve[static_cast<int>(Kind::conical)], x_, w_, corr);
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
@@ -236,6 +237,7 @@ void World::project_group(Group& g, double h, bool first) {
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   project_generic<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
+  project_generic<Kind::conical>(g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_);
   project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.

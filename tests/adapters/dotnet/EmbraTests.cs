@@ -1540,6 +1540,7 @@ namespace Embra.Tests
             Assert.AreEqual(0.5, m.FrictionStatic);
             Assert.AreEqual(ColliderDef.CurrentVersion, Native.embra_default_collider_def().Version);
             Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Dihedral));
+            Assert.AreEqual(5, Library.ConstraintArity(ConstraintKind.Conical));
             Assert.AreEqual(Native.AbiVersion, Library.AbiVersion);
             var parts = Library.VersionString.Split('.').Select(int.Parse).ToArray();
             Assert.AreEqual(parts[0] * 10000 + parts[1] * 100 + parts[2], Library.Version);

@@ -219,4 +219,31 @@ inline ConstraintEval<4> eval_equal_length(const Vec3& x0, const Vec3& x1, const
   return e;
 }
 
+/// The conical vertex condition (the angle criterion of Liu et al., "Geometric modeling with conical
+/// meshes and developable surfaces", 2006): at a vertex x0 of valence four with neighbours x1, x2,
+/// x3, x4 in order round it, C = a12 - a23 + a34 - a41, a_ij the angle at x0 between x_i - x0 and
+/// x_j - x0 (each in [0, pi]). Zero when the four faces round a vertex of a planar quad mesh touch
+/// one cone, so that their planes offset by one distance meet in a point: the mesh has exact face
+/// offsets (a panel mesh of constant thickness with planar joints). The gradient is the sum of the
+/// four angles' (eval_edge_angle); not valid when an edge has zero length or two neighbours lie on
+/// one line through x0.
+inline ConstraintEval<5> eval_conical(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, const Vec3& x4) {
+  ConstraintEval<5> e;
+  const Vec3* n[4] = {&x1, &x2, &x3, &x4};
+  for (Vec3& g : e.grad) g.setZero();
+  double value = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const auto a = eval_edge_angle(x0, *n[k], *n[(k + 1) % 4]);
+    if (!a.valid) return ConstraintEval<5>{};
+    const double sign = k % 2 == 0 ? 1.0 : -1.0;
+    value += sign * a.value;
+    e.grad[0] += sign * a.grad[0];
+    e.grad[1 + k] += sign * a.grad[1];
+    e.grad[1 + (k + 1) % 4] += sign * a.grad[2];
+  }
+  e.value = value;
+  e.valid = true;
+  return e;
+}
+
 }  // namespace embra

@@ -26,7 +26,9 @@ namespace embra {
   X(tether, 5, 2, 1, "m", "|x0 - x1| <= rest (long-range attachment, unilateral)")                            \
   X(planarity, 6, 4, 1, "m", "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")      \
   X(plane_offset, 7, 4, 1, "m", "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)") \
-  X(equal_length, 8, 4, 1, "m", "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")
+  X(equal_length, 8, 4, 1, "m", "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")                \
+  X(conical, 9, 5, 1, "rad",                                                                                  \
+    "angles at x0 between its neighbours x1..x4 in order round it: a12 - a23 + a34 - a41 = rest (0: conical)")
 
 /// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
 enum class Kind : int32_t {
@@ -53,6 +55,21 @@ inline constexpr std::array kKinds = {
 };
 
 constexpr int kKindCount = static_cast<int>(kKinds.size());
+
+/// The most particles one constraint of any kind takes.
+constexpr int kMaxArity = [] {
+  int most = 0;
+  for (const KindInfo& k : kKinds) most = k.arity > most ? k.arity : most;
+  return most;
+}();
+
+/// A constraint's particles: the first arity(kind) used, -1 past them.
+using ParticleSlots = std::array<int32_t, kMaxArity>;
+constexpr ParticleSlots no_particles() {
+  ParticleSlots p{};
+  for (int32_t& v : p) v = -1;
+  return p;
+}
 
 /// The table is indexed by the kind's number: the numbers run 0, 1, ... in the listed order.
 constexpr bool kinds_numbered_in_order() {

@@ -106,8 +106,8 @@ struct GroupDesc {
 /// One constraint as a group holds it (World::constraint).
 struct ConstraintInfo {
   Kind kind = Kind::distance;
-  std::array<int32_t, 4> particles{-1, -1, -1, -1};  // -1 past the kind's arity
-  double rest = 0.0;                                 // in the kind's unit, before any body's rest scale
+  ParticleSlots particles = no_particles();  // -1 past the kind's arity
+  double rest = 0.0;                         // in the kind's unit, before any body's rest scale
   double compliance = 0.0;
   int32_t body = -1;  // the body that generated it (it follows the body's material), or -1: added
 };
@@ -212,10 +212,10 @@ struct ConstraintResidual {
   Id group;
   int32_t index = -1;  // in the group's constraints of that kind (ConstraintArray order); -1 for a pin
   Id pin;              // the soft pin
-  std::array<int32_t, 4> particles{-1, -1, -1, -1};
-  double residual = 0.0;   // |C + alpha~ lambda| in the kind's unit
-  double violation = 0.0;  // |C|: how far from its rest, in the kind's unit
-  double force = 0.0;      // |lambda| / h^2 of the last substep: N (rad kinds: N m; volume: N/m^2)
+  ParticleSlots particles = no_particles();  // -1 past the kind's arity
+  double residual = 0.0;                     // |C + alpha~ lambda| in the kind's unit
+  double violation = 0.0;                    // |C|: how far from its rest, in the kind's unit
+  double force = 0.0;                        // |lambda| / h^2 of the last substep: N (rad kinds: N m; volume: N/m^2)
 };
 
 /// Two groups pulling the same particles opposite ways (World::group_conflicts).
