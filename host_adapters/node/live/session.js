@@ -417,7 +417,7 @@ class Session {
   step() {
     const t0 = process.hrtime.bigint();
     let error;
-    if (this.drags.size > 0) {
+    if (this.drags.size > 0 && this.bodies.some((b) => b.panels > 0)) { // a guard for panel metrics only
       error = this.#stepGuarded();
     } else {
       error = this.#tryStep();
