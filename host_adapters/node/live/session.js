@@ -16,8 +16,11 @@ const FIELDS = ['planarity', 'thickness', 'miter'];
  * panel constraints in every pass, so the panels correct last. Its compliance and its reach (the
  * drag pin's target is kept within DRAG_REACH times the scene's diagonal of the particle, however far
  * the cursor goes) bound its pull, and its speed (DRAG_SPEED) the momentum the mesh carries into its
- * panels when it is pulled taut: on the POQ drapes, 4 x 4 and 32 x 32 panels (docs/live-protocol.md),
- * the panels stay within their tolerances' max during a drag.
+ * panels when it is pulled taut. Those keep a drag's frames well inside the panels' tolerances on
+ * the POQ drapes, but they are feedback and can overshoot; what guarantees the limit is the step
+ * (#stepGuarded): while a drag is held, a frame that starts with every panel metric within DRAG_SAFE
+ * of its max and ends above it is undone and stepped again without the drag's pull
+ * (docs/live-protocol.md).
  */
 const DRAG_COMPLIANCE = 2e-5; // m/N
 const DRAG_REACH = 0.1; // of the scene's diagonal at load
@@ -25,6 +28,7 @@ const DRAG_BACK_OFF = 0.3; // of a tolerance's max: above it the drags' reach ha
 const DRAG_EASE = 0.2; // of a tolerance's max: below it the drags' reach grows back
 const DRAG_GAIN_START = 0.05; // a new drag's reach, of DRAG_REACH: it grows from there
 const DRAG_SPEED = 0.15; // of the scene's diagonal per second, times the reach's gain: the drag target's top speed
+const DRAG_SAFE = 0.6; // of a tolerance's max: a drag frame that ends above it (from within it) is undone
 const MAGIC = 0x464d4245; // 'EBMF' little-endian
 /**
  * A page's coordinates (drag targets, collider positions) are places in the scene: within its
@@ -109,6 +113,14 @@ class Session {
     this.drags = new Map(); // page -> {pin, particle}: each page holds at most one drag
     this.lastMs = 0;
     this.dragGain = 1; // the drags' reach, as a fraction of dragReach (#adaptDrag)
+    // What the drag's guard did (#stepGuarded), counted in frames since the load: stepped with a
+    // drag held, kept as first stepped, undone and stepped again without the pull (`redone`), and
+    // again at rest (`stilled`), held where they started (`held`), kept over DRAG_SAFE because the
+    // frame started over it (`over_before`) or a collider moved in it (`collider_moved`); `steps`
+    // counts every world step of those frames, `undone_worst` the worst metric (of its max) a frame
+    // undone had reached.
+    this.dragGuard = { frames: 0, kept: 0, redone: 0, stilled: 0, held: 0, over_before: 0, collider_moved: 0, steps: 0,
+                       undone_worst: 0 };
     const saved = JSON.parse(world.saveJson());
     this.name = saved.name || path.basename(this.scenePath, '.json');
     this.description = saved.description || '';
@@ -156,6 +168,7 @@ class Session {
                half_length: entry.half_length ?? 0.5, vertices: entry.vertices || [], triangles: entry.triangles || [] };
     });
     this.positions = new Float64Array(3 * this.particles);
+    this.colliderPoses = this.#colliderPoses();
     this.fieldValues = FIELDS.map(() => new Float64Array(this.particles).fill(NaN));
     this.#measure();
     this.workspace = this.#workspace();
@@ -274,29 +287,149 @@ class Session {
    * it: halved each frame) and grows back (by a quarter a frame, up to DRAG_REACH) below DRAG_EASE.
    */
   #adaptDrag() {
-    const r = this.record;
-    if (r.planarity_max === undefined) return;
-    const t = this.tolerances;
-    const worst = Math.max(r.planarity_max / t.planarity.max, r.thickness_error_max / t.thickness.max,
-                           r.miter_error_max / t.miter.max);
+    if (this.record.planarity_max === undefined) return;
+    const worst = this.#worst();
     if (worst > DRAG_BACK_OFF) this.dragGain *= 0.5;
     else if (worst < DRAG_EASE) this.dragGain = Math.min(1, this.dragGain * 1.25);
+  }
+
+  /** The worst panel metric of the last #measure, as a fraction of its tolerance's max (0: no panels). */
+  #worst() {
+    const r = this.record;
+    if (r.planarity_max === undefined) return 0;
+    const t = this.tolerances;
+    return Math.max(r.planarity_max / t.planarity.max, r.thickness_error_max / t.thickness.max,
+                    r.miter_error_max / t.miter.max);
+  }
+
+  /** Every collider's pose now, as one array of numbers (position then rotation, per collider). */
+  #colliderPoses() {
+    return this.colliders.flatMap((c) => {
+      const pose = this.world.colliderTransform(c.id);
+      return [...pose.position, ...pose.rotation];
+    });
+  }
+
+  /**
+   * The drags' pull set to nothing: each lead at its particle's place (the positions last measured),
+   * and the gain back to a new drag's.
+   */
+  #stopDrags() {
+    for (const drag of this.drags.values()) {
+      drag.lead = Array.from(this.positions.subarray(3 * drag.particle, 3 * drag.particle + 3));
+      this.world.setPinTarget(drag.pin, drag.lead);
+    }
+    this.dragGain = Math.min(this.dragGain, DRAG_GAIN_START);
+  }
+
+  /** One world step: null, or the NumericalError it failed with (the world as before it). */
+  #tryStep() {
+    try {
+      this.world.step();
+      return null;
+    } catch (e) {
+      if (!(e instanceof NumericalError)) throw e;
+      return e;
+    }
+  }
+
+  /**
+   * One frame while a drag is held, made transactional: the positions and velocities before the
+   * step are kept (a step's outcome depends on nothing else the step changes but the clock and the
+   * colliders' poses), and a frame that starts with every panel metric within DRAG_SAFE of its max
+   * and ends above it is not kept. It is stepped again from the same state with the drags' leads at
+   * their particles and the gain cut (`redone`); if that frame is over too, again with the dragged
+   * bodies at rest (`stilled`); if that is over too, the state before the frame is kept with those
+   * bodies at rest (`held`), whose metrics are the frame's start's. So a drag frame that starts
+   * within DRAG_SAFE ends within it, by construction; a drag started on a scene within it stays
+   * within it. Not undone: a frame that started over DRAG_SAFE (the scene's own motion: a drape
+   * still falling) and a frame in which a collider moved (its move cannot be put back through the
+   * C API); #adaptDrag brakes the drag there. Each re-step advances the world's clock by a frame
+   * (the frame counter has no setter). Returns null, or the NumericalError of the frame's first
+   * step (the world as before it); a re-step that fails counts as over.
+   */
+  #stepGuarded() {
+    const w = this.world;
+    const g = this.dragGuard;
+    const x0 = w.positions();
+    const v0 = w.velocities();
+    ++g.frames;
+    ++g.steps;
+    for (const drag of this.drags.values()) this.#leadDrag(drag);
+    const error = this.#tryStep();
+    if (error) return error;
+    this.#measure();
+    if (this.#worst() <= DRAG_SAFE) {
+      ++g.kept;
+      return null;
+    }
+    const poses = this.#colliderPoses();
+    if (poses.some((v, k) => v !== this.colliderPoses[k])) {
+      ++g.collider_moved;
+      return null;
+    }
+    const first = this.#worst();
+    const x1 = w.positions();
+    const v1 = w.velocities();
+    w.setPositions(x0);
+    w.setVelocities(v0);
+    this.#measure(); // the frame's start
+    if (this.#worst() > DRAG_SAFE) { // over before the step: the frame as first stepped
+      ++g.over_before;
+      w.setPositions(x1);
+      w.setVelocities(v1);
+      this.#measure();
+      return null;
+    }
+    g.undone_worst = Math.max(g.undone_worst, first);
+    this.#stopDrags();
+    ++g.steps;
+    if (!this.#tryStep()) {
+      this.#measure();
+      if (this.#worst() <= DRAG_SAFE) {
+        ++g.redone;
+        return null;
+      }
+      w.setPositions(x0);
+      w.setVelocities(v0);
+    }
+    const still = Float64Array.from(v0);
+    for (const b of this.bodies)
+      if ([...this.drags.values()].some((d) => d.particle >= b.first && d.particle < b.first + b.count))
+        still.fill(0, 3 * b.first, 3 * (b.first + b.count));
+    w.setVelocities(still);
+    ++g.steps;
+    if (!this.#tryStep()) {
+      this.#measure();
+      if (this.#worst() <= DRAG_SAFE) {
+        ++g.stilled;
+        return null;
+      }
+      w.setPositions(x0);
+      w.setVelocities(still);
+    }
+    ++g.held;
+    this.#measure();
+    return null;
   }
 
   /** Advances one frame. A numerical failure (the world restored to before the step) pauses. */
   step() {
     const t0 = process.hrtime.bigint();
-    for (const drag of this.drags.values()) this.#leadDrag(drag);
-    try {
-      this.world.step();
-    } catch (e) {
-      if (!(e instanceof NumericalError)) throw e;
-      this.paused = true;
-      this.lastMs = Number(process.hrtime.bigint() - t0) / 1e6;
-      return { type: 'error', message: `${e.message} (paused)` };
+    let error;
+    if (this.drags.size > 0 && this.bodies.some((b) => b.panels > 0)) { // a guard for panel metrics only
+      error = this.#stepGuarded();
+    } else {
+      error = this.#tryStep();
+      if (!error) this.#measure();
     }
     this.lastMs = Number(process.hrtime.bigint() - t0) / 1e6;
-    this.#measure();
+    if (error) {
+      this.paused = true;
+      return { type: 'error', message: `${error.message} (paused)` };
+    }
+    this.colliderPoses = this.#colliderPoses();
+    this.record.ms = this.lastMs;
     this.#adaptDrag();
     return null;
   }
@@ -623,4 +756,4 @@ class Session {
   }
 }
 
-module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, FIGHTS_LISTED, WORKSPACE_REACH, KEEP_FILES, outputStem };
+module.exports = { Session, RefusedMessage, FIELDS, MAGIC, DRAG_COMPLIANCE, DRAG_REACH, DRAG_SAFE, FIGHTS_LISTED, WORKSPACE_REACH, KEEP_FILES, outputStem };
