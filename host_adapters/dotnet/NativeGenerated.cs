@@ -56,6 +56,9 @@ namespace Embra
     /// <summary>EMBRA_SOLVE_*.</summary>
     public enum Solve { SettledWithinTolerance = 0, SettledOutOfTolerance = 1, Oscillating = 2, Drifting = 3 }
 
+    /// <summary>EMBRA_AREA_LOAD_*.</summary>
+    public enum AreaLoadMode { Normal = 0, TrueArea = 1, ProjectedArea = 2 }
+
     /// <summary>EMBRA_PANEL_PINS_*.</summary>
     public enum PanelPins { None = 0, TopCorners = 1, TopAndBottomCorners = 2 }
 
@@ -367,6 +370,24 @@ namespace Embra
         public int Reserved0;
     }
 
+    /// <summary>embra_area_load.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct AreaLoad
+    {
+        public fixed int Particles[3];
+        public int Mode;
+        public double Pressure;
+        public fixed double Direction[3];
+    }
+
+    /// <summary>embra_line_load.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct LineLoad
+    {
+        public fixed int Particles[2];
+        public fixed double Load[3];
+    }
+
     /// <summary>embra_panel_mesh_def.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct PanelMeshDef
@@ -605,6 +626,10 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_velocities(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_loads(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_loads(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_area_loads(IntPtr world, [In] AreaLoad[] loads, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_area_loads(IntPtr world, [Out] AreaLoad[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_line_loads(IntPtr world, [In] LineLoad[] loads, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_line_loads(IntPtr world, [Out] LineLoad[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_export_obj(IntPtr world, [Out] byte[] buffer, long capacity, out long length);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_write_obj(IntPtr world, byte[] path);

@@ -122,6 +122,7 @@ const char* const kMinimalScene = R"({
   "groups": [{"name": "g"}],
   "bodies": [{"name": "b", "mesh": {"generator": "icosphere", "radius": 1, "subdivisions": 0}}],
   "pins": [{"particle": 0}],
+  "area_loads": [{"particles": [0, 1, 2], "pressure": 1}],
   "colliders": [{"shape": "capsule"}, {"shape": "box"}],
   "fields": [{"type": "wind"}, {"type": "pressure", "body": "b"}, {"type": "surface_tension", "body": "b"},
              {"type": "vortex"}]
@@ -214,6 +215,11 @@ std::map<std::string, std::vector<json>> code_defaults() {
   c[pm + "slide_compliance"] = {p.slide_compliance};
   c[pm + "pins"] = {panel_pins_name(p.pins)};
   c[pm + "group"] = {group_name(p.group)};
+
+  // An area load's mode left out is a zeroed embra_area_load's (there is no default def).
+  const embra_area_load zeroed{};
+  c[d + "area_load/properties/mode"] = {json(zeroed.mode == EMBRA_AREA_LOAD_NORMAL ? "normal" : "?"),
+                                        saved["area_loads"][0]["mode"]};
 
   const embra_constraint_def k = embra_default_constraint_def();
   c[d + "constraint_batch/properties/group"] = {group_name(k.group)};

@@ -4,7 +4,8 @@
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
  * orders and weights, hard and soft pins, plane and line supports, a plane and a sphere, non-default solver settings, a
- * rest scale, initial velocities, point loads, and a destroyed group, pin and collider whose slots are reused):
+ * rest scale, initial velocities, point, area and line loads, and a destroyed group, pin and collider whose slots are
+ * reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -459,6 +460,31 @@ static embra_world* build_api_world(void) {
     /* Point loads on two particles (N), written to the scene's "loads" with every bit. */
     const double loads[6] = {0.1, -0.2, -1.0 / 3.0, 0.0, 0.0, 0.7};
     CHECK_OK(embra_world_set_loads(w, loads, b0, 2));
+  }
+  {
+    /* Area loads in every mode and line loads (a direction of any length, pressures and loads
+     * that are not short decimals), written to "area_loads" and "line_loads" with every bit. */
+    embra_area_load area[3];
+    embra_line_load line[2];
+    for (i = 0; i < 3; ++i) {
+      area[i].particles[0] = c0 + i;
+      area[i].particles[1] = c0 + i + 1;
+      area[i].particles[2] = c0 + i + NX;
+      area[i].mode = i; /* EMBRA_AREA_LOAD_NORMAL, _TRUE_AREA, _PROJECTED_AREA */
+      area[i].pressure = (i + 1) * 1.0 / 7.0;
+      area[i].direction[0] = 0.1 * i;
+      area[i].direction[1] = -1.0 / 3.0;
+      area[i].direction[2] = -2.5;
+    }
+    for (i = 0; i < 2; ++i) {
+      line[i].particles[0] = b0 + i;
+      line[i].particles[1] = c0 + NX + i;
+      line[i].load[0] = 0.2 / 3.0;
+      line[i].load[1] = 0.0;
+      line[i].load[2] = -0.3 - i;
+    }
+    CHECK_OK(embra_world_set_area_loads(w, area, 3));
+    CHECK_OK(embra_world_set_line_loads(w, line, 2));
   }
   if (capi_test_failed != failed_before) {
     embra_world_destroy(w);

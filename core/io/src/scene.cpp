@@ -661,6 +661,10 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
 constexpr const char* kPinSupportNames[] = {"point", "plane", "line"};
 static_assert(std::size(kPinSupportNames) == kPinSupportCount);
 
+/// The area load modes' names in the scene format, by AreaLoadMode.
+constexpr const char* kAreaLoadModeNames[] = {"normal", "true_area", "projected_area"};
+static_assert(std::size(kAreaLoadModeNames) == kAreaLoadModeCount);
+
 /// The panel pins' names in the scene format, by PanelPins.
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
 
@@ -1034,6 +1038,42 @@ class Builder {
     if (doc_.contains("state")) state(w, doc_["state"]);
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
     section("loads", [&](const json& l, const std::string& at) { load(w, l, at); });
+    std::vector<AreaLoad> area_loads;
+    section("area_loads", [&](const json& l, const std::string& at) {
+      AreaLoad a;
+      for (int k = 0; k < 3; ++k)
+        a.particles[k] = particle(w, l["particles"][k], at + "/particles/" + std::to_string(k));
+      if (l.contains("mode"))  // the schema has checked it is one of kAreaLoadModeNames
+        for (int k = 0; k < kAreaLoadModeCount; ++k)
+          if (l["mode"] == kAreaLoadModeNames[k]) a.mode = static_cast<AreaLoadMode>(k);
+      a.pressure = l["pressure"].get<double>();
+      if (l.contains("direction")) a.direction = vec3(l["direction"]);
+      guard(at, [&] {
+        w.check_area_load(a, "area load");
+        return 0;
+      });
+      area_loads.push_back(a);
+    });
+    guard("/area_loads", [&] {
+      w.set_area_loads(area_loads);
+      return 0;
+    });
+    std::vector<LineLoad> line_loads;
+    section("line_loads", [&](const json& l, const std::string& at) {
+      LineLoad a;
+      for (int k = 0; k < 2; ++k)
+        a.particles[k] = particle(w, l["particles"][k], at + "/particles/" + std::to_string(k));
+      a.load = vec3(l["load"]);
+      guard(at, [&] {
+        w.check_line_load(a, "line load");
+        return 0;
+      });
+      line_loads.push_back(a);
+    });
+    guard("/line_loads", [&] {
+      w.set_line_loads(line_loads);
+      return 0;
+    });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
@@ -1649,6 +1689,17 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   for (int32_t i = 0; i < w.particle_count(); ++i)
     if (!w.loads()[i].isZero()) loads.push_back({{"particle", i}, {"force", vec_json(w.loads()[i])}});
   if (!loads.empty()) doc["loads"] = loads;
+  json area_loads = json::array();
+  for (const AreaLoad& l : w.area_loads())
+    area_loads.push_back({{"particles", {l.particles[0], l.particles[1], l.particles[2]}},
+                          {"mode", kAreaLoadModeNames[static_cast<int>(l.mode)]},
+                          {"pressure", l.pressure},
+                          {"direction", vec_json(l.direction)}});
+  if (!area_loads.empty()) doc["area_loads"] = area_loads;
+  json line_loads = json::array();
+  for (const LineLoad& l : w.line_loads())
+    line_loads.push_back({{"particles", {l.particles[0], l.particles[1]}}, {"load", vec_json(l.load)}});
+  if (!line_loads.empty()) doc["line_loads"] = line_loads;
 
   json colliders = json::array();
   std::set<std::string> used_colliders = given_names(meta.collider_names);

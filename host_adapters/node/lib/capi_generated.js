@@ -93,6 +93,11 @@ const SOLVE_SETTLED_OUT_OF_TOLERANCE = 1;
 const SOLVE_OSCILLATING = 2;
 const SOLVE_DRIFTING = 3;
 
+// --- EMBRA_AREA_LOAD_* ---
+const AREA_LOAD_NORMAL = 0;
+const AREA_LOAD_TRUE_AREA = 1;
+const AREA_LOAD_PROJECTED_AREA = 2;
+
 // --- EMBRA_PANEL_PINS_* ---
 const PANEL_PINS_NONE = 0;
 const PANEL_PINS_TOP_CORNERS = 1;
@@ -117,6 +122,7 @@ const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, 
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
 const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_tolerance: 1, oscillating: 2, drifting: 3 });
+const AREA_LOAD_NAMES = Object.freeze({ normal: 0, true_area: 1, projected_area: 2 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
 const CUTS_NAMES = Object.freeze({ json: 0, csv: 1 });
@@ -327,6 +333,16 @@ const Warning = koffi.struct('embra_warning', {
   particle: 'int32_t',
   reserved0: 'int32_t',
 });
+const AreaLoad = koffi.struct('embra_area_load', {
+  particles: koffi.array('int32_t', 3, 'Array'),
+  mode: 'int32_t',
+  pressure: 'double',
+  direction: koffi.array('double', 3, 'Array'),
+});
+const LineLoad = koffi.struct('embra_line_load', {
+  particles: koffi.array('int32_t', 2, 'Array'),
+  load: koffi.array('double', 3, 'Array'),
+});
 const PanelMeshDef = koffi.struct('embra_panel_mesh_def', {
   version: 'int32_t',
   vertex_count: 'int32_t',
@@ -454,6 +470,8 @@ const STRUCTS = {
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
   embra_warning: Warning,
+  embra_area_load: AreaLoad,
+  embra_line_load: LineLoad,
   embra_panel_mesh_def: PanelMeshDef,
   embra_tolerance: Tolerance,
   embra_tolerances: Tolerances,
@@ -550,6 +568,10 @@ const PROTOTYPES = {
   embra_world_set_velocities: 'embra_status embra_world_set_velocities(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_set_loads: 'embra_status embra_world_set_loads(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_get_loads: 'embra_status embra_world_get_loads(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
+  embra_world_set_area_loads: 'embra_status embra_world_set_area_loads(embra_world *world, const embra_area_load *loads, int32_t count)',
+  embra_world_get_area_loads: 'embra_status embra_world_get_area_loads(const embra_world *world, embra_area_load *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_world_set_line_loads: 'embra_status embra_world_set_line_loads(embra_world *world, const embra_line_load *loads, int32_t count)',
+  embra_world_get_line_loads: 'embra_status embra_world_get_line_loads(const embra_world *world, embra_line_load *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_body_get_triangles: 'embra_status embra_body_get_triangles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_world_export_obj: 'embra_status embra_world_export_obj(const embra_world *world, char *out, int64_t capacity, _Out_ int64_t *out_length)',
   embra_world_write_obj: 'embra_status embra_world_write_obj(const embra_world *world, const char *path)',
@@ -606,12 +628,13 @@ module.exports = {
   COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH,
   RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE,
   SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING,
-  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
-  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
-  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
-  SOLVE_UNTIL_NAMES, SOLVE_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType,
-  PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef,
-  ConstraintBatchDef, PinDef, SupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual,
-  GroupConflict, Reaction, GroupReport, SolveDef, SolveResult, Warning, PanelMeshDef, Tolerance, Tolerances,
-  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
+  PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
+  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
+  PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES,
+  PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
+  SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, SupportDef,
+  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
+  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
+  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

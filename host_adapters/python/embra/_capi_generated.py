@@ -95,6 +95,11 @@ SOLVE_SETTLED_OUT_OF_TOLERANCE = 1
 SOLVE_OSCILLATING = 2
 SOLVE_DRIFTING = 3
 
+# --- EMBRA_AREA_LOAD_* ---
+AREA_LOAD_NORMAL = 0
+AREA_LOAD_TRUE_AREA = 1
+AREA_LOAD_PROJECTED_AREA = 2
+
 # --- EMBRA_PANEL_PINS_* ---
 PANEL_PINS_NONE = 0
 PANEL_PINS_TOP_CORNERS = 1
@@ -119,6 +124,7 @@ COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, 
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
 SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "oscillating": 2, "drifting": 3}
+AREA_LOAD_NAMES = {"normal": 0, "true_area": 1, "projected_area": 2}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}
 CUTS_NAMES = {"json": 0, "csv": 1}
@@ -428,6 +434,24 @@ class Warning(_Struct):  # noqa: A001 - the C name
     ]
 
 
+class AreaLoad(_Struct):
+    """embra_area_load."""
+    _fields_ = [
+        ("particles", c_int32 * 3),
+        ("mode", c_int32),
+        ("pressure", c_double),
+        ("direction", c_double * 3),
+    ]
+
+
+class LineLoad(_Struct):
+    """embra_line_load."""
+    _fields_ = [
+        ("particles", c_int32 * 2),
+        ("load", c_double * 3),
+    ]
+
+
 class PanelMeshDef(_Struct):
     """embra_panel_mesh_def."""
     _fields_ = [
@@ -652,6 +676,10 @@ PROTOTYPES = {
     "embra_world_set_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_set_loads": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_get_loads": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
+    "embra_world_set_area_loads": (c_int32, [c_void_p, POINTER(AreaLoad), c_int32]),
+    "embra_world_get_area_loads": (c_int32, [c_void_p, POINTER(AreaLoad), c_int32, POINTER(c_int32)]),
+    "embra_world_set_line_loads": (c_int32, [c_void_p, POINTER(LineLoad), c_int32]),
+    "embra_world_get_line_loads": (c_int32, [c_void_p, POINTER(LineLoad), c_int32, POINTER(c_int32)]),
     "embra_body_get_triangles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
     "embra_world_export_obj": (c_int32, [c_void_p, POINTER(c_char), c_int64, POINTER(c_int64)]),
     "embra_world_write_obj": (c_int32, [c_void_p, c_char_p]),

@@ -10,6 +10,7 @@
 #include "embra/core/constraint_math.hpp"
 #include "embra/core/fields.hpp"
 #include "embra/core/kinds.hpp"
+#include "embra/core/loads.hpp"
 
 #include <array>
 #include <atomic>
@@ -603,6 +604,22 @@ class World {
   /// substep beside gravity until changed; 0 by default. Each coordinate finite, |c| <= 1e300.
   void set_loads(int32_t first, std::span<const double> xyz);
   const std::vector<Vec3>& loads() const { return load_; }
+  /// Replaces the area loads (loads.hpp) with `loads` (empty: none), from the next step on. Refused,
+  /// changing nothing: a particle out of range, a repeated corner (a degenerate triangle), an
+  /// unknown mode, a pressure not finite within +-1e300, a direction not finite or, for the fixed
+  /// modes, zero (or too short to normalise).
+  void set_area_loads(std::span<const AreaLoad> loads);
+  const std::vector<AreaLoad>& area_loads() const { return area_loads_; }
+  /// Replaces the line loads (loads.hpp), checked likewise (an edge joining a particle to itself
+  /// is degenerate).
+  void set_line_loads(std::span<const LineLoad> loads);
+  const std::vector<LineLoad>& line_loads() const { return line_loads_; }
+  /// Throws as set_area_loads / set_line_loads would for this one load (`what` names it).
+  void check_area_load(const AreaLoad& load, const std::string& what) const;
+  void check_line_load(const LineLoad& load, const std::string& what) const;
+  /// The total load on every particle at the current positions (N): its point load plus its share
+  /// of every area and line load (a third of a triangle's, half an edge's). Weight not included.
+  std::vector<Vec3> applied_loads() const;
 
   // --- fields (fields.hpp) -------------------------------------------------------------------
   Id create_field(const FieldDesc& desc);
@@ -714,6 +731,12 @@ class World {
   std::vector<double> radius_;    // contact offset (half the body's thickness)
   std::vector<double> damping_;   // per-particle damping rate (1/s)
   std::vector<Vec3> load_;        // per-particle point load (N)
+  std::vector<AreaLoad> area_loads_;
+  std::vector<LineLoad> line_loads_;
+  std::vector<Vec3> load_now_;  // scratch: point loads plus distributed loads at the substep's start
+  /// Adds every area and line load's share at positions x to f (one entry per particle), in list
+  /// order (area loads first), so the sums are the same bits run after run.
+  void add_distributed_loads(const std::vector<Vec3>& x, std::vector<Vec3>& f) const;
   std::vector<double> mu_s_, mu_k_;
   std::vector<int32_t> body_of_;
   std::vector<int32_t> hard_pin_of_;  // pin slot or -1
