@@ -29,6 +29,8 @@ const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
 const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
+const AREA_LOAD_MODES = capi.AREA_LOAD_NAMES;
+const AREA_LOAD_MODE_NAMES = Object.fromEntries(Object.entries(AREA_LOAD_MODES).map(([k, v]) => [v, k]));
 const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
 const SOLVE_UNTIL = capi.SOLVE_UNTIL_NAMES;
 const SOLVE_OUTCOMES = Object.freeze(Object.fromEntries(Object.entries(capi.SOLVE_NAMES).map(([k, v]) => [v, k])));
@@ -1258,6 +1260,86 @@ class World {
    */
   setLoads(xyz, first = 0) {
     this.#write('embra_world_set_loads', xyz, first);
+  }
+
+  /**
+   * Replaces the area loads (embra_world_set_area_loads) with `loads`, an array of
+   * {particles: [a, b, c] (three distinct particles), pressure (Pa), mode ('normal', 'true_area' or
+   * 'projected_area'; default 'normal'), direction ([x, y, z], the fixed modes')}: a third of each
+   * triangle's force on each corner, every substep beside gravity, until set again. [] removes them.
+   */
+  setAreaLoads(loads) {
+    const { koffi } = capi;
+    if (!Array.isArray(loads)) throw new TypeError(`loads: expected an array, got ${buf.describe(loads)}`);
+    const size = koffi.sizeof(capi.AreaLoad);
+    const out = Buffer.alloc(Math.max(loads.length, 1) * size);
+    loads.forEach((l, i) => {
+      const o = options(l, `loads[${i}]`);
+      const d = {
+        particles: buf.fixed(take(o, 'particles'), 3, `loads[${i}].particles`).map((c) => buf.int32(c, `loads[${i}].particles`)),
+        mode: o.has('mode') ? enumValue(take(o, 'mode'), AREA_LOAD_MODES, `loads[${i}].mode`) : AREA_LOAD_MODES.normal,
+        pressure: buf.number(take(o, 'pressure'), `loads[${i}].pressure`),
+        direction: o.has('direction') ? buf.fixed(take(o, 'direction'), 3, `loads[${i}].direction`) : [0, 0, -1],
+      };
+      if (o.size) throw new TypeError(`loads[${i}]: unknown key '${o.keys().next().value}'`);
+      koffi.encode(out, i * size, capi.AreaLoad, d);
+    });
+    this.#call('embra_world_set_area_loads', out, loads.length);
+  }
+
+  /** The area loads as set: [{particles, mode (name), pressure, direction}]. */
+  areaLoads() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_area_loads', null, 0, n);
+    const size = koffi.sizeof(capi.AreaLoad);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_area_loads', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const l = koffi.decode(out, k * size, capi.AreaLoad);
+      result.push({ particles: Array.from(l.particles), mode: AREA_LOAD_MODE_NAMES[l.mode] ?? l.mode,
+        pressure: l.pressure, direction: Array.from(l.direction) });
+    }
+    return result;
+  }
+
+  /**
+   * Replaces the line loads (embra_world_set_line_loads) with `loads`, an array of
+   * {particles: [a, b] (two distinct particles), load ([x, y, z], N per m of the edge)}: half of each
+   * edge's force on each end, every substep beside gravity, until set again.
+   */
+  setLineLoads(loads) {
+    const { koffi } = capi;
+    if (!Array.isArray(loads)) throw new TypeError(`loads: expected an array, got ${buf.describe(loads)}`);
+    const size = koffi.sizeof(capi.LineLoad);
+    const out = Buffer.alloc(Math.max(loads.length, 1) * size);
+    loads.forEach((l, i) => {
+      const o = options(l, `loads[${i}]`);
+      const d = {
+        particles: buf.fixed(take(o, 'particles'), 2, `loads[${i}].particles`).map((c) => buf.int32(c, `loads[${i}].particles`)),
+        load: buf.fixed(take(o, 'load'), 3, `loads[${i}].load`),
+      };
+      if (o.size) throw new TypeError(`loads[${i}]: unknown key '${o.keys().next().value}'`);
+      koffi.encode(out, i * size, capi.LineLoad, d);
+    });
+    this.#call('embra_world_set_line_loads', out, loads.length);
+  }
+
+  /** The line loads as set: [{particles, load}]. */
+  lineLoads() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_line_loads', null, 0, n);
+    const size = koffi.sizeof(capi.LineLoad);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_line_loads', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const l = koffi.decode(out, k * size, capi.LineLoad);
+      result.push({ particles: Array.from(l.particles), load: Array.from(l.load) });
+    }
+    return result;
   }
 
   // --- JSON scenes --------------------------------------------------------------------------------

@@ -662,6 +662,47 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along
+        /// (0, 3, -4): 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on
+        /// each end (symplectic Euler: a h^2 n (n + 1) / 2 after n substeps). Refusals change nothing.</summary>
+        [Test]
+        public void AreaAndLineLoadsPushFreeParticles()
+        {
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = 0.0; }
+            solver.Substeps = 4;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                var start = new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 5, 2, 0, 5 };
+                w.CreateBody(start, masses: new[] { 0.5, 0.5, 0.5, 0.5, 0.5 }, def: def);
+                w.SetAreaLoads(new[] { World.MakeAreaLoad(0, 1, 2, 12.0, AreaLoadMode.TrueArea, new double[] { 0, 3, -4 }) });
+                w.SetLineLoads(new[] { World.MakeLineLoad(3, 4, new double[] { 1, 0, 0 }) });
+                var got = w.AreaLoads();
+                Assert.AreEqual(1, got.Length);
+                Assert.AreEqual((int)AreaLoadMode.TrueArea, got[0].Mode);
+                Assert.AreEqual(12.0, got[0].Pressure);
+                Assert.AreEqual(1, w.LineLoads().Length);
+                w.Step(3);
+                int n = 12;
+                double h = 1.0 / 60.0 / 4;
+                double s = h * h * n * (n + 1) / 2;
+                var p = w.GetPositions();
+                var u = new[] { 0.0, 0.6, -0.8 };
+                for (int i = 0; i < 3; ++i)
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(start[3 * i + k] + 4 * u[k] * s, p[3 * i + k], 1e-12);
+                for (int i = 3; i < 5; ++i) Assert.AreEqual(start[3 * i] + 2 * s, p[3 * i], 1e-12);
+                Assert.Throws<EmbraArgumentException>(() => w.SetAreaLoads(new[] { World.MakeAreaLoad(0, 1, 1, 1.0) }));
+                Assert.Throws<EmbraArgumentException>(() => w.SetLineLoads(new[] { World.MakeLineLoad(3, 5, new double[] { 1, 0, 0 }) }));
+                Assert.AreEqual(12.0, w.AreaLoads()[0].Pressure);
+                w.SetAreaLoads(new AreaLoad[0]);
+                w.SetLineLoads(new LineLoad[0]);
+                Assert.AreEqual(0, w.AreaLoads().Length + w.LineLoads().Length);
+            }
+        }
+
         /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
         /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
         [Test]

@@ -128,6 +128,36 @@ test('statics: two hard bars at 45 degrees carry a load, the pins react with eve
   w.close();
 });
 
+test('area and line loads push free particles by p A / 3 and q L / 2, and read back', () => {
+  // A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along (0, 3, -4):
+  // 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on each end.
+  const tri = [[0, 0, 0], [1, 0, 0], [0, 1, 0]];
+  const edge = [[0, 0, 5], [2, 0, 5]];
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 1, tethers: 0 });
+  w.createBody([...tri, ...edge], { generate: 0, masses: [0.5, 0.5, 0.5, 0.5, 0.5] });
+  w.setAreaLoads([{ particles: [0, 1, 2], mode: 'true_area', pressure: 12, direction: [0, 3, -4] }]);
+  w.setLineLoads([{ particles: [3, 4], load: [1, 0, 0] }]);
+  assert.deepEqual(w.areaLoads(), [{ particles: [0, 1, 2], mode: 'true_area', pressure: 12, direction: [0, 3, -4] }]);
+  assert.deepEqual(w.lineLoads(), [{ particles: [3, 4], load: [1, 0, 0] }]);
+  w.step(3);
+  const n = 12;
+  const h = 1 / 60 / 4;
+  const s = h * h * n * (n + 1) / 2;
+  const p = w.positions();
+  for (let i = 0; i < 3; i++) {
+    [0, 0.6, -0.8].forEach((u, k) => assert.ok(Math.abs(p[3 * i + k] - tri[i][k] - 4 * u * s) < 1e-12));
+  }
+  for (let i = 0; i < 2; i++) assert.ok(Math.abs(p[9 + 3 * i] - edge[i][0] - 2 * s) < 1e-12);
+  assert.throws(() => w.setAreaLoads([{ particles: [0, 1, 1], pressure: 1 }]), embra.EmbraError);
+  assert.throws(() => w.setLineLoads([{ particles: [3, 5], load: [1, 0, 0] }]), embra.EmbraError);
+  assert.throws(() => w.setAreaLoads([{ particles: [0, 1, 2], mode: 'plan', pressure: 1 }]), RangeError);
+  assert.equal(w.areaLoads()[0].pressure, 12);
+  w.setAreaLoads([]);
+  w.setLineLoads([]);
+  assert.deepEqual([w.areaLoads(), w.lineLoads()], [[], []]);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];
