@@ -42,7 +42,7 @@ namespace Embra
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
-    public enum PinSupport { Point = 0, Plane = 1, Line = 2 }
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }
 
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
@@ -238,6 +238,21 @@ namespace Embra
         public int Reserved0;
         public fixed double Target[3];
         public fixed double Axis[3];
+        public double Compliance;
+        public GroupId Group;
+    }
+
+    /// <summary>embra_polyline_support_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct PolylineSupportDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Particle;
+        public fixed double Target[3];
+        public int PointCount;
+        public int Closed;
+        public IntPtr Points;
         public double Compliance;
         public GroupId Group;
     }
@@ -596,6 +611,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_create(IntPtr world, ref PinDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern SupportDef embra_default_support_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern PolylineSupportDef embra_default_polyline_support_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_create(IntPtr world, ref PolylineSupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);

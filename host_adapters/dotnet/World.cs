@@ -717,6 +717,32 @@ namespace Embra
             return pin;
         }
 
+        /// <summary>A frictionless support on a polyline (embra_polyline_support_create): the particle held
+        /// on the closest point of the polyline through `points` (xyz per point, m, offsets from `target`,
+        /// so SetPinTarget moves the curve); `closed` joins its ends. Compliance 0 = hard, else m/N.</summary>
+        public PinId CreatePolylineSupport(int particle, double[] points, double[] target = null, bool closed = false,
+                                           double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(points != null && points.Length % 3 == 0, "points: a whole number of xyz triples is required");
+            if (target != null) Three(target, "target");
+            var def = Native.embra_default_polyline_support_def();
+            def.Particle = particle;
+            if (target != null)
+                for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            def.Closed = closed ? 1 : 0;
+            def.Compliance = compliance;
+            def.Group = group;
+            var pin = new PinId();
+            fixed (double* p = points)
+            {
+                def.Points = (IntPtr)p;
+                def.PointCount = points.Length / 3;
+                var d = def;
+                Call(w => Native.embra_polyline_support_create(w, ref d, out pin));
+            }
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");

@@ -1211,7 +1211,7 @@ static void test_pins(void) {
     sd.particle = g_ref.n;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
     GOOD_SUPPORT();
-    sd.support = 3;
+    sd.support = 4;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
     sd.support = -1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
@@ -1808,6 +1808,110 @@ static void test_distributed_loads(void) {
   embra_world_destroy(s.w);
 }
 
+/* Polyline supports: the curve checked whole; a refused call leaves the saved scene as it was. */
+static void test_polyline_supports(void) {
+  scene s;
+  char* before;
+  embra_polyline_support_def pd;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0};
+  double pts[3 * 5] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0.5, -0.5, 0.5, 0.2};
+  int i, k;
+  CHECK(scene_build(&s));
+  pd = embra_default_polyline_support_def();
+  CHECK(pd.version == EMBRA_POLYLINE_SUPPORT_DEF_VERSION && pd.point_count == 0 && pd.closed == 0);
+  CHECK(pd.points == NULL && pd.compliance == 0.0 && pd.target[0] == 0.0 && pd.target[2] == 0.0);
+  pd.particle = s.point;
+  pd.points = pts;
+  pd.point_count = 5;
+  pd.closed = 1;
+  CHECK_OK(embra_polyline_support_create(s.w, &pd, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"polyline\"") != NULL);
+#define GOOD_POLYLINE()                        \
+  do {                                         \
+    pd = embra_default_polyline_support_def(); \
+    pd.particle = s.point;                     \
+    pd.points = pts;                           \
+    pd.point_count = 5;                        \
+  } while (0)
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_polyline_support_create(NULL, &pd, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_polyline_support_create(s.w, NULL, &out));
+  GOOD_POLYLINE();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_polyline_support_create(s.w, &pd, NULL));
+  pd.version = 2;
+  REFUSED_SAVED(EMBRA_ERROR_VERSION, "version", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.points = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.point_count = 0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = 1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "point_count", before, s.w,
+                embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "point_count", before, s.w,
+                embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.point_count = 2;
+  pd.closed = 1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "closed", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.closed = 2;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "closed", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.group = g_ref.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  for (i = 0; i < 3; ++i) {
+    GOOD_POLYLINE();
+    pd.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+    for (k = 0; k < 15; k += 4) {
+      double bad[3 * 5];
+      memcpy(bad, pts, sizeof bad);
+      bad[k] = bad_value(i);
+      CAPI_CONTEXT("points[%d] = %s", k, bad_name(i));
+      GOOD_POLYLINE();
+      pd.points = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+    }
+  }
+  CAPI_CONTEXT("degenerate segments");
+  {
+    double repeated[3 * 5];
+    memcpy(repeated, pts, sizeof repeated);
+    memcpy(&repeated[6], &repeated[3], 3 * sizeof(double)); /* point 2 = point 1 */
+    GOOD_POLYLINE();
+    pd.points = repeated;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero length", before, s.w,
+                  embra_polyline_support_create(s.w, &pd, &out));
+    memcpy(repeated, pts, sizeof repeated);
+    memcpy(&repeated[12], &repeated[0], 3 * sizeof(double)); /* last = first: degenerate when closed */
+    pd.closed = 1;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero length", before, s.w,
+                  embra_polyline_support_create(s.w, &pd, &out));
+  }
+#undef GOOD_POLYLINE
+  CAPI_CONTEXT("embra_support_create");
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_POLYLINE; /* its curve comes through embra_polyline_support_create */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "embra_polyline_support_create", before, s.w,
+                embra_support_create(s.w, &sd, &out));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -1834,6 +1938,7 @@ int main(void) {
   RUN(test_particles);
   RUN(test_statics);
   RUN(test_distributed_loads);
+  RUN(test_polyline_supports);
   RUN(test_step);
   return capi_test_finish();
 }

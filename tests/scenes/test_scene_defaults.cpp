@@ -234,6 +234,7 @@ std::map<std::string, std::vector<json>> code_defaults() {
   const embra_support_def support = embra_default_support_def();
   c[d + "pin/properties/support"] = {json("point")};
   c[d + "pin/properties/axis"] = {json::array({support.axis[0], support.axis[1], support.axis[2]})};
+  c[d + "pin/properties/closed"] = {json(embra_default_polyline_support_def().closed == 1)};
 
   const embra_collider_def col = embra_default_collider_def();
   const json& capsule = saved["colliders"][0];

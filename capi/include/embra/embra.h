@@ -555,9 +555,15 @@ EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def*
  * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
  * the plane or across the line. */
 enum {
-  EMBRA_PIN_SUPPORT_POINT = 0, /* the particle held at the target: embra_pin_create's pin */
-  EMBRA_PIN_SUPPORT_PLANE = 1, /* on the plane through the target, normal `axis` */
-  EMBRA_PIN_SUPPORT_LINE = 2   /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POINT = 0,   /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1,   /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2,    /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of the polyline `points` (offsets from the
+                                    target, so embra_pin_set_target moves the curve), open or
+                                    `closed`: inside a segment it slides along it and its reaction
+                                    is normal to the segment; at a vertex it is held there until
+                                    pulled along a segment. The closest point is searched over
+                                    every segment at every projection (cost linear in points) */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
@@ -576,8 +582,33 @@ typedef struct embra_support_def {
 EMBRA_API embra_support_def embra_default_support_def(void);
 /* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
  * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
- * (or one too short to normalise), a negative or non-finite compliance, a stale group. */
+ * (or one too short to normalise), a negative or non-finite compliance, a stale group;
+ * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create). */
 EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
+
+/* A support on a polyline curve (EMBRA_PIN_SUPPORT_POLYLINE): a pin that holds its particle on the
+ * closest point of the polyline through `points` (open, or closed back to its first point), the
+ * points offsets from `target`, so embra_pin_set_target moves the curve as a host moves a collider.
+ * Frictionless, hard or compliant, projected in its group like the other supports. */
+#define EMBRA_POLYLINE_SUPPORT_DEF_VERSION 1
+typedef struct embra_polyline_support_def {
+  int32_t version;      /* EMBRA_POLYLINE_SUPPORT_DEF_VERSION */
+  int32_t particle;     /* world particle index */
+  double target[3];     /* m: the curve's origin; default {0, 0, 0} (the points are world points) */
+  int32_t point_count;  /* [2, EMBRA_MAX_PARTICLES]; at least 3 when closed */
+  int32_t closed;       /* 1: the last point joins the first; 0 (default): open */
+  const double* points; /* double[3 * point_count], m, offsets from target (copied at creation); no
+                           two consecutive points equal (nor the last and the first when closed) */
+  double compliance;    /* 0 (default) = hard; > 0: m/N */
+  embra_group_id group; /* its group; {0,0} = default group */
+} embra_polyline_support_def;
+
+EMBRA_API embra_polyline_support_def embra_default_polyline_support_def(void);
+/* Creates a polyline support. Refused: a particle out of range, a point count out of range, NULL
+ * points, a non-finite target or point, a degenerate (zero-length) segment, `closed` other than 0
+ * or 1, a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_polyline_support_create(embra_world* world, const embra_polyline_support_def* def,
+                                                     embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The

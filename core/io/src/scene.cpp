@@ -658,7 +658,7 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
 
 /// The pin supports' names in the scene format, by PinSupport.
-constexpr const char* kPinSupportNames[] = {"point", "plane", "line"};
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline"};
 static_assert(std::size(kPinSupportNames) == kPinSupportCount);
 
 /// The area load modes' names in the scene format, by AreaLoadMode.
@@ -1416,6 +1416,9 @@ class Builder {
         for (int k = 0; k < kPinSupportCount; ++k)
           if (p["support"] == kPinSupportNames[k]) d.support = static_cast<PinSupport>(k);
       if (p.contains("axis")) d.axis = vec3(p["axis"]);
+      if (p.contains("points"))
+        for (const json& c : p["points"]) d.curve.push_back(vec3(c));
+      d.closed = p.contains("closed") && p["closed"].get<bool>();
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1677,7 +1680,13 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     json j = {{"name", pin_name[i]}, {"particle", p.particle}};
     write_rows(kPinRows, PinDesc{p.particle, p.target, p.compliance, p.group}, j);
     if (!p.kinematic()) j["group"] = group_name(p.group);
-    if (p.support != PinSupport::point) {
+    if (p.support == PinSupport::polyline) {
+      j["support"] = kPinSupportNames[static_cast<int>(p.support)];
+      json points = json::array();
+      for (const Vec3& c : p.curve) points.push_back(vec_json(c));
+      j["points"] = points;
+      j["closed"] = p.closed;
+    } else if (p.support != PinSupport::point) {
       j["support"] = kPinSupportNames[static_cast<int>(p.support)];
       j["axis"] = vec_json(p.axis);
     }

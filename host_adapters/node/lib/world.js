@@ -801,6 +801,34 @@ class World {
     return new PinId(pin.index, pin.generation);
   }
 
+  /**
+   * A frictionless support on a polyline (embra_polyline_support_create): `particle` held on the
+   * closest point of the polyline through `points` (xyz per point, m, offsets from the target, so
+   * setPinTarget moves the curve). Options: target (default [0, 0, 0]), closed (true joins its ends),
+   * compliance (0 hard, else m/N), group. Returns its PinId.
+   */
+  createPolylineSupport(particle, points, opts) {
+    const o = options(opts, 'createPolylineSupport options');
+    const d = lib.embra_default_polyline_support_def();
+    d.particle = buf.int32(particle, 'particle');
+    const xyz = buf.doublesIn(points, 'points');
+    if (xyz === null) throw new TypeError('points: required');
+    d.points = xyz;
+    d.point_count = xyzCount(xyz, 'points');
+    if (o.has('target')) d.target = buf.fixed(take(o, 'target'), 3, 'target');
+    if (o.has('closed')) {
+      const closed = take(o, 'closed');
+      if (typeof closed !== 'boolean') throw new TypeError(`closed: expected true or false, got ${buf.describe(closed)}`);
+      d.closed = closed ? 1 : 0;
+    }
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createPolylineSupport: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_polyline_support_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
   destroyPin(pin) {
     this.#call('embra_pin_destroy', toId(pin, PinId, 'pin'));
   }

@@ -24,6 +24,7 @@ CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
 SUPPORT_DEF_VERSION = 1
+POLYLINE_SUPPORT_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
 SOLVE_RESIDUAL_TARGET_M = 1e-4
 SOLVE_RESIDUAL_TARGET_RAD = 1e-3
@@ -72,6 +73,7 @@ CONSTRAINT_EQUAL_LENGTH = 8
 PIN_SUPPORT_POINT = 0
 PIN_SUPPORT_PLANE = 1
 PIN_SUPPORT_LINE = 2
+PIN_SUPPORT_POLYLINE = 3
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -119,7 +121,7 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8}
-PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
@@ -303,6 +305,20 @@ class SupportDef(_Struct):
         ("reserved0", c_int32),
         ("target", c_double * 3),
         ("axis", c_double * 3),
+        ("compliance", c_double),
+        ("group", GroupId),
+    ]
+
+
+class PolylineSupportDef(_Struct):
+    """embra_polyline_support_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("particle", c_int32),
+        ("target", c_double * 3),
+        ("point_count", c_int32),
+        ("closed", c_int32),
+        ("points", POINTER(c_double)),
         ("compliance", c_double),
         ("group", GroupId),
     ]
@@ -646,6 +662,8 @@ PROTOTYPES = {
     "embra_pin_create": (c_int32, [c_void_p, POINTER(PinDef), POINTER(PinId)]),
     "embra_default_support_def": (SupportDef, []),
     "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
+    "embra_default_polyline_support_def": (PolylineSupportDef, []),
+    "embra_polyline_support_create": (c_int32, [c_void_p, POINTER(PolylineSupportDef), POINTER(PinId)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),

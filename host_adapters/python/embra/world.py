@@ -669,6 +669,28 @@ class World:
         self._call("embra_support_create", byref(d), byref(pin))
         return pin
 
+    def create_polyline_support(self, particle, points, target=(0.0, 0.0, 0.0), closed=False, compliance=0.0,
+                                group=None):
+        """A frictionless support on a polyline (embra_polyline_support_create): `particle` held on the
+        closest point of the polyline through `points` ((n, 3), m, offsets from `target`, so
+        set_pin_target moves the curve); `closed` joins its ends; compliance 0 = hard, > 0 m/N;
+        projected in `group`. Returns its PinId."""
+        d = lib.embra_default_polyline_support_def()
+        d.particle = buf.int32(particle, "particle")
+        d.target = buf.d3(target, "target")
+        d.closed = 1 if closed else 0
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        buf.check_rows(points, 3, "points")
+        p, n, keep = buf.doubles_in(points, "points")
+        if n % 3:
+            raise ValueError(f"points: {n} numbers is not a whole number of xyz triples")
+        d.points, d.point_count = p, buf.int32(n // 3, "point count")
+        pin = PinId()
+        self._call("embra_polyline_support_create", byref(d), byref(pin))
+        del keep
+        return pin
+
     def destroy_pin(self, pin):
         self._call("embra_pin_destroy", _id(pin, PinId, "pin"))
 

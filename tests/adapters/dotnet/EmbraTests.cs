@@ -703,6 +703,53 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A bead on a vertical circle-shaped polyline (48 segments, radius 0.6) swings under
+        /// gravity and stays on it to 1e-9 m at every frame (distance to every segment computed here).</summary>
+        [Test]
+        public void PolylineSupportHoldsABeadOnACircle()
+        {
+            int n = 48;
+            var pts = new double[3 * n];
+            for (int k = 0; k < n; ++k)
+            {
+                double a = -Math.PI / 2 + Math.PI / n + 2 * Math.PI * k / n;
+                pts[3 * k] = 0.6 * Math.Cos(a);
+                pts[3 * k + 2] = 0.6 * Math.Sin(a);
+            }
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 8;
+            solver.Iterations = 2;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0.6, 0, 0.1 }, masses: new[] { 0.3 }, def: def);
+                var pin = w.CreatePolylineSupport(0, pts, closed: true);
+                double low = double.PositiveInfinity;
+                for (int f = 0; f < 60; ++f)
+                {
+                    w.Step();
+                    var q = w.GetPositions();
+                    double best = double.PositiveInfinity;
+                    for (int s = 0; s < n; ++s)
+                    {
+                        int b = (s + 1) % n;
+                        double ex = pts[3 * b] - pts[3 * s], ez = pts[3 * b + 2] - pts[3 * s + 2];
+                        double t = ((q[0] - pts[3 * s]) * ex + (q[2] - pts[3 * s + 2]) * ez) / (ex * ex + ez * ez);
+                        t = Math.Min(1.0, Math.Max(0.0, t));
+                        double dx = q[0] - pts[3 * s] - t * ex, dz = q[2] - pts[3 * s + 2] - t * ez;
+                        best = Math.Min(best, Math.Sqrt(dx * dx + q[1] * q[1] + dz * dz));
+                    }
+                    Assert.Less(best, 1e-9);
+                    low = Math.Min(low, q[2]);
+                }
+                Assert.Less(low, -0.5);
+                Assert.AreEqual(pin, w.Reactions()[0].Pin);
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePolylineSupport(0, new double[] { 0, 0, 0, 0, 0, 0 }));
+            }
+        }
+
         /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
         /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
         [Test]

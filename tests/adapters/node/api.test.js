@@ -158,6 +158,41 @@ test('area and line loads push free particles by p A / 3 and q L / 2, and read b
   w.close();
 });
 
+test('a polyline support holds a bead on a circle while it swings', () => {
+  const pts = [];
+  for (let k = 0; k < 48; k++) {
+    const a = -Math.PI / 2 + Math.PI / 48 + 2 * Math.PI * k / 48;
+    pts.push([0.6 * Math.cos(a), 0, 0.6 * Math.sin(a)]);
+  }
+  const distance = (q) => {
+    let best = Infinity;
+    for (let s = 0; s < pts.length; s++) {
+      const a = pts[s];
+      const b = pts[(s + 1) % pts.length];
+      const e = [0, 1, 2].map((k) => b[k] - a[k]);
+      const t = Math.min(1, Math.max(0, [0, 1, 2].reduce((acc, k) => acc + (q[k] - a[k]) * e[k], 0) /
+        e.reduce((acc, c) => acc + c * c, 0)));
+      best = Math.min(best, Math.hypot(...[0, 1, 2].map((k) => q[k] - a[k] - t * e[k])));
+    }
+    return best;
+  };
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 8, iterations: 2, tethers: 0 });
+  w.createBody([[0.6, 0, 0.1]], { generate: 0, masses: [0.3] });
+  const pin = w.createPolylineSupport(0, pts, { closed: true });
+  let low = Infinity;
+  for (let f = 0; f < 60; f++) {
+    w.step();
+    const q = Array.from(w.positions());
+    assert.ok(distance(q) < 1e-9);
+    low = Math.min(low, q[2]);
+  }
+  assert.ok(low < -0.5);
+  assert.ok(w.reactions()[0].pin.equals(pin));
+  assert.throws(() => w.createPolylineSupport(0, [pts[0], pts[0], pts[1]]),
+    embra.EmbraError);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];

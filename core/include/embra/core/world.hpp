@@ -8,6 +8,7 @@
 #pragma once
 
 #include "embra/core/constraint_math.hpp"
+#include "embra/core/curves.hpp"
 #include "embra/core/fields.hpp"
 #include "embra/core/kinds.hpp"
 #include "embra/core/loads.hpp"
@@ -117,8 +118,10 @@ struct ConstraintInfo {
 /// support lets its particle slide, frictionless, on the plane through the target normal to `axis`
 /// or on the line through it along `axis`; a per-axis anchor (a roller) is a plane (one coordinate
 /// held: its axis the normal) or a line (two held: the third the line).
-enum class PinSupport : int32_t { point = 0, plane = 1, line = 2 };
-constexpr int kPinSupportCount = 3;
+/// A polyline support holds its particle on the closest point of a polyline (open, or closed back to
+/// its first point) whose points are offsets from the target: moving the target moves the curve.
+enum class PinSupport : int32_t { point = 0, plane = 1, line = 2, polyline = 3 };
+constexpr int kPinSupportCount = 4;
 
 struct PinDesc {
   int32_t particle = 0;
@@ -127,6 +130,10 @@ struct PinDesc {
   Id group;                 // group of a soft pin or a support; null = the default group
   PinSupport support = PinSupport::point;
   Vec3 axis = Vec3(0.0, 0.0, 1.0);  // plane: its normal; line: its direction (any length > 0)
+  // polyline: its points (m, offsets from the target), at least 2 (closed: 3), no two consecutive
+  // ones equal (nor the last and the first, closed), at most limits::kMaxParticles
+  std::vector<Vec3> curve{};
+  bool closed = false;
 };
 
 /// The numbering is part of the C ABI (embra_collider_shape).
@@ -407,6 +414,8 @@ struct Pin {
   Id group;
   PinSupport support = PinSupport::point;
   Vec3 axis = Vec3(0.0, 0.0, 1.0);  // unit
+  std::vector<Vec3> curve;          // polyline: its points, offsets from the target
+  bool closed = false;
   Vec3 lambda = Vec3::Zero();
   uint32_t generation = 0;
   bool alive = false;
@@ -415,12 +424,15 @@ struct Pin {
   bool kinematic() const { return compliance == 0.0 && support == PinSupport::point; }
   /// The part of d (the particle's offset from the target) the pin holds: all of it for a point,
   /// its part along the normal for a plane, its part across the line for a line.
+  /// For a polyline: d less the closest point of the curve (the offset from it).
   Vec3 held(const Vec3& d) const {
     switch (support) {
       case PinSupport::plane:
         return axis.dot(d) * axis;
       case PinSupport::line:
         return d - axis.dot(d) * axis;
+      case PinSupport::polyline:
+        return d - closest_point_on_polyline(curve, closed, d).point;
       case PinSupport::point:
         break;
     }
