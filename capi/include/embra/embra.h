@@ -558,12 +558,12 @@ enum {
   EMBRA_PIN_SUPPORT_POINT = 0,   /* the particle held at the target: embra_pin_create's pin */
   EMBRA_PIN_SUPPORT_PLANE = 1,   /* on the plane through the target, normal `axis` */
   EMBRA_PIN_SUPPORT_LINE = 2,    /* on the line through the target, along `axis` */
-  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of the polyline `points` (offsets from the
-                                    target, so embra_pin_set_target moves the curve), open or
-                                    `closed`: inside a segment it slides along it and its reaction
-                                    is normal to the segment; at a vertex it is held there until
-                                    pulled along a segment. The closest point is searched over
-                                    every segment at every projection (cost linear in points) */
+  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of a polyline, made by
+                                    embra_polyline_support_create (below): inside a segment it
+                                    slides along it and its reaction is normal to the segment; at
+                                    a vertex it is held there until pulled along a segment. The
+                                    closest point is searched over every segment at every
+                                    projection (cost linear in the points) */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
