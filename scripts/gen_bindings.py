@@ -45,6 +45,7 @@ SCHEMA_ENUMS: List[Tuple[Tuple[str, ...], str]] = [
     (("definitions", "constraint_batch", "properties", "kind", "enum"), "CONSTRAINT"),
     (("definitions", "collider", "properties", "shape", "enum"), "COLLIDER"),
     (("definitions", "pin", "properties", "support", "enum"), "PIN_SUPPORT"),
+    (("definitions", "area_load", "properties", "mode", "enum"), "AREA_LOAD"),
 ]
 
 # The C enums the C ABI casts to a core enum: group prefix -> (core enum, core count constant or
@@ -55,15 +56,18 @@ CORE_ENUMS: Dict[str, Tuple[str, Optional[str]]] = {
     "COLLIDER": ("embra::ColliderShape", "embra::kColliderShapeCount"),
     "PANEL_PINS": ("embra::PanelPins", None),
     "PIN_SUPPORT": ("embra::PinSupport", "embra::kPinSupportCount"),
+    "AREA_LOAD": ("embra::AreaLoadMode", "embra::kAreaLoadModeCount"),
     "PANEL_METRIC": ("embra::PanelMetric", "embra::kPanelMetricCount"),
     "SOLVE_UNTIL": ("embra::SolveUntil", None),
     "SOLVE": ("embra::SolveOutcome", None),
 }
 
 # C# names of enum groups where the PascalCase of the prefix is not the name.
-DOTNET_ENUM_NAMES = {"CUTS": "CutsFormat"}
+DOTNET_ENUM_NAMES = {"CUTS": "CutsFormat", "AREA_LOAD": "AreaLoadMode"}
 # C# parameters passed as an [In] array of one struct (or null): nullable struct pointers.
 DOTNET_NULLABLE_IN = {("embra_panel_mesh_get_metrics", "tolerances")}
+# C# parameters passed as an [In] array of structs: const struct pointers to `count` elements.
+DOTNET_STRUCT_ARRAYS_IN = {("embra_world_set_area_loads", "loads"), ("embra_world_set_line_loads", "loads")}
 
 SCALARS = {"int32_t", "uint32_t", "int64_t", "double", "char", "void"}
 
@@ -499,7 +503,7 @@ def cs_param(h: Header, fn: Function, i: int) -> str:
         return f"{base} {name}"
     if t.pointers > 1:
         raise ParseError(f"{fn.name}({p.name}): pointer to pointer unsupported")
-    if (fn.name, p.name) in DOTNET_NULLABLE_IN:
+    if (fn.name, p.name) in DOTNET_NULLABLE_IN or (fn.name, p.name) in DOTNET_STRUCT_ARRAYS_IN:
         return f"[In] {base}[] {name}"
     if is_out(h, fn, i):
         return f"out {base} {name}"

@@ -37,7 +37,13 @@ static_assert(static_cast<int>(embra::PanelPins::top_and_bottom_corners) == 2, "
 static_assert(static_cast<int>(embra::PinSupport::point) == 0, "embra::PinSupport::point is EMBRA_PIN_SUPPORT_POINT = 0");
 static_assert(static_cast<int>(embra::PinSupport::plane) == 1, "embra::PinSupport::plane is EMBRA_PIN_SUPPORT_PLANE = 1");
 static_assert(static_cast<int>(embra::PinSupport::line) == 2, "embra::PinSupport::line is EMBRA_PIN_SUPPORT_LINE = 2");
-static_assert(embra::kPinSupportCount == 3, "embra::PinSupport and the 3 EMBRA_PIN_SUPPORT_* values differ");
+static_assert(static_cast<int>(embra::PinSupport::polyline) == 3, "embra::PinSupport::polyline is EMBRA_PIN_SUPPORT_POLYLINE = 3");
+static_assert(embra::kPinSupportCount == 4, "embra::PinSupport and the 4 EMBRA_PIN_SUPPORT_* values differ");
+
+static_assert(static_cast<int>(embra::AreaLoadMode::normal) == 0, "embra::AreaLoadMode::normal is EMBRA_AREA_LOAD_NORMAL = 0");
+static_assert(static_cast<int>(embra::AreaLoadMode::true_area) == 1, "embra::AreaLoadMode::true_area is EMBRA_AREA_LOAD_TRUE_AREA = 1");
+static_assert(static_cast<int>(embra::AreaLoadMode::projected_area) == 2, "embra::AreaLoadMode::projected_area is EMBRA_AREA_LOAD_PROJECTED_AREA = 2");
+static_assert(embra::kAreaLoadModeCount == 3, "embra::AreaLoadMode and the 3 EMBRA_AREA_LOAD_* values differ");
 
 static_assert(static_cast<int>(embra::PanelMetric::planarity) == 0, "embra::PanelMetric::planarity is EMBRA_PANEL_METRIC_PLANARITY = 0");
 static_assert(static_cast<int>(embra::PanelMetric::thickness) == 1, "embra::PanelMetric::thickness is EMBRA_PANEL_METRIC_THICKNESS = 1");

@@ -1,7 +1,9 @@
 // Pins: hard or soft attachments of a particle to a target, and sliding supports (a pin that holds
-// its particle on a plane or a line through the target).
+// its particle on a plane or a line through the target, or on a polyline).
 #include "copy.hpp"
 #include "guard.hpp"
+
+#include "embra/core/limits.hpp"
 
 using namespace embra::capi;
 
@@ -54,10 +56,45 @@ embra_status embra_support_create(embra_world* world, const embra_support_def* d
     need_version(def->version, EMBRA_SUPPORT_DEF_VERSION, "embra_support_def");
     if (def->support < 0 || def->support >= embra::kPinSupportCount)
       refuse(EMBRA_ERROR_INVALID_ARGUMENT, "support " + num(def->support) + " is not an EMBRA_PIN_SUPPORT_* value");
+    if (def->support == EMBRA_PIN_SUPPORT_POLYLINE)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+             "a polyline support is made by embra_polyline_support_create (its def carries the curve)");
     embra::PinDesc d;
     to_core(kSupportCopies, *def, d);
     d.support = static_cast<embra::PinSupport>(def->support);
     d.group = to_id(def->group);
+    *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
+  });
+}
+
+embra_polyline_support_def embra_default_polyline_support_def(void) {
+  embra_polyline_support_def d{};
+  d.version = EMBRA_POLYLINE_SUPPORT_DEF_VERSION;
+  const embra::PinDesc core;
+  for (int k = 0; k < 3; ++k) d.target[k] = core.target[k];
+  d.compliance = core.compliance;
+  return d;
+}
+
+embra_status embra_polyline_support_create(embra_world* world, const embra_polyline_support_def* def,
+                                           embra_pin_id* out_pin) {
+  return guard("embra_polyline_support_create", world, [&] {
+    need(def, "def");
+    need(out_pin, "out_pin");
+    need_version(def->version, EMBRA_POLYLINE_SUPPORT_DEF_VERSION, "embra_polyline_support_def");
+    need_flag(def->closed, "def.closed");
+    if (def->point_count < 0 || def->point_count > embra::limits::kMaxParticles)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.point_count " + num(def->point_count) + " is out of range");
+    const std::span<const double> xyz = view(def->points, 3 * static_cast<int64_t>(def->point_count), "def.points");
+    embra::PinDesc d;
+    d.particle = def->particle;
+    d.target = vec(def->target);
+    d.compliance = def->compliance;
+    d.group = to_id(def->group);
+    d.support = embra::PinSupport::polyline;
+    d.curve.reserve(static_cast<size_t>(def->point_count));
+    for (size_t i = 0; i + 2 < xyz.size(); i += 3) d.curve.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+    d.closed = def->closed == 1;
     *out_pin = from_id<embra_pin_id>(world->world.create_pin(d));
   });
 }

@@ -401,4 +401,65 @@ embra_status embra_world_get_loads(const embra_world* world, double* out_xyz, in
                [&] { read_particles(world->world, world->world.loads(), capacity, first, count, out_xyz); });
 }
 
+embra_status embra_world_set_area_loads(embra_world* world, const embra_area_load* loads, int32_t count) {
+  return guard("embra_world_set_area_loads", world, [&] {
+    need_count(count, "count");
+    std::vector<embra::AreaLoad> core;
+    core.reserve(static_cast<size_t>(count));
+    for (const embra_area_load& l : view(loads, count, "loads")) {
+      embra::AreaLoad& a = core.emplace_back();
+      for (int k = 0; k < 3; ++k) a.particles[k] = l.particles[k];
+      a.mode = static_cast<embra::AreaLoadMode>(l.mode);  // World::set_area_loads refuses an unknown one
+      a.pressure = l.pressure;
+      a.direction = vec(l.direction);
+    }
+    world->world.set_area_loads(core);
+  });
+}
+
+embra_status embra_world_get_area_loads(const embra_world* world, embra_area_load* out, int32_t capacity,
+                                        int32_t* out_count) {
+  return guard("embra_world_get_area_loads", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::AreaLoad>& loads = world->world.area_loads();
+    const int32_t n = static_cast<int32_t>(loads.size());
+    if (fits(out, capacity, n, "area loads"))
+      for (int32_t i = 0; i < n; ++i) {
+        const embra::AreaLoad& l = loads[i];
+        out[i] = embra_area_load{{l.particles[0], l.particles[1], l.particles[2]},
+                                 static_cast<int32_t>(l.mode),
+                                 l.pressure,
+                                 {l.direction.x(), l.direction.y(), l.direction.z()}};
+      }
+    *out_count = n;
+  });
+}
+
+embra_status embra_world_set_line_loads(embra_world* world, const embra_line_load* loads, int32_t count) {
+  return guard("embra_world_set_line_loads", world, [&] {
+    need_count(count, "count");
+    std::vector<embra::LineLoad> core;
+    core.reserve(static_cast<size_t>(count));
+    for (const embra_line_load& l : view(loads, count, "loads"))
+      core.push_back(embra::LineLoad{{l.particles[0], l.particles[1]}, vec(l.load)});
+    world->world.set_line_loads(core);
+  });
+}
+
+embra_status embra_world_get_line_loads(const embra_world* world, embra_line_load* out, int32_t capacity,
+                                        int32_t* out_count) {
+  return guard("embra_world_get_line_loads", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::LineLoad>& loads = world->world.line_loads();
+    const int32_t n = static_cast<int32_t>(loads.size());
+    if (fits(out, capacity, n, "line loads"))
+      for (int32_t i = 0; i < n; ++i)
+        out[i] = embra_line_load{{loads[i].particles[0], loads[i].particles[1]},
+                                 {loads[i].load.x(), loads[i].load.y(), loads[i].load.z()}};
+    *out_count = n;
+  });
+}
+
 }  // extern "C"

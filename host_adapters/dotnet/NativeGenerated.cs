@@ -42,7 +42,7 @@ namespace Embra
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
-    public enum PinSupport { Point = 0, Plane = 1, Line = 2 }
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }
 
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
@@ -55,6 +55,9 @@ namespace Embra
 
     /// <summary>EMBRA_SOLVE_*.</summary>
     public enum Solve { SettledWithinTolerance = 0, SettledOutOfTolerance = 1, Oscillating = 2, Drifting = 3 }
+
+    /// <summary>EMBRA_AREA_LOAD_*.</summary>
+    public enum AreaLoadMode { Normal = 0, TrueArea = 1, ProjectedArea = 2 }
 
     /// <summary>EMBRA_PANEL_PINS_*.</summary>
     public enum PanelPins { None = 0, TopCorners = 1, TopAndBottomCorners = 2 }
@@ -239,6 +242,21 @@ namespace Embra
         public GroupId Group;
     }
 
+    /// <summary>embra_polyline_support_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct PolylineSupportDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Particle;
+        public fixed double Target[3];
+        public int PointCount;
+        public int Closed;
+        public IntPtr Points;
+        public double Compliance;
+        public GroupId Group;
+    }
+
     /// <summary>embra_collider_def.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct ColliderDef
@@ -365,6 +383,24 @@ namespace Embra
         public long Frame;
         public int Particle;
         public int Reserved0;
+    }
+
+    /// <summary>embra_area_load.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct AreaLoad
+    {
+        public fixed int Particles[3];
+        public int Mode;
+        public double Pressure;
+        public fixed double Direction[3];
+    }
+
+    /// <summary>embra_line_load.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct LineLoad
+    {
+        public fixed int Particles[2];
+        public fixed double Load[3];
     }
 
     /// <summary>embra_panel_mesh_def.</summary>
@@ -575,6 +611,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_create(IntPtr world, ref PinDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern SupportDef embra_default_support_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern PolylineSupportDef embra_default_polyline_support_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_create(IntPtr world, ref PolylineSupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);
@@ -605,6 +643,10 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_velocities(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_loads(IntPtr world, double[] xyz, int first, int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_loads(IntPtr world, [Out] double[] xyz, long capacity, int first, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_area_loads(IntPtr world, [In] AreaLoad[] loads, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_area_loads(IntPtr world, [Out] AreaLoad[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_line_loads(IntPtr world, [In] LineLoad[] loads, int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_line_loads(IntPtr world, [Out] LineLoad[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_body_get_triangles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_export_obj(IntPtr world, [Out] byte[] buffer, long capacity, out long length);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_write_obj(IntPtr world, byte[] path);

@@ -717,6 +717,32 @@ namespace Embra
             return pin;
         }
 
+        /// <summary>A frictionless support on a polyline (embra_polyline_support_create): the particle held
+        /// on the closest point of the polyline through `points` (xyz per point, m, offsets from `target`,
+        /// so SetPinTarget moves the curve); `closed` joins its ends. Compliance 0 = hard, else m/N.</summary>
+        public PinId CreatePolylineSupport(int particle, double[] points, double[] target = null, bool closed = false,
+                                           double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(points != null && points.Length % 3 == 0, "points: a whole number of xyz triples is required");
+            if (target != null) Three(target, "target");
+            var def = Native.embra_default_polyline_support_def();
+            def.Particle = particle;
+            if (target != null)
+                for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            def.Closed = closed ? 1 : 0;
+            def.Compliance = compliance;
+            def.Group = group;
+            var pin = new PinId();
+            fixed (double* p = points)
+            {
+                def.Points = (IntPtr)p;
+                def.PointCount = points.Length / 3;
+                var d = def;
+                Call(w => Native.embra_polyline_support_create(w, ref d, out pin));
+            }
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");
@@ -1011,6 +1037,55 @@ namespace Embra
             Need(xyz != null && xyz.Length % 3 == 0, "xyz: a whole number of xyz triples is required");
             Call(w => Native.embra_world_set_loads(w, xyz, first, xyz.Length / 3));
         }
+
+        /// <summary>An area load (embra_area_load) on the triangle of three distinct particles: pressure in
+        /// Pa, along the triangle's normal (AreaLoadMode.Normal) or along `direction` per true or per
+        /// projected area (TrueArea, ProjectedArea; the direction of any nonzero length).</summary>
+        public static AreaLoad MakeAreaLoad(int a, int b, int c, double pressure, AreaLoadMode mode = AreaLoadMode.Normal,
+                                            double[] direction = null)
+        {
+            Need(direction == null || direction.Length == 3, "direction: 3 numbers are required");
+            var l = new AreaLoad { Mode = (int)mode, Pressure = pressure };
+            l.Particles[0] = a;
+            l.Particles[1] = b;
+            l.Particles[2] = c;
+            for (int k = 0; k < 3; ++k) l.Direction[k] = direction == null ? (k == 2 ? -1.0 : 0.0) : direction[k];
+            return l;
+        }
+
+        /// <summary>A line load (embra_line_load): `load` N per m of the edge between two distinct particles.</summary>
+        public static LineLoad MakeLineLoad(int a, int b, double[] load)
+        {
+            Need(load != null && load.Length == 3, "load: 3 numbers are required");
+            var l = new LineLoad();
+            l.Particles[0] = a;
+            l.Particles[1] = b;
+            for (int k = 0; k < 3; ++k) l.Load[k] = load[k];
+            return l;
+        }
+
+        /// <summary>Replaces the area loads (embra_world_set_area_loads): a third of each triangle's force
+        /// on each corner, every substep beside gravity, until set again; an empty array removes them.
+        /// Refused, changing nothing, as the C ABI refuses.</summary>
+        public void SetAreaLoads(AreaLoad[] loads)
+        {
+            Need(loads != null, "loads: an array is required");
+            Call(w => Native.embra_world_set_area_loads(w, loads, loads.Length));
+        }
+
+        /// <summary>The area loads as set.</summary>
+        public AreaLoad[] AreaLoads() { return Ids<AreaLoad>(Native.embra_world_get_area_loads); }
+
+        /// <summary>Replaces the line loads (embra_world_set_line_loads): half of each edge's force on each
+        /// end, every substep beside gravity, until set again.</summary>
+        public void SetLineLoads(LineLoad[] loads)
+        {
+            Need(loads != null, "loads: an array is required");
+            Call(w => Native.embra_world_set_line_loads(w, loads, loads.Length));
+        }
+
+        /// <summary>The line loads as set.</summary>
+        public LineLoad[] LineLoads() { return Ids<LineLoad>(Native.embra_world_get_line_loads); }
 
         // --- JSON scenes ------------------------------------------------------------------------
         public string SaveJson() { return Text(Native.embra_world_save_json); }

@@ -1247,7 +1247,7 @@ static void test_pins(void) {
     sd.particle = g_ref.n;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
     GOOD_SUPPORT();
-    sd.support = 3;
+    sd.support = 4;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
     sd.support = -1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
@@ -1711,6 +1711,243 @@ static void test_statics(void) {
   }
 }
 
+/* The world's scene JSON, malloc'ed (NULL on failure). */
+static char* saved_json(const embra_world* w) {
+  int64_t n = 0;
+  char* text;
+  if (embra_world_save_json(w, NULL, 0, &n) != EMBRA_OK || n <= 0) return NULL;
+  text = (char*)malloc((size_t)n);
+  if (text != NULL && embra_world_save_json(w, text, n, &n) != EMBRA_OK) {
+    free(text);
+    return NULL;
+  }
+  return text;
+}
+
+/* A refused call on s's world: the status, a message naming the function and `needle`, and the
+ * saved scene byte-identical to `before`. */
+#define REFUSED_SAVED(expected, needle, before, w, ...)                                   \
+  do {                                                                                    \
+    char* after_;                                                                         \
+    prime_message();                                                                      \
+    check_refusal(__FILE__, __LINE__, #__VA_ARGS__, (__VA_ARGS__), (expected), (needle)); \
+    after_ = saved_json(w);                                                               \
+    CHECK(after_ != NULL && (before) != NULL && strcmp(after_, (before)) == 0);           \
+    free(after_);                                                                         \
+  } while (0)
+
+/* Area and line loads: every argument checked; a refused call leaves the saved scene as it was. */
+static void test_distributed_loads(void) {
+  scene s;
+  char* before;
+  embra_area_load area[2], bad, got[2];
+  embra_line_load line[1], badl, gotl[1];
+  int32_t n = -1;
+  int i, k;
+  CHECK(scene_build(&s));
+  for (i = 0; i < 2; ++i) {
+    area[i].particles[0] = s.cloth;
+    area[i].particles[1] = s.cloth + 1;
+    area[i].particles[2] = s.cloth + 2 + i;
+    area[i].mode = i == 0 ? EMBRA_AREA_LOAD_NORMAL : EMBRA_AREA_LOAD_PROJECTED_AREA;
+    area[i].pressure = 25.0 + i;
+    area[i].direction[0] = 0.0;
+    area[i].direction[1] = 0.0;
+    area[i].direction[2] = -3.0;
+  }
+  line[0].particles[0] = s.cloth;
+  line[0].particles[1] = s.cloth + 3;
+  line[0].load[0] = 1.0;
+  line[0].load[1] = 0.0;
+  line[0].load[2] = -40.0;
+  CHECK_OK(embra_world_set_area_loads(s.w, area, 2));
+  CHECK_OK(embra_world_set_line_loads(s.w, line, 1));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"area_loads\"") != NULL && strstr(before, "\"line_loads\"") != NULL);
+
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_world_set_area_loads(NULL, area, 1));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "loads", before, s.w, embra_world_set_area_loads(s.w, NULL, 1));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "count", before, s.w, embra_world_set_area_loads(s.w, area, -1));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "loads", before, s.w, embra_world_set_line_loads(s.w, NULL, 1));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "count", before, s.w, embra_world_set_line_loads(s.w, line, -1));
+  for (k = 0; k < 3; ++k) {
+    const int32_t out_of_range[3] = {-1, s.n, INT32_MAX};
+    CAPI_CONTEXT("corner %d", k);
+    for (i = 0; i < 3; ++i) {
+      embra_area_load two[2];
+      two[0] = area[0];
+      two[1] = area[1];
+      two[1].particles[k] = out_of_range[i]; /* all or nothing: the first load is not set either */
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_world_set_area_loads(s.w, two, 2));
+    }
+    bad = area[0];
+    bad.particles[k] = bad.particles[(k + 1) % 3];
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "repeats a corner", before, s.w,
+                  embra_world_set_area_loads(s.w, &bad, 1));
+  }
+  CAPI_CONTEXT("area load values");
+  bad = area[0];
+  bad.mode = 3;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "mode", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+  bad.mode = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "mode", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+  for (i = 0; i < 3; ++i) {
+    bad = area[0];
+    bad.pressure = bad_value(i);
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+    for (k = 0; k < 3; ++k) {
+      bad = area[1];
+      bad.direction[k] = bad_value(i);
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+      badl = line[0];
+      badl.load[k] = bad_value(i);
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_world_set_line_loads(s.w, &badl, 1));
+    }
+  }
+  bad = area[0];
+  bad.pressure = 2e300;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "1e300", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+  bad = area[1];
+  bad.direction[0] = bad.direction[1] = bad.direction[2] = 0.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+  bad.mode = EMBRA_AREA_LOAD_TRUE_AREA;
+  bad.direction[2] = 1e-320; /* too short to normalise */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero", before, s.w, embra_world_set_area_loads(s.w, &bad, 1));
+  CAPI_CONTEXT("line load particles");
+  badl = line[0];
+  badl.particles[1] = badl.particles[0];
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "itself", before, s.w, embra_world_set_line_loads(s.w, &badl, 1));
+  badl = line[0];
+  badl.particles[0] = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_world_set_line_loads(s.w, &badl, 1));
+
+  CAPI_CONTEXT("reading back");
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", before, s.w, embra_world_get_area_loads(s.w, got, 2, NULL));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", before, s.w, embra_world_get_area_loads(s.w, got, -1, &n));
+  REFUSED_SAVED(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer", before, s.w, embra_world_get_area_loads(s.w, got, 1, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out", before, s.w, embra_world_get_line_loads(s.w, NULL, 1, &n));
+  CHECK_OK(embra_world_get_area_loads(s.w, NULL, 0, &n));
+  CHECK(n == 2);
+  CHECK_OK(embra_world_get_area_loads(s.w, got, 2, &n));
+  CHECK(n == 2 && memcmp(got, area, sizeof area) == 0);
+  CHECK_OK(embra_world_get_line_loads(s.w, gotl, 1, &n));
+  CHECK(n == 1 && memcmp(gotl, line, sizeof line) == 0);
+  /* count 0 clears, with or without an array. */
+  CHECK_OK(embra_world_set_area_loads(s.w, NULL, 0));
+  CHECK_OK(embra_world_set_line_loads(s.w, line, 0));
+  CHECK_OK(embra_world_get_area_loads(s.w, NULL, 0, &n));
+  CHECK(n == 0);
+  CHECK_OK(embra_world_get_line_loads(s.w, NULL, 0, &n));
+  CHECK(n == 0);
+  free(before);
+  embra_world_destroy(s.w);
+}
+
+/* Polyline supports: the curve checked whole; a refused call leaves the saved scene as it was. */
+static void test_polyline_supports(void) {
+  scene s;
+  char* before;
+  embra_polyline_support_def pd;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0};
+  double pts[3 * 5] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0.5, -0.5, 0.5, 0.2};
+  int i, k;
+  CHECK(scene_build(&s));
+  pd = embra_default_polyline_support_def();
+  CHECK(pd.version == EMBRA_POLYLINE_SUPPORT_DEF_VERSION && pd.point_count == 0 && pd.closed == 0);
+  CHECK(pd.points == NULL && pd.compliance == 0.0 && pd.target[0] == 0.0 && pd.target[2] == 0.0);
+  pd.particle = s.point;
+  pd.points = pts;
+  pd.point_count = 5;
+  pd.closed = 1;
+  CHECK_OK(embra_polyline_support_create(s.w, &pd, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"polyline\"") != NULL);
+#define GOOD_POLYLINE()                        \
+  do {                                         \
+    pd = embra_default_polyline_support_def(); \
+    pd.particle = s.point;                     \
+    pd.points = pts;                           \
+    pd.point_count = 5;                        \
+  } while (0)
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_polyline_support_create(NULL, &pd, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_polyline_support_create(s.w, NULL, &out));
+  GOOD_POLYLINE();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_polyline_support_create(s.w, &pd, NULL));
+  pd.version = 2;
+  REFUSED_SAVED(EMBRA_ERROR_VERSION, "version", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.points = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.point_count = 0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = 1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "points", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "point_count", before, s.w,
+                embra_polyline_support_create(s.w, &pd, &out));
+  pd.point_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "point_count", before, s.w,
+                embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.point_count = 2;
+  pd.closed = 1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "closed", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  pd.closed = 2;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "closed", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  GOOD_POLYLINE();
+  pd.group = g_ref.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+  for (i = 0; i < 3; ++i) {
+    GOOD_POLYLINE();
+    pd.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+    for (k = 0; k < 15; k += 4) {
+      double bad[3 * 5];
+      memcpy(bad, pts, sizeof bad);
+      bad[k] = bad_value(i);
+      CAPI_CONTEXT("points[%d] = %s", k, bad_name(i));
+      GOOD_POLYLINE();
+      pd.points = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_polyline_support_create(s.w, &pd, &out));
+    }
+  }
+  CAPI_CONTEXT("degenerate segments");
+  {
+    double repeated[3 * 5];
+    memcpy(repeated, pts, sizeof repeated);
+    memcpy(&repeated[6], &repeated[3], 3 * sizeof(double)); /* point 2 = point 1 */
+    GOOD_POLYLINE();
+    pd.points = repeated;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero length", before, s.w,
+                  embra_polyline_support_create(s.w, &pd, &out));
+    memcpy(repeated, pts, sizeof repeated);
+    memcpy(&repeated[12], &repeated[0], 3 * sizeof(double)); /* last = first: degenerate when closed */
+    pd.closed = 1;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero length", before, s.w,
+                  embra_polyline_support_create(s.w, &pd, &out));
+  }
+#undef GOOD_POLYLINE
+  CAPI_CONTEXT("embra_support_create");
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_POLYLINE; /* its curve comes through embra_polyline_support_create */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "embra_polyline_support_create", before, s.w,
+                embra_support_create(s.w, &sd, &out));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -1736,6 +1973,8 @@ int main(void) {
   RUN(test_id_lists);
   RUN(test_particles);
   RUN(test_statics);
+  RUN(test_distributed_loads);
+  RUN(test_polyline_supports);
   RUN(test_step);
   return capi_test_finish();
 }

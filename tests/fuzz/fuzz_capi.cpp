@@ -17,6 +17,7 @@
 // EMBRA_FUZZ_TRACE=1 in the environment prints every call as it is made.
 //
 // Work is bounded by the target (world size, passes per step), so an input never takes long.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -1109,7 +1110,7 @@ void Session::op_edit() {
   const int32_t index = in_.chance(2) ? in_.u8() % 8 : in_.integer();
   const std::string at = "(group {" + std::to_string(g.index) + ", " + std::to_string(g.generation) + "}, kind " +
                          std::to_string(kind) + ", index " + std::to_string(index);
-  switch (in_.u8() % 14) {
+  switch (in_.u8() % 17) {
     case 10: {  // point loads
       const int32_t first = particle();
       const int32_t count = in_.chance(16) ? -1 : in_.u8() % 6;
@@ -1127,7 +1128,7 @@ void Session::op_edit() {
       embra_support_def d = embra_default_support_def();
       d.version = version(EMBRA_SUPPORT_DEF_VERSION);
       d.particle = particle();
-      d.support = in_.chance(4) ? in_.integer() : in_.u8() % 3;
+      d.support = in_.chance(4) ? in_.integer() : in_.u8() % 4;  // 3, a polyline, is refused here
       fill_vec3(d.target, true);
       if (in_.chance(2)) fill_vec3(d.axis, !in_.chance(4));
       if (in_.chance(2)) d.compliance = in_.chance(2) ? 1e-3 : in_.value();
@@ -1151,6 +1152,65 @@ void Session::op_edit() {
       call("embra_world_get_reactions", false, [&] {
         return embra_world_get_reactions(world_, in_.chance(4) ? nullptr : reactions.data(), in_.u8() % 33, &m);
       });
+      break;
+    }
+    case 16: {  // a support on a polyline, some points repeated
+      embra_polyline_support_def d = embra_default_polyline_support_def();
+      d.version = version(EMBRA_POLYLINE_SUPPORT_DEF_VERSION);
+      d.particle = particle();
+      fill_vec3(d.target, true);
+      if (in_.chance(2)) d.compliance = in_.chance(2) ? 1e-3 : in_.value();
+      if (in_.chance(2)) d.group = pick_id(in_, groups_);
+      // Out of range (refused before the points are read), or the size of the buffer given.
+      d.point_count = in_.chance(16) ? (in_.chance(2) ? -1 - in_.u8() : INT32_MAX) : in_.u8() % 7;
+      std::vector<double> points(3 * static_cast<size_t>(std::max(d.point_count, 0) % 7));
+      for (size_t i = 0; i < points.size(); i += 3) {
+        if (i >= 3 && in_.chance(8))
+          std::copy_n(&points[i - 3], 3, &points[i]);
+        else
+          fill_vec3(&points[i], !in_.chance(8));
+      }
+      d.points = in_.chance(32) ? nullptr : points.data();
+      d.closed = in_.chance(8) ? in_.integer() : in_.u8() % 2;
+      embra_pin_id pin{};
+      if (call("embra_polyline_support_create(points " + std::to_string(d.point_count) + ", closed " +
+                   std::to_string(d.closed) + ")",
+               true, [&] { return embra_polyline_support_create(world_, &d, &pin); }) == EMBRA_OK)
+        pins_.push_back(pin);
+      break;
+    }
+    case 14: {  // area loads: triangles of particles (some repeated or out of range), every mode
+      const int32_t count = in_.chance(16) ? -1 : in_.u8() % 5;
+      std::vector<embra_area_load> loads(static_cast<size_t>(count > 0 ? count : 0));
+      for (embra_area_load& l : loads) {
+        for (int32_t& c : l.particles) c = particle();
+        l.mode = in_.chance(8) ? in_.integer() : in_.u8() % 3;
+        l.pressure = in_.chance(4) ? in_.value() : in_.coordinate();
+        fill_vec3(l.direction, !in_.chance(4));
+      }
+      const embra_area_load* p = in_.chance(32) ? nullptr : loads.data();
+      call("embra_world_set_area_loads(count " + std::to_string(count) + ")", true,
+           [&] { return embra_world_set_area_loads(world_, p, count); });
+      std::vector<embra_area_load> out(8);
+      int32_t n = 0;
+      call("embra_world_get_area_loads", false,
+           [&] { return embra_world_get_area_loads(world_, in_.chance(4) ? nullptr : out.data(), in_.u8() % 9, &n); });
+      break;
+    }
+    case 15: {  // line loads
+      const int32_t count = in_.chance(16) ? -1 : in_.u8() % 5;
+      std::vector<embra_line_load> loads(static_cast<size_t>(count > 0 ? count : 0));
+      for (embra_line_load& l : loads) {
+        for (int32_t& c : l.particles) c = particle();
+        fill_vec3(l.load, !in_.chance(4));
+      }
+      const embra_line_load* p = in_.chance(32) ? nullptr : loads.data();
+      call("embra_world_set_line_loads(count " + std::to_string(count) + ")", true,
+           [&] { return embra_world_set_line_loads(world_, p, count); });
+      std::vector<embra_line_load> out(8);
+      int32_t n = 0;
+      call("embra_world_get_line_loads", false,
+           [&] { return embra_world_get_line_loads(world_, in_.chance(4) ? nullptr : out.data(), in_.u8() % 9, &n); });
       break;
     }
     case 13: {  // the OBJ text, into a buffer sized or not

@@ -122,6 +122,7 @@ const char* const kMinimalScene = R"({
   "groups": [{"name": "g"}],
   "bodies": [{"name": "b", "mesh": {"generator": "icosphere", "radius": 1, "subdivisions": 0}}],
   "pins": [{"particle": 0}],
+  "area_loads": [{"particles": [0, 1, 2], "pressure": 1}],
   "colliders": [{"shape": "capsule"}, {"shape": "box"}],
   "fields": [{"type": "wind"}, {"type": "pressure", "body": "b"}, {"type": "surface_tension", "body": "b"},
              {"type": "vortex"}]
@@ -215,6 +216,11 @@ std::map<std::string, std::vector<json>> code_defaults() {
   c[pm + "pins"] = {panel_pins_name(p.pins)};
   c[pm + "group"] = {group_name(p.group)};
 
+  // An area load's mode left out is a zeroed embra_area_load's (there is no default def).
+  const embra_area_load zeroed{};
+  c[d + "area_load/properties/mode"] = {json(zeroed.mode == EMBRA_AREA_LOAD_NORMAL ? "normal" : "?"),
+                                        saved["area_loads"][0]["mode"]};
+
   const embra_constraint_def k = embra_default_constraint_def();
   c[d + "constraint_batch/properties/group"] = {group_name(k.group)};
   c[d + "constraint_batch/properties/rest"] = {k.rest_from_current == 1 ? json("current") : json(k.rest)};
@@ -228,6 +234,7 @@ std::map<std::string, std::vector<json>> code_defaults() {
   const embra_support_def support = embra_default_support_def();
   c[d + "pin/properties/support"] = {json("point")};
   c[d + "pin/properties/axis"] = {json::array({support.axis[0], support.axis[1], support.axis[2]})};
+  c[d + "pin/properties/closed"] = {json(embra_default_polyline_support_def().closed == 1)};
 
   const embra_collider_def col = embra_default_collider_def();
   const json& capsule = saved["colliders"][0];

@@ -3,8 +3,9 @@
  * For every scene file given on the command line (CMake passes every JSON file of examples/ and of
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
- * orders and weights, hard and soft pins, plane and line supports, a plane and a sphere, non-default solver settings, a
- * rest scale, initial velocities, point loads, and a destroyed group, pin and collider whose slots are reused):
+ * orders and weights, hard and soft pins, plane, line and polyline supports, a plane and a sphere, non-default solver
+ * settings, a rest scale, initial velocities, point, area and line loads, and a destroyed group, pin and collider whose
+ * slots are reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -460,6 +461,44 @@ static embra_world* build_api_world(void) {
     const double loads[6] = {0.1, -0.2, -1.0 / 3.0, 0.0, 0.0, 0.7};
     CHECK_OK(embra_world_set_loads(w, loads, b0, 2));
   }
+  {
+    /* Area loads in every mode and line loads (a direction of any length, pressures and loads
+     * that are not short decimals), written to "area_loads" and "line_loads" with every bit. */
+    embra_area_load area[3];
+    embra_line_load line[2];
+    for (i = 0; i < 3; ++i) {
+      area[i].particles[0] = c0 + i;
+      area[i].particles[1] = c0 + i + 1;
+      area[i].particles[2] = c0 + i + NX;
+      area[i].mode = i; /* EMBRA_AREA_LOAD_NORMAL, _TRUE_AREA, _PROJECTED_AREA */
+      area[i].pressure = (i + 1) * 1.0 / 7.0;
+      area[i].direction[0] = 0.1 * i;
+      area[i].direction[1] = -1.0 / 3.0;
+      area[i].direction[2] = -2.5;
+    }
+    for (i = 0; i < 2; ++i) {
+      line[i].particles[0] = b0 + i;
+      line[i].particles[1] = c0 + NX + i;
+      line[i].load[0] = 0.2 / 3.0;
+      line[i].load[1] = 0.0;
+      line[i].load[2] = -0.3 - i;
+    }
+    /* A polyline support on a closed curve round the cloth's second row (points with every bit). */
+    {
+      double curve[3 * 4] = {0.0, 0.0, 0.0, 0.4, 0.1 / 3.0, 0.0, 0.4, 0.4, 0.05, 0.0, 0.4, -0.1};
+      embra_polyline_support_def su = embra_default_polyline_support_def();
+      embra_pin_id spin;
+      su.particle = c0 + NX + 2;
+      memcpy(su.target, &cloth_xyz[3 * (NX + 2)], sizeof su.target);
+      su.points = curve;
+      su.point_count = 4;
+      su.closed = 1;
+      su.compliance = 1e-4;
+      CHECK_OK(embra_polyline_support_create(w, &su, &spin));
+    }
+    CHECK_OK(embra_world_set_area_loads(w, area, 3));
+    CHECK_OK(embra_world_set_line_loads(w, line, 2));
+  }
   if (capi_test_failed != failed_before) {
     embra_world_destroy(w);
     return NULL;
@@ -475,7 +514,7 @@ static void api_world_round_trips(void) {
   if (w == NULL) return;
   CHECK_OK(embra_world_get_counts(w, &c));
   CHECK_INT(c.bodies, 2);
-  CHECK_INT(c.pins, 7); /* five pins and two supports */
+  CHECK_INT(c.pins, 8); /* five pins and three supports */
   CHECK_INT(c.colliders, 2);
   if (g_save_api_path != NULL) CHECK_OK(embra_world_save_file(w, g_save_api_path));
   check_round_trip("the C-ABI world", w, NULL);

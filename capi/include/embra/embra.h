@@ -566,9 +566,15 @@ EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def*
  * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
  * the plane or across the line. */
 enum {
-  EMBRA_PIN_SUPPORT_POINT = 0, /* the particle held at the target: embra_pin_create's pin */
-  EMBRA_PIN_SUPPORT_PLANE = 1, /* on the plane through the target, normal `axis` */
-  EMBRA_PIN_SUPPORT_LINE = 2   /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POINT = 0,   /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1,   /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2,    /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of a polyline, made by
+                                    embra_polyline_support_create (below): inside a segment it
+                                    slides along it and its reaction is normal to the segment; at
+                                    a vertex it is held there until pulled along a segment. The
+                                    closest point is searched over every segment at every
+                                    projection (cost linear in the points) */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
@@ -587,8 +593,33 @@ typedef struct embra_support_def {
 EMBRA_API embra_support_def embra_default_support_def(void);
 /* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
  * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
- * (or one too short to normalise), a negative or non-finite compliance, a stale group. */
+ * (or one too short to normalise), a negative or non-finite compliance, a stale group;
+ * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create). */
 EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
+
+/* A support on a polyline curve (EMBRA_PIN_SUPPORT_POLYLINE): a pin that holds its particle on the
+ * closest point of the polyline through `points` (open, or closed back to its first point), the
+ * points offsets from `target`, so embra_pin_set_target moves the curve as a host moves a collider.
+ * Frictionless, hard or compliant, projected in its group like the other supports. */
+#define EMBRA_POLYLINE_SUPPORT_DEF_VERSION 1
+typedef struct embra_polyline_support_def {
+  int32_t version;      /* EMBRA_POLYLINE_SUPPORT_DEF_VERSION */
+  int32_t particle;     /* world particle index */
+  double target[3];     /* m: the curve's origin; default {0, 0, 0} (the points are world points) */
+  int32_t point_count;  /* [2, EMBRA_MAX_PARTICLES]; at least 3 when closed */
+  int32_t closed;       /* 1: the last point joins the first; 0 (default): open */
+  const double* points; /* double[3 * point_count], m, offsets from target (copied at creation); no
+                           two consecutive points equal (nor the last and the first when closed) */
+  double compliance;    /* 0 (default) = hard; > 0: m/N */
+  embra_group_id group; /* its group; {0,0} = default group */
+} embra_polyline_support_def;
+
+EMBRA_API embra_polyline_support_def embra_default_polyline_support_def(void);
+/* Creates a polyline support. Refused: a particle out of range, a point count out of range, NULL
+ * points, a non-finite target or point, a degenerate (zero-length) segment, `closed` other than 0
+ * or 1, a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_polyline_support_create(embra_world* world, const embra_polyline_support_def* def,
+                                                     embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The
@@ -789,7 +820,8 @@ typedef struct embra_reaction {
   double force[3]; /* N: the force the pin exerts on its particle. A soft pin or a sliding support
                       (normal to its plane, across its line): its multiplier over
                       h^2. A hard point pin: minus the particle's weight (gravity / inverse mass; none
-                      for an immovable particle), its point load and the forces on it of every
+                      for an immovable particle), its point load, its share of the area and line
+                      loads (at the current positions) and the forces on it of every
                       constraint and soft pin (and automatic tether, when realign_passes >= 1:
                       without realignment they keep no multiplier). Fields (wind, pressure, surface
                       tension, vortex) and contacts on the pinned particle are not counted */
@@ -797,7 +829,8 @@ typedef struct embra_reaction {
 
 /* The reaction at every live pin after the last step, pins in creation-slot order (as
  * embra_world_get_pins). At a static rest the reactions sum to minus the total applied load (every
- * particle's weight and point load). Two-call pattern (out NULL, capacity 0: *out_count only). */
+ * particle's weight and point load, and every area and line load; loads on an immovable particle
+ * that no pin holds go to no reaction). Two-call pattern (out NULL, capacity 0: *out_count only). */
 EMBRA_API embra_status embra_world_get_reactions(const embra_world* world, embra_reaction* out, int32_t capacity,
                                                  int32_t* out_count);
 
@@ -914,6 +947,55 @@ EMBRA_API embra_status embra_world_set_loads(embra_world* world, const double* x
 /* Copies `count` particles' point loads (N) starting at `first` into out_xyz (capacity in doubles). */
 EMBRA_API embra_status embra_world_get_loads(const embra_world* world, double* out_xyz, int64_t capacity, int32_t first,
                                              int32_t count);
+
+/* Area loads: a pressure (Pa) on the triangle of three distinct particles, its force
+ * a third on each corner, applied every substep beside gravity from the positions at the substep's
+ * start, and counted in the reactions (embra_world_get_reactions). With the vector area
+ * a = (x1 - x0) x (x2 - x0) / 2 and u = direction / |direction|, the triangle's force is
+ *   EMBRA_AREA_LOAD_NORMAL          pressure * a: along the normal, following the surface as it
+ *                                   moves (wind pressure, inflation; negative: suction)
+ *   EMBRA_AREA_LOAD_TRUE_AREA       pressure * |a| * u: a fixed direction per m^2 of the triangle
+ *                                   (the self-weight of a cover)
+ *   EMBRA_AREA_LOAD_PROJECTED_AREA  pressure * |a . u| * u: a fixed direction per m^2 of the
+ *                                   triangle's projection on the plane normal to u (snow on the
+ *                                   plan area, u vertical)
+ * A triangle that comes to zero area feels no force. On a closed surface wound counter-clockwise
+ * seen from outside, NORMAL with pressure p pushes each vertex by p times the gradient of the
+ * enclosed volume. */
+enum { EMBRA_AREA_LOAD_NORMAL = 0, EMBRA_AREA_LOAD_TRUE_AREA = 1, EMBRA_AREA_LOAD_PROJECTED_AREA = 2 };
+
+typedef struct embra_area_load {
+  int32_t particles[3]; /* world particle indices, distinct */
+  int32_t mode;         /* EMBRA_AREA_LOAD_* */
+  double pressure;      /* Pa (N/m^2), finite */
+  double direction[3];  /* the fixed modes' direction: finite, of any nonzero length (kept as given,
+                           used as a unit vector); read but not used by EMBRA_AREA_LOAD_NORMAL */
+} embra_area_load;
+
+/* Replaces the world's area loads with loads[0 .. count) (count 0: none; loads may then be NULL),
+ * from the next step on: change them between steps by setting them again. Refused, changing
+ * nothing: a particle out of range, a repeated corner (a degenerate triangle), an unknown mode, a
+ * pressure or direction coordinate not finite within +-1e300, a fixed mode's zero direction (or one
+ * too short to normalise), count < 0. Saved in a scene as "area_loads". */
+EMBRA_API embra_status embra_world_set_area_loads(embra_world* world, const embra_area_load* loads, int32_t count);
+/* The world's area loads as set. Two-call pattern: out NULL and capacity 0 only write *out_count;
+ * a smaller capacity is EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. Capacity in loads. */
+EMBRA_API embra_status embra_world_get_area_loads(const embra_world* world, embra_area_load* out, int32_t capacity,
+                                                  int32_t* out_count);
+
+/* Line loads: a force per metre (N/m) of the current length of the edge between two distinct
+ * particles, along a fixed direction, half on each end; applied and counted as the area loads. */
+typedef struct embra_line_load {
+  int32_t particles[2]; /* world particle indices, distinct */
+  double load[3];       /* N/m, finite */
+} embra_line_load;
+
+/* Replaces the world's line loads, as embra_world_set_area_loads (refused likewise: an edge
+ * joining a particle to itself is degenerate). Saved in a scene as "line_loads". */
+EMBRA_API embra_status embra_world_set_line_loads(embra_world* world, const embra_line_load* loads, int32_t count);
+/* The world's line loads as set (two-call pattern, as embra_world_get_area_loads). */
+EMBRA_API embra_status embra_world_get_line_loads(const embra_world* world, embra_line_load* out, int32_t capacity,
+                                                  int32_t* out_count);
 
 /* ---------------------------------------------------------------------------------------------
  * Geometry queries

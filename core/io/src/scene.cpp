@@ -658,8 +658,12 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
 
 /// The pin supports' names in the scene format, by PinSupport.
-constexpr const char* kPinSupportNames[] = {"point", "plane", "line"};
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline"};
 static_assert(std::size(kPinSupportNames) == kPinSupportCount);
+
+/// The area load modes' names in the scene format, by AreaLoadMode.
+constexpr const char* kAreaLoadModeNames[] = {"normal", "true_area", "projected_area"};
+static_assert(std::size(kAreaLoadModeNames) == kAreaLoadModeCount);
 
 /// The panel pins' names in the scene format, by PanelPins.
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
@@ -1034,6 +1038,42 @@ class Builder {
     if (doc_.contains("state")) state(w, doc_["state"]);
     section("pins", [&](const json& p, const std::string& at) { pins(w, p, at); });
     section("loads", [&](const json& l, const std::string& at) { load(w, l, at); });
+    std::vector<AreaLoad> area_loads;
+    section("area_loads", [&](const json& l, const std::string& at) {
+      AreaLoad a;
+      for (int k = 0; k < 3; ++k)
+        a.particles[k] = particle(w, l["particles"][k], at + "/particles/" + std::to_string(k));
+      if (l.contains("mode"))  // the schema has checked it is one of kAreaLoadModeNames
+        for (int k = 0; k < kAreaLoadModeCount; ++k)
+          if (l["mode"] == kAreaLoadModeNames[k]) a.mode = static_cast<AreaLoadMode>(k);
+      a.pressure = l["pressure"].get<double>();
+      if (l.contains("direction")) a.direction = vec3(l["direction"]);
+      guard(at, [&] {
+        w.check_area_load(a, "area load");
+        return 0;
+      });
+      area_loads.push_back(a);
+    });
+    guard("/area_loads", [&] {
+      w.set_area_loads(area_loads);
+      return 0;
+    });
+    std::vector<LineLoad> line_loads;
+    section("line_loads", [&](const json& l, const std::string& at) {
+      LineLoad a;
+      for (int k = 0; k < 2; ++k)
+        a.particles[k] = particle(w, l["particles"][k], at + "/particles/" + std::to_string(k));
+      a.load = vec3(l["load"]);
+      guard(at, [&] {
+        w.check_line_load(a, "line load");
+        return 0;
+      });
+      line_loads.push_back(a);
+    });
+    guard("/line_loads", [&] {
+      w.set_line_loads(line_loads);
+      return 0;
+    });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
@@ -1376,6 +1416,9 @@ class Builder {
         for (int k = 0; k < kPinSupportCount; ++k)
           if (p["support"] == kPinSupportNames[k]) d.support = static_cast<PinSupport>(k);
       if (p.contains("axis")) d.axis = vec3(p["axis"]);
+      if (p.contains("points"))
+        for (const json& c : p["points"]) d.curve.push_back(vec3(c));
+      d.closed = p.contains("closed") && p["closed"].get<bool>();
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1637,7 +1680,13 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     json j = {{"name", pin_name[i]}, {"particle", p.particle}};
     write_rows(kPinRows, PinDesc{p.particle, p.target, p.compliance, p.group}, j);
     if (!p.kinematic()) j["group"] = group_name(p.group);
-    if (p.support != PinSupport::point) {
+    if (p.support == PinSupport::polyline) {
+      j["support"] = kPinSupportNames[static_cast<int>(p.support)];
+      json points = json::array();
+      for (const Vec3& c : p.curve) points.push_back(vec_json(c));
+      j["points"] = points;
+      j["closed"] = p.closed;
+    } else if (p.support != PinSupport::point) {
       j["support"] = kPinSupportNames[static_cast<int>(p.support)];
       j["axis"] = vec_json(p.axis);
     }
@@ -1649,6 +1698,17 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   for (int32_t i = 0; i < w.particle_count(); ++i)
     if (!w.loads()[i].isZero()) loads.push_back({{"particle", i}, {"force", vec_json(w.loads()[i])}});
   if (!loads.empty()) doc["loads"] = loads;
+  json area_loads = json::array();
+  for (const AreaLoad& l : w.area_loads())
+    area_loads.push_back({{"particles", {l.particles[0], l.particles[1], l.particles[2]}},
+                          {"mode", kAreaLoadModeNames[static_cast<int>(l.mode)]},
+                          {"pressure", l.pressure},
+                          {"direction", vec_json(l.direction)}});
+  if (!area_loads.empty()) doc["area_loads"] = area_loads;
+  json line_loads = json::array();
+  for (const LineLoad& l : w.line_loads())
+    line_loads.push_back({{"particles", {l.particles[0], l.particles[1]}}, {"load", vec_json(l.load)}});
+  if (!line_loads.empty()) doc["line_loads"] = line_loads;
 
   json colliders = json::array();
   std::set<std::string> used_colliders = given_names(meta.collider_names);

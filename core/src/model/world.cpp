@@ -1314,10 +1314,29 @@ Id World::create_pin(const PinDesc& desc) {
   check_non_negative(desc.compliance, "pin compliance");
   const int32_t support = static_cast<int32_t>(desc.support);
   if (support < 0 || support >= kPinSupportCount)
-    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1) or line (2)");
+    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1), line (2) or polyline (3)");
   for (int k = 0; k < 3; ++k) check_finite(desc.axis[k], "pin axis");
+  const bool polyline = desc.support == PinSupport::polyline;
+  if (polyline) {
+    const size_t n = desc.curve.size();
+    if (n < (desc.closed ? 3u : 2u) || n > static_cast<size_t>(limits::kMaxParticles))
+      invalid("a polyline support needs 2 to 2097152 points (3 when closed); " + std::to_string(n) + " given");
+    for (const Vec3& c : desc.curve)
+      for (int k = 0; k < 3; ++k) check_finite(c[k], "polyline point");
+    const size_t segments = desc.closed ? n : n - 1;
+    for (size_t s = 0; s < segments; ++s) {
+      const double length2 = (desc.curve[(s + 1) % n] - desc.curve[s]).squaredNorm();
+      // Squared, so a segment too short to divide by (squared length 0 or below the smallest
+      // positive double's range) is degenerate too.
+      if (!(length2 >= limits::kMinPositive) || !std::isfinite(length2))
+        invalid("polyline segment " + std::to_string(s) + " (points " + std::to_string(s) + " and " +
+                std::to_string((s + 1) % n) + ") has zero length (or one beyond range): it is degenerate");
+    }
+  } else if (!desc.curve.empty()) {
+    invalid("polyline points are given for a support that is not a polyline");
+  }
   const double axis_length = desc.axis.norm();
-  if (desc.support != PinSupport::point &&
+  if (desc.support != PinSupport::point && !polyline &&
       !(axis_length > 0.0 && std::isfinite(axis_length) && (desc.axis / axis_length).allFinite()))
     invalid(std::string("pin axis is zero (or too short to normalise): a ") +
             (desc.support == PinSupport::plane ? "plane" : "line") + " support needs a direction (its " +
@@ -1336,7 +1355,9 @@ Id World::create_pin(const PinDesc& desc) {
   p.compliance = desc.compliance;
   p.group = gid;
   p.support = desc.support;
-  if (desc.support != PinSupport::point) p.axis = desc.axis / axis_length;
+  if (desc.support != PinSupport::point && !polyline) p.axis = desc.axis / axis_length;
+  p.curve = desc.curve;
+  p.closed = polyline && desc.closed;
   const Id id = slots::create(pins_, p);
   const int32_t slot = static_cast<int32_t>(id.index);
   if (kinematic) {

@@ -50,6 +50,8 @@ std::vector<Reaction> World::reactions() const {
         for (int m = 0; m < 2; ++m) f[t.ids[2 * i + m]] += (t.lambda[i] * inv_h2) * e.grad[m];
       }
     }
+  // The loads as the last substep applied them: at a static rest its start is where it ended.
+  const std::vector<Vec3> load = any_hard ? applied_loads() : std::vector<Vec3>();
   std::vector<Reaction> out;
   for (size_t i = 0; i < pins_.size(); ++i) {
     const Pin& p = pins_[i];
@@ -62,7 +64,7 @@ std::vector<Reaction> World::reactions() const {
     } else {
       const double inv_mass = inv_mass_[p.particle];
       const Vec3 weight = inv_mass > 0.0 ? Vec3(settings_.gravity / inv_mass) : Vec3(Vec3::Zero());
-      r.force = -(weight + load_[p.particle] + f[p.particle]);
+      r.force = -(weight + load[p.particle] + f[p.particle]);
     }
     out.push_back(r);
   }

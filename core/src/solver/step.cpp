@@ -3,7 +3,7 @@
 //   begin_frame                hard pins' start, control.before_frame, solver arrays brought up to date
 //   for each substep:
 //     move_colliders           collider poses along their path over the frame
-//     predict                  fields, x <- x + h v + h^2 (g + w f) (f: point load); hard-pinned
+//     predict                  fields, x <- x + h v + h^2 (g + w f) (f: point, area and line loads); hard-pinned
 //                              particles follow their target
 //     find_contacts            particles against colliders (swept over the substep), cloth against
 //     find_self_contacts       itself (self_collision.cpp), panel faces against spheres
@@ -115,11 +115,18 @@ void add_corrections(const SolverArray& a, const std::vector<Vec3>& x, const std
 void World::predict(double h, double alpha) {
   apply_fields(h, report_.time + alpha * settings_.dt - h);  // fields/fields.cpp
   const Vec3 dv = h * settings_.gravity;
+  // Point loads, and the area and line loads from the positions at the substep's start (N).
+  const bool distributed = !area_loads_.empty() || !line_loads_.empty();
+  if (distributed) {
+    load_now_ = load_;
+    add_distributed_loads(x_, load_now_);
+  }
+  const std::vector<Vec3>& load = distributed ? load_now_ : load_;
   each_particle(*pool_, x_.size(), [&](size_t i) {
     x_prev_[i] = x_[i];
     if (w_[i] == 0.0) return;
     v_[i] += dv;
-    if (!load_[i].isZero()) v_[i] += (h * w_[i]) * load_[i];  // point loads (N)
+    if (!load[i].isZero()) v_[i] += (h * w_[i]) * load[i];
     x_[i] += h * v_[i];
   });
   for (const Pin& p : pins_)
@@ -203,6 +210,17 @@ void World::project_group(Group& g, double h, bool first) {
     if (w + alpha <= 0.0) continue;
     // The held part only (all of it for a point): a support's multiplier stays along its normal
     // (plane) or across its line, so the particle slides freely the other ways.
+    if (p.support == PinSupport::polyline) {
+      // Held on the closest point of the curve: inside a segment, the multiplier keeps only its part
+      // across the segment (it slides along it freely); at a vertex, all of it.
+      const Vec3 d = x_[p.particle] - p.target;
+      const CurvePoint c = closest_point_on_polyline(p.curve, p.closed, d);
+      const Vec3 lambda = c.inside_segment ? Vec3(p.lambda - c.tangent.dot(p.lambda) * c.tangent) : p.lambda;
+      const Vec3 dl = (-(d - c.point) - alpha * lambda) / (w + alpha);
+      p.lambda = lambda + dl;
+      x_[p.particle] += w * dl;
+      continue;
+    }
     const Vec3 dl = (-p.held(x_[p.particle] - p.target) - alpha * p.lambda) / (w + alpha);
     p.lambda += dl;
     x_[p.particle] += w * dl;

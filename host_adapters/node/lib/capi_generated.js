@@ -22,6 +22,7 @@ const CONSTRAINT_DEF_VERSION = 1;
 const CONSTRAINT_BATCH_DEF_VERSION = 1;
 const PIN_DEF_VERSION = 1;
 const SUPPORT_DEF_VERSION = 1;
+const POLYLINE_SUPPORT_DEF_VERSION = 1;
 const COLLIDER_DEF_VERSION = 2;
 const SOLVE_RESIDUAL_TARGET_M = 1e-4;
 const SOLVE_RESIDUAL_TARGET_RAD = 1e-3;
@@ -71,6 +72,7 @@ const CONSTRAINT_CONICAL = 9;
 const PIN_SUPPORT_POINT = 0;
 const PIN_SUPPORT_PLANE = 1;
 const PIN_SUPPORT_LINE = 2;
+const PIN_SUPPORT_POLYLINE = 3;
 
 // --- embra_collider_shape ---
 const COLLIDER_PLANE = 0;
@@ -94,6 +96,11 @@ const SOLVE_SETTLED_OUT_OF_TOLERANCE = 1;
 const SOLVE_OSCILLATING = 2;
 const SOLVE_DRIFTING = 3;
 
+// --- EMBRA_AREA_LOAD_* ---
+const AREA_LOAD_NORMAL = 0;
+const AREA_LOAD_TRUE_AREA = 1;
+const AREA_LOAD_PROJECTED_AREA = 2;
+
 // --- EMBRA_PANEL_PINS_* ---
 const PANEL_PINS_NONE = 0;
 const PANEL_PINS_TOP_CORNERS = 1;
@@ -113,11 +120,12 @@ const CUTS_CSV = 1;
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8, conical: 9 });
-const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2 });
+const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
 const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_tolerance: 1, oscillating: 2, drifting: 3 });
+const AREA_LOAD_NAMES = Object.freeze({ normal: 0, true_area: 1, projected_area: 2 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
 const CUTS_NAMES = Object.freeze({ json: 0, csv: 1 });
@@ -242,6 +250,16 @@ const SupportDef = koffi.struct('embra_support_def', {
   compliance: 'double',
   group: GroupIdType,
 });
+const PolylineSupportDef = koffi.struct('embra_polyline_support_def', {
+  version: 'int32_t',
+  particle: 'int32_t',
+  target: koffi.array('double', 3, 'Array'),
+  point_count: 'int32_t',
+  closed: 'int32_t',
+  points: 'const double *',
+  compliance: 'double',
+  group: GroupIdType,
+});
 const ColliderDef = koffi.struct('embra_collider_def', {
   version: 'int32_t',
   shape: 'embra_collider_shape',
@@ -327,6 +345,16 @@ const Warning = koffi.struct('embra_warning', {
   frame: 'int64_t',
   particle: 'int32_t',
   reserved0: 'int32_t',
+});
+const AreaLoad = koffi.struct('embra_area_load', {
+  particles: koffi.array('int32_t', 3, 'Array'),
+  mode: 'int32_t',
+  pressure: 'double',
+  direction: koffi.array('double', 3, 'Array'),
+});
+const LineLoad = koffi.struct('embra_line_load', {
+  particles: koffi.array('int32_t', 2, 'Array'),
+  load: koffi.array('double', 3, 'Array'),
 });
 const PanelMeshDef = koffi.struct('embra_panel_mesh_def', {
   version: 'int32_t',
@@ -445,6 +473,7 @@ const STRUCTS = {
   embra_constraint_batch_def: ConstraintBatchDef,
   embra_pin_def: PinDef,
   embra_support_def: SupportDef,
+  embra_polyline_support_def: PolylineSupportDef,
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
   embra_kind_residual: KindResidual,
@@ -455,6 +484,8 @@ const STRUCTS = {
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
   embra_warning: Warning,
+  embra_area_load: AreaLoad,
+  embra_line_load: LineLoad,
   embra_panel_mesh_def: PanelMeshDef,
   embra_tolerance: Tolerance,
   embra_tolerances: Tolerances,
@@ -521,6 +552,8 @@ const PROTOTYPES = {
   embra_pin_create: 'embra_status embra_pin_create(embra_world *world, const embra_pin_def *def, _Out_ embra_pin_id *out_pin)',
   embra_default_support_def: 'embra_support_def embra_default_support_def(void)',
   embra_support_create: 'embra_status embra_support_create(embra_world *world, const embra_support_def *def, _Out_ embra_pin_id *out_pin)',
+  embra_default_polyline_support_def: 'embra_polyline_support_def embra_default_polyline_support_def(void)',
+  embra_polyline_support_create: 'embra_status embra_polyline_support_create(embra_world *world, const embra_polyline_support_def *def, _Out_ embra_pin_id *out_pin)',
   embra_pin_destroy: 'embra_status embra_pin_destroy(embra_world *world, embra_pin_id pin)',
   embra_pin_set_target: 'embra_status embra_pin_set_target(embra_world *world, embra_pin_id pin, const double *target)',
   embra_pin_get_target: 'embra_status embra_pin_get_target(const embra_world *world, embra_pin_id pin, double *out_target)',
@@ -551,6 +584,10 @@ const PROTOTYPES = {
   embra_world_set_velocities: 'embra_status embra_world_set_velocities(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_set_loads: 'embra_status embra_world_set_loads(embra_world *world, const double *xyz, int32_t first, int32_t count)',
   embra_world_get_loads: 'embra_status embra_world_get_loads(const embra_world *world, double *out_xyz, int64_t capacity, int32_t first, int32_t count)',
+  embra_world_set_area_loads: 'embra_status embra_world_set_area_loads(embra_world *world, const embra_area_load *loads, int32_t count)',
+  embra_world_get_area_loads: 'embra_status embra_world_get_area_loads(const embra_world *world, embra_area_load *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_world_set_line_loads: 'embra_status embra_world_set_line_loads(embra_world *world, const embra_line_load *loads, int32_t count)',
+  embra_world_get_line_loads: 'embra_status embra_world_get_line_loads(const embra_world *world, embra_line_load *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_body_get_triangles: 'embra_status embra_body_get_triangles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_world_export_obj: 'embra_status embra_world_export_obj(const embra_world *world, char *out, int64_t capacity, _Out_ int64_t *out_length)',
   embra_world_write_obj: 'embra_status embra_world_write_obj(const embra_world *world, const char *path)',
@@ -596,23 +633,25 @@ module.exports = {
   ABI_VERSION, MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS,
   MAX_PASSES_PER_STEP, MAX_OBJ_BYTES, MAX_THREADS, SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION,
   CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, SUPPORT_DEF_VERSION,
-  COLLIDER_DEF_VERSION, SOLVE_RESIDUAL_TARGET_M, SOLVE_RESIDUAL_TARGET_RAD, SOLVE_RESIDUAL_TARGET_M3,
-  SOLVE_WORST_RESIDUAL, SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION,
-  LOAD_OPTIONS_VERSION, WIND_DEF_VERSION, PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION,
-  VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT, ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA,
-  ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL, ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH,
-  GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE,
-  CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER, CONSTRAINT_PLANARITY,
-  CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, CONSTRAINT_CONICAL, PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE,
-  PIN_SUPPORT_LINE, COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX,
-  COLLIDER_MESH, RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE,
-  SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING,
-  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
-  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
-  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
-  SOLVE_UNTIL_NAMES, SOLVE_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType,
-  PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef,
-  ConstraintBatchDef, PinDef, SupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual,
-  GroupConflict, Reaction, GroupReport, SolveDef, SolveResult, Warning, PanelMeshDef, Tolerance, Tolerances,
-  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  POLYLINE_SUPPORT_DEF_VERSION, COLLIDER_DEF_VERSION, SOLVE_RESIDUAL_TARGET_M, SOLVE_RESIDUAL_TARGET_RAD,
+  SOLVE_RESIDUAL_TARGET_M3, SOLVE_WORST_RESIDUAL, SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION,
+  TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION, WIND_DEF_VERSION, PRESSURE_DEF_VERSION,
+  SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT, ERROR_STALE_ID,
+  ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL, ERROR_INTERNAL,
+  ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE,
+  CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER,
+  CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, CONSTRAINT_CONICAL,
+  PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE, PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, COLLIDER_PLANE,
+  COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS,
+  RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE,
+  SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA,
+  AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS,
+  PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE,
+  PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES,
+  COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES,
+  PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts,
+  GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, SupportDef, PolylineSupportDef,
+  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
+  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
+  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

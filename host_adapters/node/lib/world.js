@@ -29,6 +29,8 @@ const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
 const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
+const AREA_LOAD_MODES = capi.AREA_LOAD_NAMES;
+const AREA_LOAD_MODE_NAMES = Object.fromEntries(Object.entries(AREA_LOAD_MODES).map(([k, v]) => [v, k]));
 const PANEL_METRICS = capi.PANEL_METRIC_NAMES;
 const SOLVE_UNTIL = capi.SOLVE_UNTIL_NAMES;
 const SOLVE_OUTCOMES = Object.freeze(Object.fromEntries(Object.entries(capi.SOLVE_NAMES).map(([k, v]) => [v, k])));
@@ -799,6 +801,34 @@ class World {
     return new PinId(pin.index, pin.generation);
   }
 
+  /**
+   * A frictionless support on a polyline (embra_polyline_support_create): `particle` held on the
+   * closest point of the polyline through `points` (xyz per point, m, offsets from the target, so
+   * setPinTarget moves the curve). Options: target (default [0, 0, 0]), closed (true joins its ends),
+   * compliance (0 hard, else m/N), group. Returns its PinId.
+   */
+  createPolylineSupport(particle, points, opts) {
+    const o = options(opts, 'createPolylineSupport options');
+    const d = lib.embra_default_polyline_support_def();
+    d.particle = buf.int32(particle, 'particle');
+    const xyz = buf.doublesIn(points, 'points');
+    if (xyz === null) throw new TypeError('points: required');
+    d.points = xyz;
+    d.point_count = xyzCount(xyz, 'points');
+    if (o.has('target')) d.target = buf.fixed(take(o, 'target'), 3, 'target');
+    if (o.has('closed')) {
+      const closed = take(o, 'closed');
+      if (typeof closed !== 'boolean') throw new TypeError(`closed: expected true or false, got ${buf.describe(closed)}`);
+      d.closed = closed ? 1 : 0;
+    }
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createPolylineSupport: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_polyline_support_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
   destroyPin(pin) {
     this.#call('embra_pin_destroy', toId(pin, PinId, 'pin'));
   }
@@ -1258,6 +1288,86 @@ class World {
    */
   setLoads(xyz, first = 0) {
     this.#write('embra_world_set_loads', xyz, first);
+  }
+
+  /**
+   * Replaces the area loads (embra_world_set_area_loads) with `loads`, an array of
+   * {particles: [a, b, c] (three distinct particles), pressure (Pa), mode ('normal', 'true_area' or
+   * 'projected_area'; default 'normal'), direction ([x, y, z], the fixed modes')}: a third of each
+   * triangle's force on each corner, every substep beside gravity, until set again. [] removes them.
+   */
+  setAreaLoads(loads) {
+    const { koffi } = capi;
+    if (!Array.isArray(loads)) throw new TypeError(`loads: expected an array, got ${buf.describe(loads)}`);
+    const size = koffi.sizeof(capi.AreaLoad);
+    const out = Buffer.alloc(Math.max(loads.length, 1) * size);
+    loads.forEach((l, i) => {
+      const o = options(l, `loads[${i}]`);
+      const d = {
+        particles: buf.fixed(take(o, 'particles'), 3, `loads[${i}].particles`).map((c) => buf.int32(c, `loads[${i}].particles`)),
+        mode: o.has('mode') ? enumValue(take(o, 'mode'), AREA_LOAD_MODES, `loads[${i}].mode`) : AREA_LOAD_MODES.normal,
+        pressure: buf.number(take(o, 'pressure'), `loads[${i}].pressure`),
+        direction: o.has('direction') ? buf.fixed(take(o, 'direction'), 3, `loads[${i}].direction`) : [0, 0, -1],
+      };
+      if (o.size) throw new TypeError(`loads[${i}]: unknown key '${o.keys().next().value}'`);
+      koffi.encode(out, i * size, capi.AreaLoad, d);
+    });
+    this.#call('embra_world_set_area_loads', out, loads.length);
+  }
+
+  /** The area loads as set: [{particles, mode (name), pressure, direction}]. */
+  areaLoads() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_area_loads', null, 0, n);
+    const size = koffi.sizeof(capi.AreaLoad);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_area_loads', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const l = koffi.decode(out, k * size, capi.AreaLoad);
+      result.push({ particles: Array.from(l.particles), mode: AREA_LOAD_MODE_NAMES[l.mode] ?? l.mode,
+        pressure: l.pressure, direction: Array.from(l.direction) });
+    }
+    return result;
+  }
+
+  /**
+   * Replaces the line loads (embra_world_set_line_loads) with `loads`, an array of
+   * {particles: [a, b] (two distinct particles), load ([x, y, z], N per m of the edge)}: half of each
+   * edge's force on each end, every substep beside gravity, until set again.
+   */
+  setLineLoads(loads) {
+    const { koffi } = capi;
+    if (!Array.isArray(loads)) throw new TypeError(`loads: expected an array, got ${buf.describe(loads)}`);
+    const size = koffi.sizeof(capi.LineLoad);
+    const out = Buffer.alloc(Math.max(loads.length, 1) * size);
+    loads.forEach((l, i) => {
+      const o = options(l, `loads[${i}]`);
+      const d = {
+        particles: buf.fixed(take(o, 'particles'), 2, `loads[${i}].particles`).map((c) => buf.int32(c, `loads[${i}].particles`)),
+        load: buf.fixed(take(o, 'load'), 3, `loads[${i}].load`),
+      };
+      if (o.size) throw new TypeError(`loads[${i}]: unknown key '${o.keys().next().value}'`);
+      koffi.encode(out, i * size, capi.LineLoad, d);
+    });
+    this.#call('embra_world_set_line_loads', out, loads.length);
+  }
+
+  /** The line loads as set: [{particles, load}]. */
+  lineLoads() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_line_loads', null, 0, n);
+    const size = koffi.sizeof(capi.LineLoad);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_line_loads', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const l = koffi.decode(out, k * size, capi.LineLoad);
+      result.push({ particles: Array.from(l.particles), load: Array.from(l.load) });
+    }
+    return result;
   }
 
   // --- JSON scenes --------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
 SUPPORT_DEF_VERSION = 1
+POLYLINE_SUPPORT_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
 SOLVE_RESIDUAL_TARGET_M = 1e-4
 SOLVE_RESIDUAL_TARGET_RAD = 1e-3
@@ -73,6 +74,7 @@ CONSTRAINT_CONICAL = 9
 PIN_SUPPORT_POINT = 0
 PIN_SUPPORT_PLANE = 1
 PIN_SUPPORT_LINE = 2
+PIN_SUPPORT_POLYLINE = 3
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -96,6 +98,11 @@ SOLVE_SETTLED_OUT_OF_TOLERANCE = 1
 SOLVE_OSCILLATING = 2
 SOLVE_DRIFTING = 3
 
+# --- EMBRA_AREA_LOAD_* ---
+AREA_LOAD_NORMAL = 0
+AREA_LOAD_TRUE_AREA = 1
+AREA_LOAD_PROJECTED_AREA = 2
+
 # --- EMBRA_PANEL_PINS_* ---
 PANEL_PINS_NONE = 0
 PANEL_PINS_TOP_CORNERS = 1
@@ -115,11 +122,12 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8, "conical": 9}
-PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
 SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "oscillating": 2, "drifting": 3}
+AREA_LOAD_NAMES = {"normal": 0, "true_area": 1, "projected_area": 2}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}
 CUTS_NAMES = {"json": 0, "csv": 1}
@@ -303,6 +311,20 @@ class SupportDef(_Struct):
     ]
 
 
+class PolylineSupportDef(_Struct):
+    """embra_polyline_support_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("particle", c_int32),
+        ("target", c_double * 3),
+        ("point_count", c_int32),
+        ("closed", c_int32),
+        ("points", POINTER(c_double)),
+        ("compliance", c_double),
+        ("group", GroupId),
+    ]
+
+
 class ColliderDef(_Struct):
     """embra_collider_def."""
     _fields_ = [
@@ -426,6 +448,24 @@ class Warning(_Struct):  # noqa: A001 - the C name
         ("frame", c_int64),
         ("particle", c_int32),
         ("reserved0", c_int32),
+    ]
+
+
+class AreaLoad(_Struct):
+    """embra_area_load."""
+    _fields_ = [
+        ("particles", c_int32 * 3),
+        ("mode", c_int32),
+        ("pressure", c_double),
+        ("direction", c_double * 3),
+    ]
+
+
+class LineLoad(_Struct):
+    """embra_line_load."""
+    _fields_ = [
+        ("particles", c_int32 * 2),
+        ("load", c_double * 3),
     ]
 
 
@@ -623,6 +663,8 @@ PROTOTYPES = {
     "embra_pin_create": (c_int32, [c_void_p, POINTER(PinDef), POINTER(PinId)]),
     "embra_default_support_def": (SupportDef, []),
     "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
+    "embra_default_polyline_support_def": (PolylineSupportDef, []),
+    "embra_polyline_support_create": (c_int32, [c_void_p, POINTER(PolylineSupportDef), POINTER(PinId)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
@@ -653,6 +695,10 @@ PROTOTYPES = {
     "embra_world_set_velocities": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_set_loads": (c_int32, [c_void_p, POINTER(c_double), c_int32, c_int32]),
     "embra_world_get_loads": (c_int32, [c_void_p, POINTER(c_double), c_int64, c_int32, c_int32]),
+    "embra_world_set_area_loads": (c_int32, [c_void_p, POINTER(AreaLoad), c_int32]),
+    "embra_world_get_area_loads": (c_int32, [c_void_p, POINTER(AreaLoad), c_int32, POINTER(c_int32)]),
+    "embra_world_set_line_loads": (c_int32, [c_void_p, POINTER(LineLoad), c_int32]),
+    "embra_world_get_line_loads": (c_int32, [c_void_p, POINTER(LineLoad), c_int32, POINTER(c_int32)]),
     "embra_body_get_triangles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
     "embra_world_export_obj": (c_int32, [c_void_p, POINTER(c_char), c_int64, POINTER(c_int64)]),
     "embra_world_write_obj": (c_int32, [c_void_p, c_char_p]),

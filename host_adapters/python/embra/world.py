@@ -16,10 +16,10 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 
 from . import _buffers as buf
 from . import _capi
-from ._capi import (BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
+from ._capi import (AreaLoad, BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
                     ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, Reaction, SolveResult, SolverDef,
                     StepReport, PressureDef, SurfaceTensionDef, VortexDef, WindDef,
-                    Tolerances, Warning, WorldCounts, lib)
+                    Tolerances, Warning, WorldCounts, LineLoad, lib)
 from .errors import EmbraError, check, error_for
 
 # The names each enum's values go by here and in scenes: generated from embra.h with the enums.
@@ -28,6 +28,8 @@ KINDS = dict(_capi.CONSTRAINT_NAMES)
 GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
 PIN_SUPPORTS = dict(_capi.PIN_SUPPORT_NAMES)
+AREA_LOAD_MODES = dict(_capi.AREA_LOAD_NAMES)
+AREA_LOAD_MODE_NAMES = {v: k for k, v in _capi.AREA_LOAD_NAMES.items()}
 PANEL_METRICS = dict(_capi.PANEL_METRIC_NAMES)
 CUTS_FORMATS = dict(_capi.CUTS_NAMES)
 SOLVE_UNTIL = dict(_capi.SOLVE_UNTIL_NAMES)
@@ -667,6 +669,28 @@ class World:
         self._call("embra_support_create", byref(d), byref(pin))
         return pin
 
+    def create_polyline_support(self, particle, points, target=(0.0, 0.0, 0.0), closed=False, compliance=0.0,
+                                group=None):
+        """A frictionless support on a polyline (embra_polyline_support_create): `particle` held on the
+        closest point of the polyline through `points` ((n, 3), m, offsets from `target`, so
+        set_pin_target moves the curve); `closed` joins its ends; compliance 0 = hard, > 0 m/N;
+        projected in `group`. Returns its PinId."""
+        d = lib.embra_default_polyline_support_def()
+        d.particle = buf.int32(particle, "particle")
+        d.target = buf.d3(target, "target")
+        d.closed = 1 if closed else 0
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        buf.check_rows(points, 3, "points")
+        p, n, keep = buf.doubles_in(points, "points")
+        if n % 3:
+            raise ValueError(f"points: {n} numbers is not a whole number of xyz triples")
+        d.points, d.point_count = p, buf.int32(n // 3, "point count")
+        pin = PinId()
+        self._call("embra_polyline_support_create", byref(d), byref(pin))
+        del keep
+        return pin
+
     def destroy_pin(self, pin):
         self._call("embra_pin_destroy", _id(pin, PinId, "pin"))
 
@@ -891,7 +915,8 @@ class World:
     def reactions(self):
         """The force (N) every live pin exerts on its particle after the last step
         (embra_world_get_reactions): a list of dicts {pin (PinId), particle, force ([x, y, z])}, pins in
-        creation-slot order. At a static rest they sum to minus the weights and point loads."""
+        creation-slot order. At a static rest they sum to minus the weights and the point, area and
+        line loads."""
         n = c_int32()
         self._call("embra_world_get_reactions", None, 0, byref(n))
         out = (Reaction * max(n.value, 1))()
@@ -951,6 +976,55 @@ class World:
         """Sets point loads (N, one xyz row per particle) on particles [first, first + len): forces
         applied every substep beside gravity until set again."""
         self._write("embra_world_set_loads", xyz, first)
+
+    def set_area_loads(self, loads):
+        """Replaces the area loads (embra_world_set_area_loads) with `loads`, a list of dicts
+        {particles: [a, b, c] (three distinct particles), pressure (Pa), mode ("normal", "true_area"
+        or "projected_area"; default "normal"), direction ([x, y, z], the fixed modes')}: a third of
+        each triangle's force on each corner, every substep beside gravity, until set again. An
+        empty list removes them. Refused, changing nothing, as the C ABI refuses."""
+        loads = list(loads)
+        arr = (AreaLoad * max(len(loads), 1))()
+        for i, l in enumerate(loads):
+            corners = list(l["particles"])
+            if len(corners) != 3:
+                raise ValueError(f"loads[{i}].particles: expected 3 particles, got {len(corners)}")
+            arr[i].particles = (c_int32 * 3)(*(buf.int32(c, f"loads[{i}].particles") for c in corners))
+            arr[i].mode = _enum(l.get("mode", "normal"), AREA_LOAD_MODES, f"loads[{i}].mode")
+            arr[i].pressure = float(l["pressure"])
+            arr[i].direction = buf.d3(l.get("direction", (0.0, 0.0, -1.0)), f"loads[{i}].direction")
+        self._call("embra_world_set_area_loads", arr, len(loads))
+
+    def area_loads(self):
+        """The area loads as set: a list of dicts {particles, mode (name), pressure, direction}."""
+        n = c_int32()
+        self._call("embra_world_get_area_loads", None, 0, byref(n))
+        out = (AreaLoad * max(n.value, 1))()
+        self._call("embra_world_get_area_loads", out, n.value, byref(n))
+        return [{"particles": list(l.particles), "mode": AREA_LOAD_MODE_NAMES.get(l.mode, l.mode),
+                 "pressure": l.pressure, "direction": list(l.direction)} for l in out[:n.value]]
+
+    def set_line_loads(self, loads):
+        """Replaces the line loads (embra_world_set_line_loads) with `loads`, a list of dicts
+        {particles: [a, b] (two distinct particles), load ([x, y, z], N per m of the edge)}: half of
+        each edge's force on each end, every substep beside gravity, until set again."""
+        loads = list(loads)
+        arr = (LineLoad * max(len(loads), 1))()
+        for i, l in enumerate(loads):
+            ends = list(l["particles"])
+            if len(ends) != 2:
+                raise ValueError(f"loads[{i}].particles: expected 2 particles, got {len(ends)}")
+            arr[i].particles = (c_int32 * 2)(*(buf.int32(c, f"loads[{i}].particles") for c in ends))
+            arr[i].load = buf.d3(l["load"], f"loads[{i}].load")
+        self._call("embra_world_set_line_loads", arr, len(loads))
+
+    def line_loads(self):
+        """The line loads as set: a list of dicts {particles, load}."""
+        n = c_int32()
+        self._call("embra_world_get_line_loads", None, 0, byref(n))
+        out = (LineLoad * max(n.value, 1))()
+        self._call("embra_world_get_line_loads", out, n.value, byref(n))
+        return [{"particles": list(l.particles), "load": list(l.load)} for l in out[:n.value]]
 
     # --- JSON scenes ---------------------------------------------------------------------------
     def save_json(self):

@@ -662,6 +662,94 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along
+        /// (0, 3, -4): 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on
+        /// each end (symplectic Euler: a h^2 n (n + 1) / 2 after n substeps). Refusals change nothing.</summary>
+        [Test]
+        public void AreaAndLineLoadsPushFreeParticles()
+        {
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = 0.0; }
+            solver.Substeps = 4;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                var start = new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 5, 2, 0, 5 };
+                w.CreateBody(start, masses: new[] { 0.5, 0.5, 0.5, 0.5, 0.5 }, def: def);
+                w.SetAreaLoads(new[] { World.MakeAreaLoad(0, 1, 2, 12.0, AreaLoadMode.TrueArea, new double[] { 0, 3, -4 }) });
+                w.SetLineLoads(new[] { World.MakeLineLoad(3, 4, new double[] { 1, 0, 0 }) });
+                var got = w.AreaLoads();
+                Assert.AreEqual(1, got.Length);
+                Assert.AreEqual((int)AreaLoadMode.TrueArea, got[0].Mode);
+                Assert.AreEqual(12.0, got[0].Pressure);
+                Assert.AreEqual(1, w.LineLoads().Length);
+                w.Step(3);
+                int n = 12;
+                double h = 1.0 / 60.0 / 4;
+                double s = h * h * n * (n + 1) / 2;
+                var p = w.GetPositions();
+                var u = new[] { 0.0, 0.6, -0.8 };
+                for (int i = 0; i < 3; ++i)
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(start[3 * i + k] + 4 * u[k] * s, p[3 * i + k], 1e-12);
+                for (int i = 3; i < 5; ++i) Assert.AreEqual(start[3 * i] + 2 * s, p[3 * i], 1e-12);
+                Assert.Throws<EmbraArgumentException>(() => w.SetAreaLoads(new[] { World.MakeAreaLoad(0, 1, 1, 1.0) }));
+                Assert.Throws<EmbraArgumentException>(() => w.SetLineLoads(new[] { World.MakeLineLoad(3, 5, new double[] { 1, 0, 0 }) }));
+                Assert.AreEqual(12.0, w.AreaLoads()[0].Pressure);
+                w.SetAreaLoads(new AreaLoad[0]);
+                w.SetLineLoads(new LineLoad[0]);
+                Assert.AreEqual(0, w.AreaLoads().Length + w.LineLoads().Length);
+            }
+        }
+
+        /// <summary>A bead on a vertical circle-shaped polyline (48 segments, radius 0.6) swings under
+        /// gravity and stays on it to 1e-9 m at every frame (distance to every segment computed here).</summary>
+        [Test]
+        public void PolylineSupportHoldsABeadOnACircle()
+        {
+            int n = 48;
+            var pts = new double[3 * n];
+            for (int k = 0; k < n; ++k)
+            {
+                double a = -Math.PI / 2 + Math.PI / n + 2 * Math.PI * k / n;
+                pts[3 * k] = 0.6 * Math.Cos(a);
+                pts[3 * k + 2] = 0.6 * Math.Sin(a);
+            }
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 8;
+            solver.Iterations = 2;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0.6, 0, 0.1 }, masses: new[] { 0.3 }, def: def);
+                var pin = w.CreatePolylineSupport(0, pts, closed: true);
+                double low = double.PositiveInfinity;
+                for (int f = 0; f < 60; ++f)
+                {
+                    w.Step();
+                    var q = w.GetPositions();
+                    double best = double.PositiveInfinity;
+                    for (int s = 0; s < n; ++s)
+                    {
+                        int b = (s + 1) % n;
+                        double ex = pts[3 * b] - pts[3 * s], ez = pts[3 * b + 2] - pts[3 * s + 2];
+                        double t = ((q[0] - pts[3 * s]) * ex + (q[2] - pts[3 * s + 2]) * ez) / (ex * ex + ez * ez);
+                        t = Math.Min(1.0, Math.Max(0.0, t));
+                        double dx = q[0] - pts[3 * s] - t * ex, dz = q[2] - pts[3 * s + 2] - t * ez;
+                        best = Math.Min(best, Math.Sqrt(dx * dx + q[1] * q[1] + dz * dz));
+                    }
+                    Assert.Less(best, 1e-9);
+                    low = Math.Min(low, q[2]);
+                }
+                Assert.Less(low, -0.5);
+                Assert.AreEqual(pin, w.Reactions()[0].Pin);
+                Assert.Throws<EmbraArgumentException>(() => w.CreatePolylineSupport(0, new double[] { 0, 0, 0, 0, 0, 0 }));
+            }
+        }
+
         /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
         /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
         [Test]

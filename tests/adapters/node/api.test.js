@@ -128,6 +128,71 @@ test('statics: two hard bars at 45 degrees carry a load, the pins react with eve
   w.close();
 });
 
+test('area and line loads push free particles by p A / 3 and q L / 2, and read back', () => {
+  // A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along (0, 3, -4):
+  // 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on each end.
+  const tri = [[0, 0, 0], [1, 0, 0], [0, 1, 0]];
+  const edge = [[0, 0, 5], [2, 0, 5]];
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 1, tethers: 0 });
+  w.createBody([...tri, ...edge], { generate: 0, masses: [0.5, 0.5, 0.5, 0.5, 0.5] });
+  w.setAreaLoads([{ particles: [0, 1, 2], mode: 'true_area', pressure: 12, direction: [0, 3, -4] }]);
+  w.setLineLoads([{ particles: [3, 4], load: [1, 0, 0] }]);
+  assert.deepEqual(w.areaLoads(), [{ particles: [0, 1, 2], mode: 'true_area', pressure: 12, direction: [0, 3, -4] }]);
+  assert.deepEqual(w.lineLoads(), [{ particles: [3, 4], load: [1, 0, 0] }]);
+  w.step(3);
+  const n = 12;
+  const h = 1 / 60 / 4;
+  const s = h * h * n * (n + 1) / 2;
+  const p = w.positions();
+  for (let i = 0; i < 3; i++) {
+    [0, 0.6, -0.8].forEach((u, k) => assert.ok(Math.abs(p[3 * i + k] - tri[i][k] - 4 * u * s) < 1e-12));
+  }
+  for (let i = 0; i < 2; i++) assert.ok(Math.abs(p[9 + 3 * i] - edge[i][0] - 2 * s) < 1e-12);
+  assert.throws(() => w.setAreaLoads([{ particles: [0, 1, 1], pressure: 1 }]), embra.EmbraError);
+  assert.throws(() => w.setLineLoads([{ particles: [3, 5], load: [1, 0, 0] }]), embra.EmbraError);
+  assert.throws(() => w.setAreaLoads([{ particles: [0, 1, 2], mode: 'plan', pressure: 1 }]), RangeError);
+  assert.equal(w.areaLoads()[0].pressure, 12);
+  w.setAreaLoads([]);
+  w.setLineLoads([]);
+  assert.deepEqual([w.areaLoads(), w.lineLoads()], [[], []]);
+  w.close();
+});
+
+test('a polyline support holds a bead on a circle while it swings', () => {
+  const pts = [];
+  for (let k = 0; k < 48; k++) {
+    const a = -Math.PI / 2 + Math.PI / 48 + 2 * Math.PI * k / 48;
+    pts.push([0.6 * Math.cos(a), 0, 0.6 * Math.sin(a)]);
+  }
+  const distance = (q) => {
+    let best = Infinity;
+    for (let s = 0; s < pts.length; s++) {
+      const a = pts[s];
+      const b = pts[(s + 1) % pts.length];
+      const e = [0, 1, 2].map((k) => b[k] - a[k]);
+      const t = Math.min(1, Math.max(0, [0, 1, 2].reduce((acc, k) => acc + (q[k] - a[k]) * e[k], 0) /
+        e.reduce((acc, c) => acc + c * c, 0)));
+      best = Math.min(best, Math.hypot(...[0, 1, 2].map((k) => q[k] - a[k] - t * e[k])));
+    }
+    return best;
+  };
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 8, iterations: 2, tethers: 0 });
+  w.createBody([[0.6, 0, 0.1]], { generate: 0, masses: [0.3] });
+  const pin = w.createPolylineSupport(0, pts, { closed: true });
+  let low = Infinity;
+  for (let f = 0; f < 60; f++) {
+    w.step();
+    const q = Array.from(w.positions());
+    assert.ok(distance(q) < 1e-9);
+    low = Math.min(low, q[2]);
+  }
+  assert.ok(low < -0.5);
+  assert.ok(w.reactions()[0].pin.equals(pin));
+  assert.throws(() => w.createPolylineSupport(0, [pts[0], pts[0], pts[1]]),
+    embra.EmbraError);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];

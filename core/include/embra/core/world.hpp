@@ -8,8 +8,10 @@
 #pragma once
 
 #include "embra/core/constraint_math.hpp"
+#include "embra/core/curves.hpp"
 #include "embra/core/fields.hpp"
 #include "embra/core/kinds.hpp"
+#include "embra/core/loads.hpp"
 
 #include <array>
 #include <atomic>
@@ -116,8 +118,10 @@ struct ConstraintInfo {
 /// support lets its particle slide, frictionless, on the plane through the target normal to `axis`
 /// or on the line through it along `axis`; a per-axis anchor (a roller) is a plane (one coordinate
 /// held: its axis the normal) or a line (two held: the third the line).
-enum class PinSupport : int32_t { point = 0, plane = 1, line = 2 };
-constexpr int kPinSupportCount = 3;
+/// A polyline support holds its particle on the closest point of a polyline (open, or closed back to
+/// its first point) whose points are offsets from the target: moving the target moves the curve.
+enum class PinSupport : int32_t { point = 0, plane = 1, line = 2, polyline = 3 };
+constexpr int kPinSupportCount = 4;
 
 struct PinDesc {
   int32_t particle = 0;
@@ -126,6 +130,10 @@ struct PinDesc {
   Id group;                 // group of a soft pin or a support; null = the default group
   PinSupport support = PinSupport::point;
   Vec3 axis = Vec3(0.0, 0.0, 1.0);  // plane: its normal; line: its direction (any length > 0)
+  // polyline: its points (m, offsets from the target), at least 2 (closed: 3), no two consecutive
+  // ones equal (nor the last and the first, closed), at most limits::kMaxParticles
+  std::vector<Vec3> curve{};
+  bool closed = false;
 };
 
 /// The numbering is part of the C ABI (embra_collider_shape).
@@ -406,6 +414,8 @@ struct Pin {
   Id group;
   PinSupport support = PinSupport::point;
   Vec3 axis = Vec3(0.0, 0.0, 1.0);  // unit
+  std::vector<Vec3> curve;          // polyline: its points, offsets from the target
+  bool closed = false;
   Vec3 lambda = Vec3::Zero();
   uint32_t generation = 0;
   bool alive = false;
@@ -414,12 +424,15 @@ struct Pin {
   bool kinematic() const { return compliance == 0.0 && support == PinSupport::point; }
   /// The part of d (the particle's offset from the target) the pin holds: all of it for a point,
   /// its part along the normal for a plane, its part across the line for a line.
+  /// For a polyline: d less the closest point of the curve (the offset from it).
   Vec3 held(const Vec3& d) const {
     switch (support) {
       case PinSupport::plane:
         return axis.dot(d) * axis;
       case PinSupport::line:
         return d - axis.dot(d) * axis;
+      case PinSupport::polyline:
+        return d - closest_point_on_polyline(curve, closed, d).point;
       case PinSupport::point:
         break;
     }
@@ -603,6 +616,22 @@ class World {
   /// substep beside gravity until changed; 0 by default. Each coordinate finite, |c| <= 1e300.
   void set_loads(int32_t first, std::span<const double> xyz);
   const std::vector<Vec3>& loads() const { return load_; }
+  /// Replaces the area loads (loads.hpp) with `loads` (empty: none), from the next step on. Refused,
+  /// changing nothing: a particle out of range, a repeated corner (a degenerate triangle), an
+  /// unknown mode, a pressure not finite within +-1e300, a direction not finite or, for the fixed
+  /// modes, zero (or too short to normalise).
+  void set_area_loads(std::span<const AreaLoad> loads);
+  const std::vector<AreaLoad>& area_loads() const { return area_loads_; }
+  /// Replaces the line loads (loads.hpp), checked likewise (an edge joining a particle to itself
+  /// is degenerate).
+  void set_line_loads(std::span<const LineLoad> loads);
+  const std::vector<LineLoad>& line_loads() const { return line_loads_; }
+  /// Throws as set_area_loads / set_line_loads would for this one load (`what` names it).
+  void check_area_load(const AreaLoad& load, const std::string& what) const;
+  void check_line_load(const LineLoad& load, const std::string& what) const;
+  /// The total load on every particle at the current positions (N): its point load plus its share
+  /// of every area and line load (a third of a triangle's, half an edge's). Weight not included.
+  std::vector<Vec3> applied_loads() const;
 
   // --- fields (fields.hpp) -------------------------------------------------------------------
   Id create_field(const FieldDesc& desc);
@@ -714,6 +743,12 @@ class World {
   std::vector<double> radius_;    // contact offset (half the body's thickness)
   std::vector<double> damping_;   // per-particle damping rate (1/s)
   std::vector<Vec3> load_;        // per-particle point load (N)
+  std::vector<AreaLoad> area_loads_;
+  std::vector<LineLoad> line_loads_;
+  std::vector<Vec3> load_now_;  // scratch: point loads plus distributed loads at the substep's start
+  /// Adds every area and line load's share at positions x to f (one entry per particle), in list
+  /// order (area loads first), so the sums are the same bits run after run.
+  void add_distributed_loads(const std::vector<Vec3>& x, std::vector<Vec3>& f) const;
   std::vector<double> mu_s_, mu_k_;
   std::vector<int32_t> body_of_;
   std::vector<int32_t> hard_pin_of_;  // pin slot or -1

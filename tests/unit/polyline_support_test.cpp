@@ -1,0 +1,208 @@
+// Polyline supports (PinSupport::polyline): a pin that holds its particle on the closest point of a
+// polyline, checked against geometry worked out here, independently of the solver.
+//
+//   - the distance to the polyline, |q - closest point|, has the gradient (q - c) / |q - c|: checked
+//     by central differences against a brute-force distance (every segment, here);
+//   - one hard projection puts a particle on the curve (distance 0 to rounding); a compliant one
+//     brings it closer every step;
+//   - a bead on a circle-shaped polyline (64 segments, a vertical wire) pulled by gravity and a
+//     point load swings and stays on the polyline to 1e-9 m at every frame; damped, it comes to rest
+//     on the lowest segment with a reaction normal to it that balances its weight and load;
+//   - an open polyline holds its particle at its end; moving the target moves the curve;
+//   - the same bits run after run; bad curves are refused and change nothing.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <vector>
+
+namespace embra {
+namespace {
+
+constexpr double kG = 9.81;
+
+/// Distance from q to the polyline, every segment tried (the test's own closest point).
+double distance_to_polyline(const std::vector<Vec3>& pts, bool closed, const Vec3& q) {
+  double best = INFINITY;
+  const size_t n = pts.size();
+  for (size_t s = 0; s < (closed ? n : n - 1); ++s) {
+    const Vec3 a = pts[s], b = pts[(s + 1) % n];
+    const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (q - (a + t * (b - a))).norm());
+  }
+  return best;
+}
+
+/// A circle of radius r about the origin in the x-z plane, n points, the lowest segment horizontal.
+std::vector<Vec3> circle(double r, int n) {
+  std::vector<Vec3> pts;
+  for (int k = 0; k < n; ++k) {
+    const double a = -std::numbers::pi / 2 + std::numbers::pi / n + 2.0 * std::numbers::pi * k / n;
+    pts.emplace_back(r * std::cos(a), 0.0, r * std::sin(a));
+  }
+  return pts;
+}
+
+Id polyline_support(World& w, int32_t particle, const Vec3& target, const std::vector<Vec3>& pts, bool closed,
+                    double compliance = 0.0) {
+  PinDesc d;
+  d.particle = particle;
+  d.target = target;
+  d.support = PinSupport::polyline;
+  d.curve = pts;
+  d.closed = closed;
+  d.compliance = compliance;
+  return w.create_pin(d);
+}
+
+TEST(PolylineSupport, DistanceGradientMatchesFiniteDifferences) {
+  const std::vector<Vec3> pts = {Vec3(0, 0, 0), Vec3(1, 0.2, 0), Vec3(1.5, 1, 0.3), Vec3(0.8, 1.6, -0.2)};
+  const Vec3 qs[] = {Vec3(0.5, -0.4, 0.2), Vec3(1.6, 0.4, 0.1), Vec3(0.9, 1.9, 0.4), Vec3(-0.3, -0.2, 0.1)};
+  double worst = 0.0;
+  for (const bool closed : {false, true})
+    for (const Vec3& q : qs) {
+      const CurvePoint c = closest_point_on_polyline(pts, closed, q);
+      EXPECT_NEAR((q - c.point).norm(), distance_to_polyline(pts, closed, q), 1e-15);
+      const Vec3 grad = (q - c.point).normalized();
+      for (int k = 0; k < 3; ++k) {
+        constexpr double e = 1e-6;
+        Vec3 a = q, b = q;
+        a[k] += e;
+        b[k] -= e;
+        const double fd = (distance_to_polyline(pts, closed, a) - distance_to_polyline(pts, closed, b)) / (2 * e);
+        worst = std::max(worst, std::abs(fd - grad[k]));
+      }
+      if (c.inside_segment) {
+        EXPECT_LT(std::abs(c.tangent.dot(q - c.point)), 1e-14) << "normal to its segment";
+      }
+    }
+  RecordProperty("gradient_error", test::sci(worst));
+  EXPECT_LT(worst, 1e-8);
+}
+
+TEST(PolylineSupport, ProjectionPutsTheParticleOnTheCurve) {
+  // One substep, one iteration, no gravity, at rest: the one projection moves the particle along
+  // the normal to its closest segment (so the closest point stays), leaving alpha / (1 / m + alpha)
+  // of its distance (alpha = compliance / h^2): 0 for a hard support.
+  const std::vector<Vec3> pts = circle(0.5, 16);
+  const Vec3 target(0.2, 0.1, 0.3);
+  const Vec3 start = target + Vec3(0.2, 0.35, -0.1);
+  const double d0 = distance_to_polyline(pts, true, start - target);
+  for (const double compliance : {0.0, 1e-6, 1e-4, 1e-3}) {
+    World w(test::settings(1, 1));
+    const int32_t p = test::add_particles(w, {start}, {2.0});
+    polyline_support(w, p, target, pts, true, compliance);
+    w.step();
+    const double h = w.settings().dt;
+    const double alpha = compliance / (h * h);
+    const double d1 = distance_to_polyline(pts, true, w.positions()[p] - target);
+    EXPECT_LT(d1, d0);
+    EXPECT_NEAR(d1, alpha / (0.5 + alpha) * d0, 1e-15 + 1e-12 * d0) << "compliance " << compliance;
+  }
+}
+
+TEST(PolylineSupport, BeadOnACircleStaysOnItAndRestsOnTheLowestSegment) {
+  constexpr double r = 0.8;
+  const std::vector<Vec3> pts = circle(r, 64);
+  Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG));
+  s.tethers = 0;
+  s.realign_passes = 2;
+  World w(s);
+  const double m = 0.4;
+  // Released at 60 degrees from the bottom, off the wire by 1 cm: the first projection puts it on.
+  const double a0 = -std::numbers::pi / 2 + std::numbers::pi / 3;
+  const Vec3 centre(1.0, 2.0, 3.0);
+  const int32_t p = test::add_particles(w, {centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0))}, {m});
+  const Id pin = polyline_support(w, p, centre, pts, true);
+  const double load[3] = {0.5, 0.0, -1.0};  // N
+  w.set_loads(p, load);
+  double off = 0.0, lowest = INFINITY, highest = -INFINITY;
+  for (int f = 0; f < 240; ++f) {
+    w.step();
+    const Vec3 x = w.positions()[p] - centre;
+    off = std::max(off, distance_to_polyline(pts, true, x));
+    lowest = std::min(lowest, x.x());
+    highest = std::max(highest, x.x());
+  }
+  RecordProperty("max_distance_swinging", test::sci(off));
+  EXPECT_LT(off, 1e-9) << "on the polyline at every frame while it swings";
+  EXPECT_LT(lowest, -0.3) << "it swung across the bottom";
+  EXPECT_GT(highest, 0.3);
+  // Damped, it settles where the wire's normal balances weight and load: on the lowest segment
+  // (horizontal) when the load's pull along it is 0 there. Take the side load off and damp.
+  const double down[3] = {0.0, 0.0, -1.0};
+  w.set_loads(p, down);
+  Settings damped = w.settings();
+  damped.damping = 3.0;
+  w.set_settings(damped);
+  for (int f = 0; f < 1200; ++f) w.step();
+  const Vec3 x = w.positions()[p] - centre;
+  EXPECT_LT(distance_to_polyline(pts, true, x), 1e-9);
+  EXPECT_NEAR(x.z(), pts[0].z(), 1e-9) << "on the lowest segment, z = " << pts[0].z();
+  EXPECT_LT(std::abs(x.x()), std::abs(pts[0].x())) << "between its ends";
+  const std::vector<Reaction> reactions = w.reactions();
+  ASSERT_EQ(reactions.size(), 1u);
+  EXPECT_EQ(reactions[0].pin, pin);
+  const Vec3 total = Vec3(0.0, 0.0, -m * kG) + Vec3(0.0, 0.0, -1.0);
+  const double imbalance = (reactions[0].force + total).norm() / total.norm();
+  RecordProperty("reaction_imbalance", test::sci(imbalance));
+  EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
+  EXPECT_LT(std::abs(reactions[0].force.x()), 1e-9 * total.norm()) << "normal to the (horizontal) segment";
+}
+
+TEST(PolylineSupport, OpenEndHoldsAndMovingTheTargetMovesTheCurve) {
+  // An open polyline sloping down to its end at (0, 0, 0): a particle slides down and stops there.
+  const std::vector<Vec3> pts = {Vec3(-1.0, 0.0, 1.0), Vec3(-0.5, 0.0, 0.4), Vec3(0.0, 0.0, 0.0)};
+  Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG), 2.0);
+  s.tethers = 0;
+  World w(s);
+  const int32_t p = test::add_particles(w, {Vec3(-0.9, 0.0, 0.88)}, {1.0});
+  const Id pin = polyline_support(w, p, Vec3::Zero(), pts, false);
+  for (int f = 0; f < 600; ++f) w.step();
+  EXPECT_LT(w.positions()[p].norm(), 1e-9) << "held at the curve's end";
+  const Vec3 shift(0.3, -0.2, 0.5);
+  w.set_pin_target(pin, shift);
+  for (int f = 0; f < 600; ++f) w.step();
+  EXPECT_LT((w.positions()[p] - shift).norm(), 1e-9) << "the curve moved with its target";
+}
+
+TEST(PolylineSupport, SameBitsRunAfterRun) {
+  std::vector<Vec3> runs;
+  for (int run = 0; run < 2; ++run) {
+    Settings s = test::settings(4, 3, Vec3(0.0, 0.0, -kG));
+    s.tethers = 0;
+    World w(s);
+    const int32_t p = test::add_particles(w, {Vec3(0.7, 0.0, 0.1)}, {1.0});
+    polyline_support(w, p, Vec3::Zero(), circle(0.75, 40), true, 1e-5);
+    for (int f = 0; f < 100; ++f) w.step();
+    runs.push_back(w.positions()[p]);
+  }
+  EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), sizeof(Vec3)));
+}
+
+TEST(PolylineSupport, BadCurvesAreRefusedAndChangeNothing) {
+  World w;
+  const int32_t p = test::add_particles(w, {Vec3::Zero()}, {1.0});
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(1, 1, 0);
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a}, false), Error) << "one point";
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a, b}, true), Error) << "closed needs 3";
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a, b, b, c}, false), Error) << "a zero-length segment";
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a, b, c, a}, true), Error) << "last = first, closed";
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a, Vec3(1e-170, 0, 0)}, false), Error) << "too short";
+  EXPECT_THROW(polyline_support(w, p, Vec3::Zero(), {a, Vec3(NAN, 0, 0)}, false), Error);
+  EXPECT_THROW(polyline_support(w, p + 1, Vec3::Zero(), {a, b}, false), Error);
+  PinDesc plane;
+  plane.particle = p;
+  plane.support = PinSupport::plane;
+  plane.curve = {a, b};
+  EXPECT_THROW(w.create_pin(plane), Error) << "points for a plane";
+  EXPECT_EQ(w.pin_count(), 0u);
+  polyline_support(w, p, Vec3::Zero(), {a, b, c, a}, false);  // open: last = first is a loop, fine
+  EXPECT_EQ(w.pin_count(), 1u);
+}
+
+}  // namespace
+}  // namespace embra
