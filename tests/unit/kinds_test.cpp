@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 #include <string>
 
@@ -198,7 +199,12 @@ TEST(Kinds, ConicalFormFindingGivesExactPanelOffsets) {
     ++frames;
   }
   RecordProperty("frames", frames);
-  RecordProperty("conical_defect_before", std::to_string(before));
+  const auto text = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return std::string(b);
+  };
+  RecordProperty("conical_defect_before", text(before));
   EXPECT_LT(defect(), 1e-8) << "after " << frames << " frames";
   // The mesh stayed near where it started (no collapse onto a degenerate solution).
   double moved = 0.0;
@@ -229,8 +235,8 @@ TEST(Kinds, ConicalFormFindingGivesExactPanelOffsets) {
   EXPECT_LT(r.corner_distance_top.max, 1e-8 * edge);
   EXPECT_LT(r.corner_distance_bottom.max, 1e-8 * edge);
   EXPECT_LT(r.miter.max, 1e-8 * edge);
-  RecordProperty("thickness_error", std::to_string(r.thickness.max));
-  RecordProperty("miter", std::to_string(r.miter.max));
+  RecordProperty("thickness_error", text(r.thickness.max));
+  RecordProperty("miter", text(r.miter.max));
 }
 
 }  // namespace
