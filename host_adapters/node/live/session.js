@@ -382,32 +382,29 @@ class Session {
       return null;
     }
     g.undone_worst = Math.max(g.undone_worst, first);
-    this.#stopDrags();
-    ++g.steps;
-    if (!this.#tryStep()) {
-      this.#measure();
-      if (this.#worst() <= DRAG_SAFE) {
-        ++g.redone;
-        return null;
+    // A re-step from (x0, velocities): kept (counted as `outcome`) when it ends within DRAG_SAFE,
+    // else the state is put back.
+    const retry = (velocities, outcome) => {
+      ++g.steps;
+      if (!this.#tryStep()) {
+        this.#measure();
+        if (this.#worst() <= DRAG_SAFE) {
+          ++g[outcome];
+          return true;
+        }
       }
       w.setPositions(x0);
-      w.setVelocities(v0);
-    }
+      w.setVelocities(velocities);
+      return false;
+    };
+    this.#stopDrags();
+    if (retry(v0, 'redone')) return null;
     const still = Float64Array.from(v0);
     for (const b of this.bodies)
       if ([...this.drags.values()].some((d) => d.particle >= b.first && d.particle < b.first + b.count))
         still.fill(0, 3 * b.first, 3 * (b.first + b.count));
     w.setVelocities(still);
-    ++g.steps;
-    if (!this.#tryStep()) {
-      this.#measure();
-      if (this.#worst() <= DRAG_SAFE) {
-        ++g.stilled;
-        return null;
-      }
-      w.setPositions(x0);
-      w.setVelocities(still);
-    }
+    if (retry(still, 'stilled')) return null;
     ++g.held;
     this.#measure();
     return null;
