@@ -19,10 +19,10 @@ constexpr std::tuple kSolverCopies{Copy{&embra_solver_def::dt, &embra::Settings:
                                    Copy{&embra_solver_def::chebyshev_rho_milli, &embra::Settings::chebyshev_rho_milli},
                                    Copy{&embra_solver_def::self_collision, &embra::Settings::self_collision},
                                    Copy{&embra_solver_def::chain_solve, &embra::Settings::chain_solve},
-                                   Copy{&embra_solver_def::threads, &embra::Settings::threads}};
+                                   Copy{&embra_solver_def::threads, &embra::Settings::threads},
+                                   Copy{&embra_solver_def::global_solve, &embra::Settings::global_solve}};
 
 embra::Settings to_settings(const embra_solver_def& d) {
-  if (d.reserved0 != 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.reserved0 must be 0");
   embra::Settings s;
   to_core(kSolverCopies, d, s);
   return s;

@@ -118,7 +118,7 @@ namespace Embra
         public int SelfCollision;
         public int ChainSolve;
         public int Threads;
-        public int Reserved0;
+        public int GlobalSolve;
     }
 
     /// <summary>embra_world_counts.</summary>

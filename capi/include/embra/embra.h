@@ -237,7 +237,21 @@ typedef struct embra_solver_def {
                                   same bits at any count, so this changes only the time a step takes
                                   (128 x 128 cloth: 27.5 ms/frame on 1 thread, 17.1 on 2). The threads
                                   wait for work between steps without using the CPU */
-  int32_t reserved0;           /* 0 */
+  int32_t global_solve;        /* 0 (default) or 1. 1: each substep is first solved as one system (the
+                                  global solve): the substep's implicit step over every constraint and
+                                  soft pin of the enabled groups, found by Newton's method on its energy
+                                  (1/2 |x - x~|^2_M + sum C^2 / (2 alpha~), hard constraints as a penalty
+                                  of 1e8 times their effective mass), with the geometric stiffness of
+                                  lengths in tension, a sparse LDL^T factorisation and a line search that
+                                  accepts only steps lowering the energy (it cannot blow up); the
+                                  multipliers are set from it and the `iterations` run on from there,
+                                  groups in their order and weight (hard constraints end exact; contacts,
+                                  pressure volumes and fields act in the iterations). A load carried
+                                  across a large or stiff structure needs no iterations to travel: the
+                                  statics are exact whatever the size. Costs a factorisation per Newton
+                                  iteration (up to 8 a substep, fewer near rest), one thread. The
+                                  form-finding preset uses it. This field was reserved0 (always 0) before
+                                  ABI 1.x added it: hosts that zero it keep the iterations alone. */
 } embra_solver_def;
 
 EMBRA_API embra_solver_def embra_default_solver_def(void);

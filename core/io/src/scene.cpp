@@ -581,7 +581,8 @@ constexpr std::tuple kSolverRows{Row{"dt", &Settings::dt},
                                  Row{"chebyshev_rho_milli", &Settings::chebyshev_rho_milli},
                                  Row{"self_collision", &Settings::self_collision},
                                  Row{"chain_solve", &Settings::chain_solve},
-                                 Row{"threads", &Settings::threads}};
+                                 Row{"threads", &Settings::threads},
+                                 Row{"global_solve", &Settings::global_solve}};
 
 constexpr std::tuple kMaterialRows{Row{"mass", &Material::mass},
                                    Row{"density", &Material::density},

@@ -527,6 +527,7 @@ void World::begin_frame(const StepControl& control) {
 
 void World::solve(double h, const StepControl& control) {
   if (settings_.realign_passes > 0) predicted_ = x_;
+  if (settings_.global_solve) global_step(h);
   for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
     if (pass > 0) realign(predicted_);
     // Chebyshev acceleration acts on iterations 2 .. iterations - 2 (chebyshev_step): none below 4.

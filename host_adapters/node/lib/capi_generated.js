@@ -165,7 +165,7 @@ const SolverDef = koffi.struct('embra_solver_def', {
   self_collision: 'int32_t',
   chain_solve: 'int32_t',
   threads: 'int32_t',
-  reserved0: 'int32_t',
+  global_solve: 'int32_t',
 });
 const WorldCounts = koffi.struct('embra_world_counts', {
   particles: 'int32_t',

@@ -192,7 +192,7 @@ class SolverDef(_Struct):
         ("self_collision", c_int32),
         ("chain_solve", c_int32),
         ("threads", c_int32),
-        ("reserved0", c_int32),
+        ("global_solve", c_int32),
     ]
 
 

@@ -193,6 +193,10 @@ struct Settings {
   // machine; at most limits::kMaxThreads. Each colour's constraints and chains are split over them;
   // the result is the same bits at any count.
   int32_t threads = 1;
+  // 1: each substep's implicit problem over every constraint and soft pin of the enabled groups is
+  // first solved as one system, by Newton's method on its energy with a sparse factorisation
+  // (solver/global_solve.cpp), then the iterations run on from it; 0 (default): the iterations alone.
+  int32_t global_solve = 0;
 };
 
 struct GroupReport {
@@ -500,10 +504,12 @@ inline Settings form_finding_settings() {
   s.substeps = 1;
   s.iterations = 1;
   s.damping = 6.0;
+  s.global_solve = 1;
   return s;
 }
 
 class ThreadPool;
+struct GlobalSolve;
 
 /// The world. Not thread-safe: one thread at a time per world; different worlds are independent.
 class World {
@@ -710,6 +716,11 @@ class World {
   /// Projects a group once; `first`: its first projection in the substep (the chain solve's turn).
   void project_group(Group& g, double h, bool first);
   void project_contacts(Group& g, double h);
+  /// Settings::global_solve: the substep's implicit problem solved by Newton's method, the
+  /// multipliers set from it (solver/global_solve.cpp).
+  void global_step(double h);
+  /// One sweep over the global solve's rows at x (global_solve.cpp says what each pass does).
+  void global_terms(const std::vector<Vec3>& x, double inv_h2, int pass, double t, bool matrix, bool store);
   // The step's stages (step.cpp lists them in order).
   void begin_frame(const StepControl& control);
   void solve(double h, const StepControl& control);
@@ -779,6 +790,7 @@ class World {
   std::vector<double> measure_values_;                // measure(): one array's constraint values
   std::vector<double> chain_scratch_;                 // per thread: kChainScratch per link of the longest chain, + 1
   std::unique_ptr<ThreadPool> pool_;                  // Settings::threads
+  std::unique_ptr<GlobalSolve> global_;               // Settings::global_solve: pattern, factorisation, scratch
   std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
