@@ -39,7 +39,7 @@ namespace Embra
     public enum Generate { None = 0, Stretch = 1, Shear = 2, Bend = 4, Volume = 8 }
 
     /// <summary>EMBRA_CONSTRAINT_*.</summary>
-    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9 }
+    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9, LengthMin = 10, AngleMin = 11, AngleMax = 12, Colinear = 13, Direction = 14, Cocircular = 15, Cospherical = 16 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
     public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }

@@ -949,8 +949,10 @@ static void test_constraint_add(void) {
       continue;
     }
     for (slot = 0; slot < n; ++slot) {
-      /* Equal length's two edges may share a particle (slots 1 and 2, 3 and 0); one edge may not. */
-      const int shared_edges = kind == EMBRA_CONSTRAINT_EQUAL_LENGTH && slot % 2 == 1;
+      /* Equal length's and direction's two edges may share a particle (slots 1 and 2, 3 and 0); one
+       * edge may not. */
+      const int shared_edges =
+          (kind == EMBRA_CONSTRAINT_EQUAL_LENGTH || kind == EMBRA_CONSTRAINT_DIRECTION) && slot % 2 == 1;
       CAPI_CONTEXT("kind %d, particle %d", kind, slot);
       d = good_constraint(kind);
       d.particles[slot] = -1;
@@ -1015,6 +1017,29 @@ static void test_constraint_add(void) {
   d.rest_from_current = 0;
   d.rest = 0.5;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "weld", embra_constraint_add(W, &d));
+  d = good_constraint(EMBRA_CONSTRAINT_LENGTH_MIN);
+  d.rest_from_current = 0;
+  d.rest = -0.1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest length", embra_constraint_add(W, &d));
+  d = good_constraint(EMBRA_CONSTRAINT_COLINEAR);
+  d.rest_from_current = 0;
+  d.rest = -0.1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest distance", embra_constraint_add(W, &d));
+  for (kind = EMBRA_CONSTRAINT_ANGLE_MIN; kind <= EMBRA_CONSTRAINT_DIRECTION; ++kind) {
+    if (kind == EMBRA_CONSTRAINT_COLINEAR) continue;
+    CAPI_CONTEXT("kind %d, rest angle out of [0, pi]", kind);
+    d = good_constraint(kind);
+    d.rest_from_current = 0;
+    d.rest = 3.2;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
+    d.rest = -0.01;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
+  }
+  CAPI_CONTEXT("cocircular rest beyond 2 pi");
+  d = good_constraint(EMBRA_CONSTRAINT_COCIRCULAR);
+  d.rest_from_current = 0;
+  d.rest = -6.3;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
 
   CAPI_CONTEXT("degenerate, rest measured from current positions");
   d = embra_default_constraint_def(); /* F0 and F1 coincide */
@@ -1042,6 +1067,39 @@ static void test_constraint_add(void) {
   d.particles[1] = g_ref.fixture + F2;
   d.particles[2] = g_ref.fixture + F3;
   d.particles[3] = g_ref.fixture + F4;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_LENGTH_MIN; /* F0 and F1 coincide: no direction to push apart in */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  for (kind = EMBRA_CONSTRAINT_ANGLE_MIN; kind <= EMBRA_CONSTRAINT_ANGLE_MAX; ++kind) {
+    d = embra_default_constraint_def();
+    d.kind = kind; /* an edge of zero length */
+    d.particles[0] = g_ref.fixture + F0;
+    d.particles[1] = g_ref.fixture + F1;
+    d.particles[2] = g_ref.fixture + F2;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  }
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_COLINEAR; /* the line's ends F0 and F1 coincide */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F2;
+  d.particles[2] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_DIRECTION; /* the reference edge F0-F1 has zero length */
+  d.particles[0] = g_ref.fixture + F2;
+  d.particles[1] = g_ref.fixture + F3;
+  d.particles[2] = g_ref.fixture + F0;
+  d.particles[3] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_COCIRCULAR; /* the corner at F2 is straight (F0 F2 F5 collinear) */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F2;
+  d.particles[2] = g_ref.fixture + F5;
+  d.particles[3] = g_ref.fixture + F3;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
 }
 
@@ -1098,6 +1156,44 @@ static void test_constraints_add(void) {
       cone_rest = bad_value(i);
       REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_constraints_add(W, &d));
     }
+  }
+  {
+    /* Five points on one sphere: the tetrahedron's four corners and the cloth's middle particle (its
+     * five particles do not fit embra_constraint_def). */
+    int32_t five[5];
+    double five_rest = 0.0;
+    scene s;
+    CAPI_CONTEXT("cospherical");
+    d = embra_default_constraint_batch_def();
+    d.kind = EMBRA_CONSTRAINT_COSPHERICAL;
+    d.count = 1;
+    d.particles = five;
+    five[0] = g_ref.tet, five[1] = g_ref.tet + 1, five[2] = g_ref.tet + 2, five[3] = g_ref.tet + 3;
+    five[4] = g_ref.cloth + 4;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_constraints_add(s.w, &d));
+    d.rest = &five_rest;
+    CHECK_OK(embra_constraints_add(s.w, &d));
+    d.rest = NULL;
+    embra_world_destroy(s.w);
+    five[4] = -1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_constraints_add(W, &d));
+    five[4] = g_ref.n;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_constraints_add(W, &d));
+    five[4] = g_ref.tet + 1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_constraints_add(W, &d));
+    five[4] = g_ref.cloth + 4;
+    d.rest = &five_rest;
+    for (i = 0; i < 3; ++i) {
+      CAPI_CONTEXT("cospherical, %s", bad_name(i));
+      five_rest = bad_value(i);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_constraints_add(W, &d));
+    }
+    CAPI_CONTEXT("cospherical, flat");
+    d.rest = NULL; /* F0 F2 F3 F4 lie in a plane: no sphere through them */
+    five[0] = g_ref.fixture + F0, five[1] = g_ref.fixture + F2, five[2] = g_ref.fixture + F3;
+    five[3] = g_ref.fixture + F4, five[4] = g_ref.fixture + F5;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraints_add(W, &d));
   }
   GOOD_BATCH();
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_constraints_add(W, NULL));

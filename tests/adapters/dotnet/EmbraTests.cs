@@ -1629,6 +1629,13 @@ namespace Embra.Tests
             Assert.AreEqual(ColliderDef.CurrentVersion, Native.embra_default_collider_def().Version);
             Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Dihedral));
             Assert.AreEqual(5, Library.ConstraintArity(ConstraintKind.Conical));
+            Assert.AreEqual(2, Library.ConstraintArity(ConstraintKind.LengthMin));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.AngleMin));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.AngleMax));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.Colinear));
+            Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Direction));
+            Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Cocircular));
+            Assert.AreEqual(5, Library.ConstraintArity(ConstraintKind.Cospherical));
             Assert.AreEqual(Native.AbiVersion, Library.AbiVersion);
             var parts = Library.VersionString.Split('.').Select(int.Parse).ToArray();
             Assert.AreEqual(parts[0] * 10000 + parts[1] * 100 + parts[2], Library.Version);

@@ -34,7 +34,8 @@ test('defaults are the documented ones', () => {
   assert.deepEqual([m.mass, m.density, m.stretch_compliance, m.bend_compliance], [0, 1, 0, 1]);
   assert.deepEqual([m.friction_static, m.friction_dynamic], [0.5, 0.3]);
   assert.deepEqual(['distance', 'edge_angle', 'dihedral', 'tet_volume', 'weld', 'tether', 'planarity',
-    'plane_offset', 'equal_length', 'conical'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4, 4, 5]);
+    'plane_offset', 'equal_length', 'conical', 'length_min', 'angle_min', 'angle_max', 'colinear', 'direction',
+    'cocircular', 'cospherical'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4, 4, 5, 2, 3, 3, 3, 4, 4, 5]);
   const b = embra.defaultBodyDef();
   assert.equal(b.generate, embra.GENERATE.stretch | embra.GENERATE.bend | embra.GENERATE.volume);
   assert.ok(b.stretch_group instanceof embra.GroupId && b.stretch_group.equals(new embra.GroupId()));

@@ -60,8 +60,9 @@ def test_defaults_are_the_documented_ones():
     assert (m.friction_static, m.friction_dynamic) == (0.5, 0.3)
     assert [embra.constraint_arity(k) for k in ("distance", "edge_angle", "dihedral", "tet_volume", "weld",
                                                 "tether", "planarity", "plane_offset", "equal_length",
-                                                "conical")] == \
-        [2, 3, 4, 4, 2, 2, 4, 4, 4, 5]
+                                                "conical", "length_min", "angle_min", "angle_max",
+                                                "colinear", "direction", "cocircular", "cospherical")] == \
+        [2, 3, 4, 4, 2, 2, 4, 4, 4, 5, 2, 3, 3, 3, 4, 4, 5]
 
 
 def test_free_fall_is_symplectic_euler_in_closed_form():
