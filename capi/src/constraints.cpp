@@ -1,8 +1,12 @@
 // Constraints added by the host, one or a batch at a time.
 #include "guard.hpp"
 
+#include "embra/core/limits.hpp"
+
+#include <algorithm>
 #include <iterator>
 #include <string>
+#include <vector>
 
 using namespace embra::capi;
 
@@ -67,6 +71,49 @@ embra_status embra_constraints_add(embra_world* world, const embra_constraint_ba
     if (def->compliances) d.compliance = std::span<const double>(def->compliances, static_cast<size_t>(def->count));
     d.uniform_compliance = def->compliance;
     world->world.add_constraints(d);
+  });
+}
+
+embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                         int32_t count, double compliance, int32_t* out_added) {
+  return guard("embra_polygon_planarity_add", world, [&] {
+    if (count < 4) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be >= 4 (fewer corners are always planar)");
+    if (count > embra::limits::kMaxConstraints)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be <= " + num(embra::limits::kMaxConstraints));
+    const std::span<const int32_t> corners = view(particles, count, "particles");
+    const int32_t n = world->world.particle_count();
+    for (int32_t i = 0; i < count; ++i)
+      if (corners[i] < 0 || corners[i] >= n)
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particles[" + num(i) + "] = " + num(corners[i]) +
+                                                 " is outside the world's particles [0, " + num(n) + ")");
+    std::vector<int32_t> sorted(corners.begin(), corners.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i] == sorted[i - 1])
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+               "the polygon is degenerate: particle " + num(sorted[i]) + " appears twice");
+    // One window of four consecutive corners for a quad; every one of them, cyclically, for more.
+    const int32_t windows = count == 4 ? 1 : count;
+    std::vector<int32_t> ids(static_cast<size_t>(windows) * 4);
+    const std::vector<embra::Vec3>& x = world->world.positions();
+    for (int32_t w = 0; w < windows; ++w) {
+      for (int k = 0; k < 4; ++k) ids[4 * static_cast<size_t>(w) + k] = corners[(w + k) % count];
+      const int32_t* q = &ids[4 * static_cast<size_t>(w)];
+      const embra::Vec3 d1 = x[q[2]] - x[q[0]], d2 = x[q[3]] - x[q[1]];
+      if (!(d1.cross(d2).norm() > 1e-12 * d1.norm() * d2.norm()))
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT, "the polygon is degenerate: corners " + num(w) + " to " +
+                                                 num((w + 3) % count) +
+                                                 " have parallel diagonals (in line): no plane to pull them to");
+    }
+    const std::vector<double> rest(static_cast<size_t>(windows), 0.0);
+    embra::ConstraintDesc d;
+    d.kind = embra::Kind::planarity;
+    d.group = to_id(group);
+    d.particles = ids;
+    d.rest = rest;
+    d.uniform_compliance = compliance;
+    world->world.add_constraints(d);
+    if (out_added != nullptr) *out_added = windows;
   });
 }
 

@@ -1103,6 +1103,50 @@ static void test_constraint_add(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
 }
 
+/* embra_polygon_planarity_add: the cloth's boundary ring (eight corners, planar) is good; a corner
+ * outside the world or given twice, fewer than four corners, a bad compliance, a stale group and
+ * four corners in line are refused. */
+static void test_polygon_planarity_add(void) {
+  const int32_t c = g_ref.cloth;
+  int32_t ring[8], line[4], added = -1, i;
+  const embra_group_id deflt = {0, 0};
+  ring[0] = c + 0, ring[1] = c + 1, ring[2] = c + 2, ring[3] = c + 5;
+  ring[4] = c + 8, ring[5] = c + 7, ring[6] = c + 6, ring[7] = c + 3;
+  {
+    scene s;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_polygon_planarity_add(s.w, deflt, ring, 8, 0.0, &added));
+    CHECK_INT(added, 8);
+    CHECK_OK(embra_polygon_planarity_add(s.w, deflt, ring, 4, 1e-3, &added));
+    CHECK_INT(added, 1);
+    embra_world_destroy(s.w);
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_polygon_planarity_add(NULL, deflt, ring, 8, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_polygon_planarity_add(W, deflt, NULL, 8, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, 3, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, -1, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("polygon compliance %s", bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance",
+            embra_polygon_planarity_add(W, deflt, ring, 8, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("polygon");
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_polygon_planarity_add(W, deflt, ring, 8, -1e-6, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_polygon_planarity_add(W, g_ref.g_dead, ring, 8, 0.0, NULL));
+  ring[5] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  ring[5] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  ring[5] = c + 1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  /* F0 F2 F5 and one more on their line would be parallel diagonals; F0 F2 F5 F3: F3 off it. A
+   * window (F0, F2, F5, F1) with F1 = F0: diagonals F0-F5 and F2-F1, both along the line. */
+  line[0] = g_ref.fixture + F0, line[1] = g_ref.fixture + F2, line[2] = g_ref.fixture + F5;
+  line[3] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_polygon_planarity_add(W, deflt, line, 4, 0.0, NULL));
+}
+
 static void test_constraints_add(void) {
   embra_constraint_batch_def d;
   int32_t ids[8];
@@ -2064,6 +2108,7 @@ int main(void) {
   RUN(test_body_queries);
   RUN(test_constraint_add);
   RUN(test_constraints_add);
+  RUN(test_polygon_planarity_add);
   RUN(test_pins);
   RUN(test_colliders);
   RUN(test_id_lists);

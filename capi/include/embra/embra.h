@@ -538,6 +538,18 @@ EMBRA_API embra_constraint_batch_def embra_default_constraint_batch_def(void);
 /* Adds all constraints of the batch or none. */
 EMBRA_API embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def);
 
+/* Planarity of a polygon of any number of corners: `particles`, `count` >= 4 corners in order
+ * round it, held in one plane by EMBRA_CONSTRAINT_PLANARITY constraints of rest 0 on windows of four
+ * consecutive corners: the quad itself for count 4, and for more all `count` windows (c_i,
+ * c_i+1, c_i+2, c_i+3), indices round the polygon, so that every corner is in four windows and none
+ * defines the plane. Consecutive windows share three corners, so all of them planar is the polygon
+ * planar. In `group` ({0,0} = default), with `compliance` (m/N, >= 0; 0 = hard). *out_added (may be
+ * NULL) is the number added, the last of the group's planarity constraints. All or none: refused for
+ * a corner outside the world or given twice, and for a window whose diagonals are parallel (four
+ * corners in line: no plane to pull them to). */
+EMBRA_API embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                                   int32_t count, double compliance, int32_t* out_added);
+
 /* Edits without a rebuild. A constraint is named by its group ({0,0}: the default group), kind and
  * index among the group's constraints of that kind: those bodies generated first (in body order),
  * then the added ones in the order added, the numbering of embra_constraint_residual.index and

@@ -92,6 +92,28 @@ def test_equal_length_splits_a_pinned_line_evenly():
             assert abs(math.dist(p[3 * i:3 * i + 3], p[3 * i + 3:3 * i + 6]) - 0.25) < 1e-9
 
 
+def test_polygon_planarity_flattens_a_skew_hexagon():
+    """A hexagon with its corners up and down in turn, held planar (six windows of four corners):
+    every corner ends on the plane through corners 0, 2 and 4, and a range 0.3 <= |x0 - x3| (a
+    length_min) is met."""
+    xyz = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3), 0.2 if k % 2 == 0 else -0.2) for k in range(6)]
+    with embra.World(gravity=(0.0, 0.0, 0.0), substeps=4, iterations=10) as w:
+        w.create_body(xyz, generate=0, masses=[1.0] * 6)
+        assert w.add_polygon_planarity(range(6)) == 6
+        assert w.add_constraints("length_min", [(0, 3)], rest=[2.5]) == 1
+        w.step(60)
+        p = [flat(w.positions())[3 * k:3 * k + 3] for k in range(6)]
+        a = [p[2][i] - p[0][i] for i in range(3)]
+        b = [p[4][i] - p[0][i] for i in range(3)]
+        n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        ln = math.sqrt(sum(v * v for v in n))
+        for k in range(6):
+            assert abs(sum((p[k][i] - p[0][i]) * n[i] for i in range(3)) / ln) < 1e-9
+        assert math.dist(p[0], p[3]) >= 2.5 - 1e-9
+        with pytest.raises(embra.EmbraError, match="twice"):
+            w.add_polygon_planarity([0, 1, 2, 1])
+
+
 def test_statics_two_bar_truss_forces_and_reactions():
     """A load hung from two pins by two hard bars at 45 degrees: each bar carries the load over
     2 sin 45 (tension, N), and the pins' reactions sum to minus every weight and point load."""
