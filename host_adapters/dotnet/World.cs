@@ -648,6 +648,17 @@ namespace Embra
             return count;
         }
 
+        /// <summary>Holds a polygon of four or more corners (particle indices in order round it) in one
+        /// plane (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four
+        /// consecutive corners, all of them cyclically for more than four. Returns how many were added.</summary>
+        public int AddPolygonPlanarity(int[] particles, double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(particles != null, "particles: required");
+            int added = 0;
+            Call(w => Native.embra_polygon_planarity_add(w, group, particles, particles.Length, compliance, out added));
+            return added;
+        }
+
         // Edits of one constraint, named as the diagnostics name it: group (default: the default group),
         // kind and index among the group's constraints of that kind (those bodies generated first, then the
         // added ones in the order added). Only added constraints are edited; a body's follow its material.

@@ -480,6 +480,40 @@ namespace Embra.Tests
                 }
             }
         }
+
+        /// <summary>A hexagon with its corners up and down in turn, held planar: every corner ends on the
+        /// plane through corners 0, 2 and 4, and a corner given twice is refused.</summary>
+        [Test]
+        public void PolygonPlanarityFlattensASkewHexagon()
+        {
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = 0.0; }
+            solver.Substeps = 4;
+            solver.Iterations = 10;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                var xyz = new double[18];
+                for (int k = 0; k < 6; ++k)
+                {
+                    xyz[3 * k] = Math.Cos(k * Math.PI / 3);
+                    xyz[3 * k + 1] = Math.Sin(k * Math.PI / 3);
+                    xyz[3 * k + 2] = k % 2 == 0 ? 0.2 : -0.2;
+                }
+                w.CreateBody(xyz, masses: new[] { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0 }, def: def);
+                Assert.AreEqual(6, w.AddPolygonPlanarity(new[] { 0, 1, 2, 3, 4, 5 }));
+                w.Step(200);
+                var p = w.GetPositions();
+                Func<int, int, double> at = (k, i) => p[3 * k + i] - p[i];  // corner k from corner 0
+                double nx = at(2, 1) * at(4, 2) - at(2, 2) * at(4, 1), ny = at(2, 2) * at(4, 0) - at(2, 0) * at(4, 2),
+                       nz = at(2, 0) * at(4, 1) - at(2, 1) * at(4, 0);
+                double len = Math.Sqrt(nx * nx + ny * ny + nz * nz);
+                for (int k = 0; k < 6; ++k)
+                    Assert.AreEqual(0.0, (at(k, 0) * nx + at(k, 1) * ny + at(k, 2) * nz) / len, 1e-9, "corner " + k);
+                Assert.Throws<EmbraArgumentException>(() => w.AddPolygonPlanarity(new[] { 0, 1, 2, 1 }));
+            }
+        }
     }
 
     public class SolveTests

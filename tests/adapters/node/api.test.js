@@ -105,6 +105,27 @@ test('equal length: four links between fixed ends, neighbours held equal, end a 
   w.close();
 });
 
+test('polygon planarity: a hexagon with its corners up and down in turn ends on one plane', () => {
+  const xyz = [];
+  for (let k = 0; k < 6; k++) xyz.push([Math.cos(k * Math.PI / 3), Math.sin(k * Math.PI / 3), k % 2 ? -0.2 : 0.2]);
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 10 });
+  w.createBody(xyz, { generate: 0, masses: [1, 1, 1, 1, 1, 1] });
+  assert.equal(w.addPolygonPlanarity([0, 1, 2, 3, 4, 5]), 6);
+  w.step(200);
+  const p = w.positions();
+  const v = (k) => [0, 1, 2].map((i) => p[3 * k + i] - p[i]);  // corner k from corner 0
+  const a = v(2), b = v(4);
+  const n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const len = Math.hypot(...n);
+  for (let k = 0; k < 6; k++) {
+    const d = v(k);
+    const off = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / len;  // from the plane through 0, 2, 4
+    assert.ok(Math.abs(off) < 1e-9, `corner ${k}: ${off}`);
+  }
+  assert.throws(() => w.addPolygonPlanarity([0, 1, 2, 1]), /twice/);
+  w.close();
+});
+
 test('statics: two hard bars at 45 degrees carry a load, the pins react with every weight and load', () => {
   const xyz = [[-1, 0, 0], [1, 0, 0], [0, 0, -1]];
   const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 20, damping: 5, tethers: 0,
