@@ -1147,6 +1147,48 @@ static void test_polygon_planarity_add(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_polygon_planarity_add(W, deflt, line, 4, 0.0, NULL));
 }
 
+/* embra_rigid_set_add: the flat cloth (nine points) and the tetrahedron with the free point (solid)
+ * are good, 4 n - 9 constraints each; a point outside the world or given twice, fewer than three, a
+ * bad compliance, a stale group, two points at one place and a set on one line are refused. */
+static void test_rigid_set_add(void) {
+  const int32_t c = g_ref.cloth;
+  int32_t cloth[9], solid[5], bad[3], added = -1, i;
+  const embra_group_id deflt = {0, 0};
+  for (i = 0; i < 9; ++i) cloth[i] = c + i;
+  for (i = 0; i < 4; ++i) solid[i] = g_ref.tet + i;
+  solid[4] = g_ref.point;
+  {
+    scene s;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_rigid_set_add(s.w, deflt, cloth, 9, 0.0, &added));
+    CHECK_INT(added, 27);
+    CHECK_OK(embra_rigid_set_add(s.w, deflt, solid, 5, 1e-6, &added));
+    CHECK_INT(added, 11);
+    embra_world_destroy(s.w);
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_rigid_set_add(NULL, deflt, cloth, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_rigid_set_add(W, deflt, NULL, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, 2, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("rigid set compliance %s", bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("rigid set");
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, -1.0, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_rigid_set_add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
+  cloth[7] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = c + 2;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  bad[0] = g_ref.fixture + F0, bad[1] = g_ref.fixture + F2, bad[2] = g_ref.fixture + F5; /* on one line */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
+  bad[1] = g_ref.fixture + F1, bad[2] = g_ref.fixture + F3; /* F0 and F1 at one place */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
+}
+
 static void test_constraints_add(void) {
   embra_constraint_batch_def d;
   int32_t ids[8];
@@ -2109,6 +2151,7 @@ int main(void) {
   RUN(test_constraint_add);
   RUN(test_constraints_add);
   RUN(test_polygon_planarity_add);
+  RUN(test_rigid_set_add);
   RUN(test_pins);
   RUN(test_colliders);
   RUN(test_id_lists);

@@ -550,6 +550,21 @@ EMBRA_API embra_status embra_constraints_add(embra_world* world, const embra_con
 EMBRA_API embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id group, const int32_t* particles,
                                                    int32_t count, double compliance, int32_t* out_added);
 
+/* A rigid point set by bracing (not shape matching): `particles`, `count` >= 3 points, keep their
+ * current shape, moving only as one rigid body, through constraints of existing kinds with rests
+ * measured now. A base of three or four of the points (the first, the one farthest from it, the one
+ * farthest from their line, the one farthest from their plane) is braced by the distances among
+ * its points, and every other point by its distances to each base point. A solid set (a point at
+ * least 1e-3 of the set's size off the plane of the first three base points) adds the base
+ * tetrahedron's volume (EMBRA_CONSTRAINT_TET_VOLUME: keeps its handedness, which distances alone
+ * cannot); a flat one holds each other point at its offset from the base's plane
+ * (EMBRA_CONSTRAINT_PLANE_OFFSET). Either way n points take 4 n - 9 constraints; *out_added (may
+ * be NULL) is that count. In `group` ({0,0} = default), with `compliance` (>= 0; 0 = hard). All or
+ * none: refused for a point outside the world or given twice, two points at one place, and a set on
+ * one line (no frame to hold). */
+EMBRA_API embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                           int32_t count, double compliance, int32_t* out_added);
+
 /* Edits without a rebuild. A constraint is named by its group ({0,0}: the default group), kind and
  * index among the group's constraints of that kind: those bodies generated first (in body order),
  * then the added ones in the order added, the numbering of embra_constraint_residual.index and

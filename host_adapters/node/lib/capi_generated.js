@@ -550,6 +550,7 @@ const PROTOTYPES = {
   embra_default_constraint_batch_def: 'embra_constraint_batch_def embra_default_constraint_batch_def(void)',
   embra_constraints_add: 'embra_status embra_constraints_add(embra_world *world, const embra_constraint_batch_def *def)',
   embra_polygon_planarity_add: 'embra_status embra_polygon_planarity_add(embra_world *world, embra_group_id group, const int32_t *particles, int32_t count, double compliance, _Out_ int32_t *out_added)',
+  embra_rigid_set_add: 'embra_status embra_rigid_set_add(embra_world *world, embra_group_id group, const int32_t *particles, int32_t count, double compliance, _Out_ int32_t *out_added)',
   embra_group_get_constraint_count: 'embra_status embra_group_get_constraint_count(const embra_world *world, embra_group_id group, embra_constraint_kind kind, _Out_ int32_t *out_count, _Out_ int32_t *out_generated)',
   embra_constraint_get: 'embra_status embra_constraint_get(const embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, _Out_ embra_constraint_def *out_def)',
   embra_constraint_set_compliance: 'embra_status embra_constraint_set_compliance(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, double compliance)',

@@ -661,6 +661,7 @@ PROTOTYPES = {
     "embra_default_constraint_batch_def": (ConstraintBatchDef, []),
     "embra_constraints_add": (c_int32, [c_void_p, POINTER(ConstraintBatchDef)]),
     "embra_polygon_planarity_add": (c_int32, [c_void_p, GroupId, POINTER(c_int32), c_int32, c_double, POINTER(c_int32)]),
+    "embra_rigid_set_add": (c_int32, [c_void_p, GroupId, POINTER(c_int32), c_int32, c_double, POINTER(c_int32)]),
     "embra_group_get_constraint_count": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_int32), POINTER(c_int32)]),
     "embra_constraint_get": (c_int32, [c_void_p, GroupId, c_int32, c_int32, POINTER(ConstraintDef)]),
     "embra_constraint_set_compliance": (c_int32, [c_void_p, GroupId, c_int32, c_int32, c_double]),

@@ -600,6 +600,17 @@ class World:
         self._call("embra_constraints_add", byref(d))
         return count
 
+    def add_rigid_set(self, particles, compliance=0.0, group=None):
+        """Keeps three or more points (particle indices) in their current shape, moving as one rigid
+        body (embra_rigid_set_add): bracing by distance constraints to a base of three or four of
+        them, with the base's volume (solid) or each point's offset from its plane (flat). Returns
+        how many constraints were added (4 n - 9)."""
+        p, n, keep = buf.ints_in(particles, "particles")
+        added = c_int32(0)
+        self._call("embra_rigid_set_add", _id(group, GroupId, "group"), p, buf.int32(n, "count"), float(compliance),
+                   byref(added))
+        return added.value
+
     def add_polygon_planarity(self, particles, compliance=0.0, group=None):
         """Holds a polygon of four or more corners (particle indices in order round it) in one plane
         (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four

@@ -114,6 +114,26 @@ def test_polygon_planarity_flattens_a_skew_hexagon():
             w.add_polygon_planarity([0, 1, 2, 1])
 
 
+def test_rigid_set_keeps_its_shape_while_it_falls_and_turns():
+    """Six points braced rigid (4 n - 9 = 15 constraints), one corner pinned, 60 frames of gravity at
+    4 x 40 iterations: every pairwise distance as it was to 1e-6 m; points on one line are refused."""
+    xyz = [(0, 0, 1), (0.4, 0, 1), (0, 0.4, 1), (0, 0, 1.4), (0.3, 0.3, 1.3), (-0.2, 0.1, 1.2)]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=4, iterations=40, tethers=0) as w:
+        w.create_body(xyz, generate=0, masses=[1.0] * 6)
+        assert w.add_rigid_set(range(6)) == 15
+        w.create_pin(0, xyz[0])
+        w.step(60)
+        p = [flat(w.positions())[3 * k:3 * k + 3] for k in range(6)]
+        assert math.dist(p[4], xyz[4]) > 0.05  # it turned
+        for i in range(6):
+            for j in range(i + 1, 6):
+                assert abs(math.dist(p[i], p[j]) - math.dist(xyz[i], xyz[j])) < 1e-6
+    with embra.World() as w:
+        w.create_body([(0, 0, 0), (1, 0, 0), (2, 0, 0)], generate=0, masses=[1.0] * 3)
+        with pytest.raises(embra.EmbraError, match="line"):
+            w.add_rigid_set([0, 1, 2])
+
+
 def test_statics_two_bar_truss_forces_and_reactions():
     """A load hung from two pins by two hard bars at 45 degrees: each bar carries the load over
     2 sin 45 (tension, N), and the pins' reactions sum to minus every weight and point load."""
