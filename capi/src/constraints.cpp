@@ -1,8 +1,13 @@
 // Constraints added by the host, one or a batch at a time.
 #include "guard.hpp"
 
+#include "embra/core/limits.hpp"
+
+#include <algorithm>
 #include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 using namespace embra::capi;
 
@@ -67,6 +72,126 @@ embra_status embra_constraints_add(embra_world* world, const embra_constraint_ba
     if (def->compliances) d.compliance = std::span<const double>(def->compliances, static_cast<size_t>(def->count));
     d.uniform_compliance = def->compliance;
     world->world.add_constraints(d);
+  });
+}
+
+embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                         int32_t count, double compliance, int32_t* out_added) {
+  return guard("embra_polygon_planarity_add", world, [&] {
+    if (count < 4) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be >= 4 (fewer corners are always planar)");
+    if (count > embra::limits::kMaxConstraints)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be <= " + num(embra::limits::kMaxConstraints));
+    const std::span<const int32_t> corners = view(particles, count, "particles");
+    const int32_t n = world->world.particle_count();
+    for (int32_t i = 0; i < count; ++i)
+      if (corners[i] < 0 || corners[i] >= n)
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particles[" + num(i) + "] = " + num(corners[i]) +
+                                                 " is outside the world's particles [0, " + num(n) + ")");
+    std::vector<int32_t> sorted(corners.begin(), corners.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i] == sorted[i - 1])
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+               "the polygon is degenerate: particle " + num(sorted[i]) + " appears twice");
+    // One window of four consecutive corners for a quad; every one of them, cyclically, for more.
+    const int32_t windows = count == 4 ? 1 : count;
+    std::vector<int32_t> ids(static_cast<size_t>(windows) * 4);
+    const std::vector<embra::Vec3>& x = world->world.positions();
+    for (int32_t w = 0; w < windows; ++w) {
+      for (int k = 0; k < 4; ++k) ids[4 * static_cast<size_t>(w) + k] = corners[(w + k) % count];
+      const int32_t* q = &ids[4 * static_cast<size_t>(w)];
+      const embra::Vec3 d1 = x[q[2]] - x[q[0]], d2 = x[q[3]] - x[q[1]];
+      if (!(d1.cross(d2).norm() > 1e-12 * d1.norm() * d2.norm()))
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT, "the polygon is degenerate: corners " + num(w) + " to " +
+                                                 num((w + 3) % count) +
+                                                 " have parallel diagonals (in line): no plane to pull them to");
+    }
+    const std::vector<double> rest(static_cast<size_t>(windows), 0.0);
+    embra::ConstraintDesc d;
+    d.kind = embra::Kind::planarity;
+    d.group = to_id(group);
+    d.particles = ids;
+    d.rest = rest;
+    d.uniform_compliance = compliance;
+    world->world.add_constraints(d);
+    if (out_added != nullptr) *out_added = windows;
+  });
+}
+
+embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const int32_t* particles, int32_t count,
+                                 double compliance, int32_t* out_added) {
+  return guard("embra_rigid_set_add", world, [&] {
+    if (count < 3) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be >= 3 (two points: a distance constraint)");
+    if (count > embra::limits::kMaxConstraints / 5)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be <= " + num(embra::limits::kMaxConstraints / 5));
+    const std::span<const int32_t> pts = view(particles, count, "particles");
+    const int32_t n = world->world.particle_count();
+    for (int32_t i = 0; i < count; ++i)
+      if (pts[i] < 0 || pts[i] >= n)
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+               "particles[" + num(i) + "] = " + num(pts[i]) + " is outside the world's particles [0, " + num(n) + ")");
+    std::vector<int32_t> sorted(pts.begin(), pts.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i] == sorted[i - 1])
+        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+               "the point set is degenerate: particle " + num(sorted[i]) + " appears twice");
+    // The base: a the first point, b the farthest from it, c the farthest from the line ab, d the
+    // farthest from the plane abc (the first of equals, so the choice is the same on every machine).
+    const std::vector<embra::Vec3>& x = world->world.positions();
+    const auto farthest = [&](auto&& distance) {
+      int32_t best = 0;
+      double most = -1.0;
+      for (int32_t i = 0; i < count; ++i)
+        if (const double d = distance(x[pts[i]]); d > most) most = d, best = i;
+      return std::pair<int32_t, double>{best, most};
+    };
+    const embra::Vec3 xa = x[pts[0]];
+    const auto [ib, size] = farthest([&](const embra::Vec3& p) { return (p - xa).norm(); });
+    const embra::Vec3 u = (x[pts[ib]] - xa) / size;
+    const auto [ic, off_line] = farthest([&](const embra::Vec3& p) { return (p - xa).cross(u).norm(); });
+    if (!(off_line > 1e-6 * size))
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+             "the point set is degenerate: its points are on one line (or coincide), no rigid frame to hold");
+    const embra::Vec3 normal = u.cross(x[pts[ic]] - xa).normalized();
+    const auto [id, off_plane] = farthest([&](const embra::Vec3& p) { return std::abs((p - xa).dot(normal)); });
+    // Solid when a point is 1e-3 of the set's size off the plane (its base tetrahedron then has a volume
+    // the tet_volume kind measures: at least 1e-10 of the size cubed); else flat, each point held at
+    // its offset from the base's plane.
+    const bool solid = off_plane > 1e-3 * size;
+    std::vector<int32_t> base{pts[0], pts[ib], pts[ic]};
+    if (solid) base.push_back(pts[id]);
+    // Distances among the base; every other point's distances to each base point; a solid base's
+    // volume (its handedness), a flat set's points held on the base's plane.
+    std::vector<int32_t> pairs, tet, offsets;
+    for (size_t i = 0; i < base.size(); ++i)
+      for (size_t j = i + 1; j < base.size(); ++j) pairs.insert(pairs.end(), {base[i], base[j]});
+    for (int32_t i = 0; i < count; ++i) {
+      if (std::find(base.begin(), base.end(), pts[i]) != base.end()) continue;
+      for (int32_t b : base) pairs.insert(pairs.end(), {pts[i], b});
+      if (!solid) offsets.insert(offsets.end(), {pts[i], base[0], base[1], base[2]});
+    }
+    if (solid) tet = base;
+    const int64_t total = static_cast<int64_t>(pairs.size() / 2 + tet.size() / 4 + offsets.size() / 4);
+    if (world->world.constraint_count() + total > embra::limits::kMaxConstraints)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "a world holds at most " + num(embra::limits::kMaxConstraints) +
+                                               " constraints; this set would make " +
+                                               num(world->world.constraint_count() + total));
+    // Every check that could refuse is done: the three batches are added together or the group is
+    // stale for the first (refused before anything is added).
+    const auto add = [&](embra::Kind kind, const std::vector<int32_t>& ids) {
+      if (ids.empty()) return;
+      embra::ConstraintDesc d;
+      d.kind = kind;
+      d.group = to_id(group);
+      d.particles = ids;
+      d.uniform_compliance = compliance;
+      world->world.add_constraints(d);
+    };
+    add(embra::Kind::distance, pairs);
+    add(embra::Kind::tet_volume, tet);
+    add(embra::Kind::plane_offset, offsets);
+    if (out_added != nullptr) *out_added = static_cast<int32_t>(total);
   });
 }
 

@@ -20,7 +20,14 @@ static_assert(static_cast<int>(embra::Kind::planarity) == 6, "embra::Kind::plana
 static_assert(static_cast<int>(embra::Kind::plane_offset) == 7, "embra::Kind::plane_offset is EMBRA_CONSTRAINT_PLANE_OFFSET = 7");
 static_assert(static_cast<int>(embra::Kind::equal_length) == 8, "embra::Kind::equal_length is EMBRA_CONSTRAINT_EQUAL_LENGTH = 8");
 static_assert(static_cast<int>(embra::Kind::conical) == 9, "embra::Kind::conical is EMBRA_CONSTRAINT_CONICAL = 9");
-static_assert(embra::kKindCount == 10, "embra::Kind and the 10 EMBRA_CONSTRAINT_* values differ");
+static_assert(static_cast<int>(embra::Kind::length_min) == 10, "embra::Kind::length_min is EMBRA_CONSTRAINT_LENGTH_MIN = 10");
+static_assert(static_cast<int>(embra::Kind::angle_min) == 11, "embra::Kind::angle_min is EMBRA_CONSTRAINT_ANGLE_MIN = 11");
+static_assert(static_cast<int>(embra::Kind::angle_max) == 12, "embra::Kind::angle_max is EMBRA_CONSTRAINT_ANGLE_MAX = 12");
+static_assert(static_cast<int>(embra::Kind::colinear) == 13, "embra::Kind::colinear is EMBRA_CONSTRAINT_COLINEAR = 13");
+static_assert(static_cast<int>(embra::Kind::direction) == 14, "embra::Kind::direction is EMBRA_CONSTRAINT_DIRECTION = 14");
+static_assert(static_cast<int>(embra::Kind::cocircular) == 15, "embra::Kind::cocircular is EMBRA_CONSTRAINT_COCIRCULAR = 15");
+static_assert(static_cast<int>(embra::Kind::cospherical) == 16, "embra::Kind::cospherical is EMBRA_CONSTRAINT_COSPHERICAL = 16");
+static_assert(embra::kKindCount == 17, "embra::Kind and the 17 EMBRA_CONSTRAINT_* values differ");
 
 static_assert(static_cast<int>(embra::ColliderShape::plane) == 0, "embra::ColliderShape::plane is EMBRA_COLLIDER_PLANE = 0");
 static_assert(static_cast<int>(embra::ColliderShape::sphere) == 1, "embra::ColliderShape::sphere is EMBRA_COLLIDER_SPHERE = 1");

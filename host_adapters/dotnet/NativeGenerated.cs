@@ -39,7 +39,7 @@ namespace Embra
     public enum Generate { None = 0, Stretch = 1, Shear = 2, Bend = 4, Volume = 8 }
 
     /// <summary>EMBRA_CONSTRAINT_*.</summary>
-    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9 }
+    public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9, LengthMin = 10, AngleMin = 11, AngleMax = 12, Colinear = 13, Direction = 14, Cocircular = 15, Cospherical = 16 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
     public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }
@@ -601,6 +601,8 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_add(IntPtr world, ref ConstraintDef def);
         [DllImport(Library, CallingConvention = C)] public static extern ConstraintBatchDef embra_default_constraint_batch_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraints_add(IntPtr world, ref ConstraintBatchDef def);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_polygon_planarity_add(IntPtr world, GroupId group, int[] particles, int count, double compliance, out int added);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_rigid_set_add(IntPtr world, GroupId group, int[] particles, int count, double compliance, out int added);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_constraint_count(IntPtr world, GroupId group, int kind, out int count, out int generated);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_get(IntPtr world, GroupId group, int kind, int index, out ConstraintDef def);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_set_compliance(IntPtr world, GroupId group, int kind, int index, double compliance);

@@ -648,6 +648,29 @@ namespace Embra
             return count;
         }
 
+        /// <summary>Holds a polygon of four or more corners (particle indices in order round it) in one
+        /// plane (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four
+        /// consecutive corners, all of them cyclically for more than four. Returns how many were added.</summary>
+        public int AddPolygonPlanarity(int[] particles, double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(particles != null, "particles: required");
+            int added = 0;
+            Call(w => Native.embra_polygon_planarity_add(w, group, particles, particles.Length, compliance, out added));
+            return added;
+        }
+
+        /// <summary>Keeps three or more points (particle indices) in their current shape, moving as one
+        /// rigid body (embra_rigid_set_add): bracing by distance constraints to a base of three or four of
+        /// them, with the base's volume (solid) or each point's offset from its plane (flat). Returns how
+        /// many constraints were added (4 n - 9).</summary>
+        public int AddRigidSet(int[] particles, double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(particles != null, "particles: required");
+            int added = 0;
+            Call(w => Native.embra_rigid_set_add(w, group, particles, particles.Length, compliance, out added));
+            return added;
+        }
+
         // Edits of one constraint, named as the diagnostics name it: group (default: the default group),
         // kind and index among the group's constraints of that kind (those bodies generated first, then the
         // added ones in the order added). Only added constraints are edited; a body's follow its material.

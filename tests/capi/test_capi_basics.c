@@ -243,7 +243,14 @@ static void test_constraint_arity(void) {
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_PLANE_OFFSET), 4);
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_EQUAL_LENGTH), 4);
   CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_CONICAL), 5);
-  CHECK_INT(embra_constraint_arity(10), 0);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_LENGTH_MIN), 2);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_ANGLE_MIN), 3);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_ANGLE_MAX), 3);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_COLINEAR), 3);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_DIRECTION), 4);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_COCIRCULAR), 4);
+  CHECK_INT(embra_constraint_arity(EMBRA_CONSTRAINT_COSPHERICAL), 5);
+  CHECK_INT(embra_constraint_arity(17), 0);
   CHECK_INT(embra_constraint_arity(INT32_MAX), 0);
   CHECK_INT(embra_constraint_arity(INT32_MIN), 0);
 }

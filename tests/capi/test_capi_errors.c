@@ -949,8 +949,10 @@ static void test_constraint_add(void) {
       continue;
     }
     for (slot = 0; slot < n; ++slot) {
-      /* Equal length's two edges may share a particle (slots 1 and 2, 3 and 0); one edge may not. */
-      const int shared_edges = kind == EMBRA_CONSTRAINT_EQUAL_LENGTH && slot % 2 == 1;
+      /* Equal length's and direction's two edges may share a particle (slots 1 and 2, 3 and 0); one
+       * edge may not. */
+      const int shared_edges =
+          (kind == EMBRA_CONSTRAINT_EQUAL_LENGTH || kind == EMBRA_CONSTRAINT_DIRECTION) && slot % 2 == 1;
       CAPI_CONTEXT("kind %d, particle %d", kind, slot);
       d = good_constraint(kind);
       d.particles[slot] = -1;
@@ -1015,6 +1017,29 @@ static void test_constraint_add(void) {
   d.rest_from_current = 0;
   d.rest = 0.5;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "weld", embra_constraint_add(W, &d));
+  d = good_constraint(EMBRA_CONSTRAINT_LENGTH_MIN);
+  d.rest_from_current = 0;
+  d.rest = -0.1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest length", embra_constraint_add(W, &d));
+  d = good_constraint(EMBRA_CONSTRAINT_COLINEAR);
+  d.rest_from_current = 0;
+  d.rest = -0.1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest distance", embra_constraint_add(W, &d));
+  for (kind = EMBRA_CONSTRAINT_ANGLE_MIN; kind <= EMBRA_CONSTRAINT_DIRECTION; ++kind) {
+    if (kind == EMBRA_CONSTRAINT_COLINEAR) continue;
+    CAPI_CONTEXT("kind %d, rest angle out of [0, pi]", kind);
+    d = good_constraint(kind);
+    d.rest_from_current = 0;
+    d.rest = 3.2;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
+    d.rest = -0.01;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
+  }
+  CAPI_CONTEXT("cocircular rest beyond 2 pi");
+  d = good_constraint(EMBRA_CONSTRAINT_COCIRCULAR);
+  d.rest_from_current = 0;
+  d.rest = -6.3;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "rest angle", embra_constraint_add(W, &d));
 
   CAPI_CONTEXT("degenerate, rest measured from current positions");
   d = embra_default_constraint_def(); /* F0 and F1 coincide */
@@ -1043,6 +1068,125 @@ static void test_constraint_add(void) {
   d.particles[2] = g_ref.fixture + F3;
   d.particles[3] = g_ref.fixture + F4;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_LENGTH_MIN; /* F0 and F1 coincide: no direction to push apart in */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  for (kind = EMBRA_CONSTRAINT_ANGLE_MIN; kind <= EMBRA_CONSTRAINT_ANGLE_MAX; ++kind) {
+    d = embra_default_constraint_def();
+    d.kind = kind; /* an edge of zero length */
+    d.particles[0] = g_ref.fixture + F0;
+    d.particles[1] = g_ref.fixture + F1;
+    d.particles[2] = g_ref.fixture + F2;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  }
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_COLINEAR; /* the line's ends F0 and F1 coincide */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F2;
+  d.particles[2] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_DIRECTION; /* the reference edge F0-F1 has zero length */
+  d.particles[0] = g_ref.fixture + F2;
+  d.particles[1] = g_ref.fixture + F3;
+  d.particles[2] = g_ref.fixture + F0;
+  d.particles[3] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+  d = embra_default_constraint_def();
+  d.kind = EMBRA_CONSTRAINT_COCIRCULAR; /* the corner at F2 is straight (F0 F2 F5 collinear) */
+  d.particles[0] = g_ref.fixture + F0;
+  d.particles[1] = g_ref.fixture + F2;
+  d.particles[2] = g_ref.fixture + F5;
+  d.particles[3] = g_ref.fixture + F3;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraint_add(W, &d));
+}
+
+/* embra_polygon_planarity_add: the cloth's boundary ring (eight corners, planar) is good; a corner
+ * outside the world or given twice, fewer than four corners, a bad compliance, a stale group and
+ * four corners in line are refused. */
+static void test_polygon_planarity_add(void) {
+  const int32_t c = g_ref.cloth;
+  int32_t ring[8], line[4], added = -1, i;
+  const embra_group_id deflt = {0, 0};
+  ring[0] = c + 0, ring[1] = c + 1, ring[2] = c + 2, ring[3] = c + 5;
+  ring[4] = c + 8, ring[5] = c + 7, ring[6] = c + 6, ring[7] = c + 3;
+  {
+    scene s;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_polygon_planarity_add(s.w, deflt, ring, 8, 0.0, &added));
+    CHECK_INT(added, 8);
+    CHECK_OK(embra_polygon_planarity_add(s.w, deflt, ring, 4, 1e-3, &added));
+    CHECK_INT(added, 1);
+    embra_world_destroy(s.w);
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_polygon_planarity_add(NULL, deflt, ring, 8, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_polygon_planarity_add(W, deflt, NULL, 8, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, 3, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, -1, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_polygon_planarity_add(W, deflt, ring, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("polygon compliance %s", bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance",
+            embra_polygon_planarity_add(W, deflt, ring, 8, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("polygon");
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_polygon_planarity_add(W, deflt, ring, 8, -1e-6, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_polygon_planarity_add(W, g_ref.g_dead, ring, 8, 0.0, NULL));
+  ring[5] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  ring[5] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  ring[5] = c + 1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_polygon_planarity_add(W, deflt, ring, 8, 0.0, NULL));
+  /* F0 F2 F5 and one more on their line would be parallel diagonals; F0 F2 F5 F3: F3 off it. A
+   * window (F0, F2, F5, F1) with F1 = F0: diagonals F0-F5 and F2-F1, both along the line. */
+  line[0] = g_ref.fixture + F0, line[1] = g_ref.fixture + F2, line[2] = g_ref.fixture + F5;
+  line[3] = g_ref.fixture + F1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_polygon_planarity_add(W, deflt, line, 4, 0.0, NULL));
+}
+
+/* embra_rigid_set_add: the flat cloth (nine points) and the tetrahedron with the free point (solid)
+ * are good, 4 n - 9 constraints each; a point outside the world or given twice, fewer than three, a
+ * bad compliance, a stale group, two points at one place and a set on one line are refused. */
+static void test_rigid_set_add(void) {
+  const int32_t c = g_ref.cloth;
+  int32_t cloth[9], solid[5], bad[3], added = -1, i;
+  const embra_group_id deflt = {0, 0};
+  for (i = 0; i < 9; ++i) cloth[i] = c + i;
+  for (i = 0; i < 4; ++i) solid[i] = g_ref.tet + i;
+  solid[4] = g_ref.point;
+  {
+    scene s;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_rigid_set_add(s.w, deflt, cloth, 9, 0.0, &added));
+    CHECK_INT(added, 27);
+    CHECK_OK(embra_rigid_set_add(s.w, deflt, solid, 5, 1e-6, &added));
+    CHECK_INT(added, 11);
+    embra_world_destroy(s.w);
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_rigid_set_add(NULL, deflt, cloth, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_rigid_set_add(W, deflt, NULL, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, 2, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("rigid set compliance %s", bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("rigid set");
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, -1.0, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_rigid_set_add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
+  cloth[7] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = c + 2;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  bad[0] = g_ref.fixture + F0, bad[1] = g_ref.fixture + F2, bad[2] = g_ref.fixture + F5; /* on one line */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
+  bad[1] = g_ref.fixture + F1, bad[2] = g_ref.fixture + F3; /* F0 and F1 at one place */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
 }
 
 static void test_constraints_add(void) {
@@ -1098,6 +1242,44 @@ static void test_constraints_add(void) {
       cone_rest = bad_value(i);
       REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_constraints_add(W, &d));
     }
+  }
+  {
+    /* Five points on one sphere: the tetrahedron's four corners and the cloth's middle particle (its
+     * five particles do not fit embra_constraint_def). */
+    int32_t five[5];
+    double five_rest = 0.0;
+    scene s;
+    CAPI_CONTEXT("cospherical");
+    d = embra_default_constraint_batch_def();
+    d.kind = EMBRA_CONSTRAINT_COSPHERICAL;
+    d.count = 1;
+    d.particles = five;
+    five[0] = g_ref.tet, five[1] = g_ref.tet + 1, five[2] = g_ref.tet + 2, five[3] = g_ref.tet + 3;
+    five[4] = g_ref.cloth + 4;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_constraints_add(s.w, &d));
+    d.rest = &five_rest;
+    CHECK_OK(embra_constraints_add(s.w, &d));
+    d.rest = NULL;
+    embra_world_destroy(s.w);
+    five[4] = -1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_constraints_add(W, &d));
+    five[4] = g_ref.n;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_constraints_add(W, &d));
+    five[4] = g_ref.tet + 1;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_constraints_add(W, &d));
+    five[4] = g_ref.cloth + 4;
+    d.rest = &five_rest;
+    for (i = 0; i < 3; ++i) {
+      CAPI_CONTEXT("cospherical, %s", bad_name(i));
+      five_rest = bad_value(i);
+      REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", embra_constraints_add(W, &d));
+    }
+    CAPI_CONTEXT("cospherical, flat");
+    d.rest = NULL; /* F0 F2 F3 F4 lie in a plane: no sphere through them */
+    five[0] = g_ref.fixture + F0, five[1] = g_ref.fixture + F2, five[2] = g_ref.fixture + F3;
+    five[3] = g_ref.fixture + F4, five[4] = g_ref.fixture + F5;
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_constraints_add(W, &d));
   }
   GOOD_BATCH();
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "def", embra_constraints_add(W, NULL));
@@ -1968,6 +2150,8 @@ int main(void) {
   RUN(test_body_queries);
   RUN(test_constraint_add);
   RUN(test_constraints_add);
+  RUN(test_polygon_planarity_add);
+  RUN(test_rigid_set_add);
   RUN(test_pins);
   RUN(test_colliders);
   RUN(test_id_lists);

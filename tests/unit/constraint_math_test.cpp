@@ -31,10 +31,12 @@ template <int N>
 using Points = std::array<Vec3, N>;
 
 template <int N>
-void check_gradient(const std::function<ConstraintEval<N>(const Points<N>&)>& f, const Points<N>& x, const char* what,
-                    int config) {
+double check_gradient(const std::function<ConstraintEval<N>(const Points<N>&)>& f, const Points<N>& x, const char* what,
+                      int config) {
   const ConstraintEval<N> e = f(x);
-  ASSERT_TRUE(e.valid) << what << " config " << config;
+  EXPECT_TRUE(e.valid) << what << " config " << config;
+  if (!e.valid) return 0.0;
+  double worst = 0.0;  // the largest |grad - fd| / max(1, |fd|)
   for (int k = 0; k < N; ++k)
     for (int c = 0; c < 3; ++c) {
       Points<N> xp = x, xm = x;
@@ -43,6 +45,7 @@ void check_gradient(const std::function<ConstraintEval<N>(const Points<N>&)>& f,
       const double fd = (f(xp).value - f(xm).value) / (2 * kStep);
       EXPECT_NEAR(e.grad[k][c], fd, kTol * std::max(1.0, std::abs(fd)))
           << what << " config " << config << " operand " << k << " coordinate " << c;
+      worst = std::max(worst, std::abs(e.grad[k][c] - fd) / std::max(1.0, std::abs(fd)));
     }
   // A function of the shape alone is invariant under translation and rotation: its gradients sum
   // to zero and have no net moment. (These two facts are what make a projection conserve linear
@@ -56,6 +59,7 @@ void check_gradient(const std::function<ConstraintEval<N>(const Points<N>&)>& f,
   }
   EXPECT_LT(sum.norm(), 1e-13 * scale) << what << " config " << config;
   EXPECT_LT(moment.norm(), 1e-13 * scale) << what << " config " << config;
+  return worst;
 }
 
 // Two points: C = |x0 - x1|.
@@ -218,6 +222,118 @@ TEST(ConstraintMath, EqualLengthValueAndGradient) {
   EXPECT_NEAR(eval_equal_length(Vec3(3, 0, 0), Vec3(0, 4, 0), Vec3(3, 0, 0), Vec3(0, 0, 0)).value, 2.0, 1e-15);
   EXPECT_FALSE(eval_equal_length(Vec3(1, 2, 3), Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(1, 0, 0)).valid);
   EXPECT_FALSE(eval_equal_length(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 2, 3), Vec3(1, 2, 3)).valid);
+}
+
+// Point x1 and the line through x0 and x2: C = distance of x1 from it. Expected value from Eigen's
+// ParametrizedLine.
+TEST(ConstraintMath, ColinearValueAndGradient) {
+  double worst = 0.0;  // gradient against central differences, relative (check_gradient)
+  Rng rng(10);
+  int checked = 0;
+  for (int i = 0; i < 4 * kConfigs && checked < kConfigs; ++i) {
+    Points<3> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    if ((x[2] - x[0]).norm() < 0.3) continue;
+    ++checked;
+    const auto line = Eigen::ParametrizedLine<double, 3>::Through(x[0], x[2]);
+    EXPECT_NEAR(eval_colinear(x[0], x[1], x[2]).value, line.distance(x[1]), 1e-14);
+    worst = std::max(
+        worst, check_gradient<3>([](const Points<3>& p) { return eval_colinear(p[0], p[1], p[2]); }, x, "colinear", i));
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // 0.5 above the x axis, past the segment's end (the line, not the segment); on the line: 0.
+  EXPECT_NEAR(eval_colinear(Vec3(0, 0, 0), Vec3(3, 0.5, 0), Vec3(1, 0, 0)).value, 0.5, 1e-15);
+  EXPECT_EQ(eval_colinear(Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(1, 0, 0)).value, 0.0);
+  EXPECT_FALSE(eval_colinear(Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(1, 0, 0)).valid);  // on it: no gradient
+  EXPECT_FALSE(eval_colinear(Vec3(1, 1, 1), Vec3(3, 0, 0), Vec3(1, 1, 1)).valid);  // no line
+  RecordProperty("colinear_gradient_worst_relative_error", test::sci(worst));
+}
+
+// Edges x0 -> x1 and x2 -> x3: C = the angle between them.
+TEST(ConstraintMath, DirectionValueAndGradient) {
+  double worst = 0.0;  // gradient against central differences, relative (check_gradient)
+  Rng rng(11);
+  for (int i = 0; i < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const double expected =
+        std::acos(std::clamp((x[1] - x[0]).normalized().dot((x[3] - x[2]).normalized()), -1.0, 1.0));
+    EXPECT_NEAR(eval_direction(x[0], x[1], x[2], x[3]).value, expected, 1e-12);
+    worst = std::max(worst, check_gradient<4>([](const Points<4>& p) { return eval_direction(p[0], p[1], p[2], p[3]); },
+                                              x, "direction", i));
+  }
+  // Along the z axis: 0; against it: pi; across: pi / 2. Parallel edges have no gradient.
+  const Vec3 z0(5, 5, 0), z1(5, 5, 1);
+  EXPECT_EQ(eval_direction(Vec3(0, 0, 0), Vec3(0, 0, 2), z0, z1).value, 0.0);
+  EXPECT_NEAR(eval_direction(Vec3(0, 0, 2), Vec3(0, 0, 0), z0, z1).value, std::numbers::pi, 1e-15);
+  EXPECT_NEAR(eval_direction(Vec3(0, 0, 0), Vec3(1, 2, 0), z0, z1).value, std::numbers::pi / 2, 1e-15);
+  EXPECT_FALSE(eval_direction(Vec3(0, 0, 0), Vec3(0, 0, 2), z0, z1).valid);
+  EXPECT_FALSE(eval_direction(Vec3(1, 0, 0), Vec3(1, 0, 0), z0, z1).valid);
+  RecordProperty("direction_gradient_worst_relative_error", test::sci(worst));
+}
+
+// A quad x0 x1 x2 x3: C = a0 - a1 + a2 - a3, a_k its angle at x_k.
+TEST(ConstraintMath, CocircularValueAndGradient) {
+  double worst = 0.0;  // gradient against central differences, relative (check_gradient)
+  Rng rng(12);
+  auto angle = [](const Vec3& c, const Vec3& a, const Vec3& b) {
+    return std::acos(std::clamp((a - c).normalized().dot((b - c).normalized()), -1.0, 1.0));
+  };
+  for (int i = 0; i < kConfigs; ++i) {
+    Points<4> x{rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1), rng.vec(-1, 1)};
+    const double expected =
+        angle(x[0], x[3], x[1]) - angle(x[1], x[0], x[2]) + angle(x[2], x[1], x[3]) - angle(x[3], x[2], x[0]);
+    EXPECT_NEAR(eval_cocircular(x[0], x[1], x[2], x[3]).value, expected, 1e-12);
+    worst =
+        std::max(worst, check_gradient<4>([](const Points<4>& p) { return eval_cocircular(p[0], p[1], p[2], p[3]); }, x,
+                                          "cocircular", i));
+  }
+  // Four points at random places round one circle (in order, tilted in space): C = 0. A rhombus of
+  // angles 60 and 120 degrees is not cyclic: C = 2 pi / 3 - 4 pi / 3.
+  for (int i = 0; i < kConfigs; ++i) {
+    const Vec3 c = rng.vec(-1, 1), u = rng.vec(-1, 1).normalized();
+    const Vec3 v = u.cross(rng.vec(-1, 1)).normalized(), w = u.cross(v);
+    const double r = rng.uniform(0.2, 2.0);
+    double t[4];
+    for (double& a : t) a = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    std::sort(t, t + 4);
+    if (t[1] - t[0] < 0.2 || t[2] - t[1] < 0.2 || t[3] - t[2] < 0.2 || t[0] + 2 * std::numbers::pi - t[3] < 0.2)
+      continue;
+    Points<4> x;
+    for (int k = 0; k < 4; ++k) x[k] = c + r * (std::cos(t[k]) * v + std::sin(t[k]) * w);
+    EXPECT_NEAR(eval_cocircular(x[0], x[1], x[2], x[3]).value, 0.0, 1e-13) << "circle " << i;
+  }
+  const double h = std::sqrt(3.0) / 2;
+  EXPECT_NEAR(eval_cocircular(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1.5, h, 0), Vec3(0.5, h, 0)).value,
+              2 * std::numbers::pi / 3 - 4 * std::numbers::pi / 3, 1e-14);
+  EXPECT_FALSE(eval_cocircular(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(0, 1, 0)).valid);  // x1 straight
+  EXPECT_FALSE(eval_cocircular(Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(2, 1, 0), Vec3(0, 1, 0)).valid);  // zero edge
+  RecordProperty("cocircular_gradient_worst_relative_error", test::sci(worst));
+}
+
+// Five points: C = signed distance of x4 from the sphere through x0..x3. Built on a known sphere
+// (centre c, radius R): four points on it and the fifth at R + d from c must read d.
+TEST(ConstraintMath, CosphericalValueAndGradient) {
+  double worst = 0.0;  // gradient against central differences, relative (check_gradient)
+  Rng rng(13);
+  int checked = 0;
+  for (int i = 0; i < 8 * kConfigs && checked < kConfigs; ++i) {
+    const Vec3 c = rng.vec(-1, 1);
+    const double r = rng.uniform(0.3, 2.0), d = rng.uniform(-0.25, 0.5) * r;
+    Points<5> x;
+    for (int k = 0; k < 5; ++k) x[k] = c + (k < 4 ? r : r + d) * rng.vec(-1, 1).normalized();
+    if (std::abs(eval_tet_volume(x[0], x[1], x[2], x[3]).value) < 0.05 * r * r * r) continue;
+    ++checked;
+    EXPECT_NEAR(eval_cospherical(x[0], x[1], x[2], x[3], x[4]).value, d, 1e-13 * (1 + r)) << "config " << i;
+    worst = std::max(
+        worst, check_gradient<5>([](const Points<5>& p) { return eval_cospherical(p[0], p[1], p[2], p[3], p[4]); }, x,
+                                 "cospherical", i));
+  }
+  EXPECT_EQ(checked, kConfigs);
+  // Four corners of a flat square: no sphere through them. The fifth at the centre: no direction.
+  const Vec3 o(0, 0, 0), ex(1, 0, 0), ey(0, 1, 0), ez(0, 0, 1);
+  EXPECT_FALSE(eval_cospherical(o, ex, ey, Vec3(1, 1, 0), ez).valid);
+  EXPECT_FALSE(eval_cospherical(o, ex, ey, ez, Vec3(0.5, 0.5, 0.5)).valid);
+  EXPECT_NEAR(eval_cospherical(o, ex, ey, ez, Vec3(0.5, 0.5, 0.5) + 2.0 * ex).value, 2.0 - std::sqrt(0.75), 1e-15);
+  RecordProperty("cospherical_gradient_worst_relative_error", test::sci(worst));
 }
 
 // A vertex and its four neighbours: C = a12 - a23 + a34 - a41, the angles at x0.

@@ -133,6 +133,20 @@ inline double deviation(Kind kind, const std::vector<Vec3>& x, const int32_t* p,
       return eval_equal_length(x[p[0]], x[p[1]], x[p[2]], x[p[3]]).value - rest;
     case Kind::conical:
       return eval_conical(x[p[0]], x[p[1]], x[p[2]], x[p[3]], x[p[4]]).value - rest;
+    case Kind::length_min:  // one-sided: only a shortfall counts
+      return std::min(eval_distance(x[p[0]], x[p[1]]).value - rest, 0.0);
+    case Kind::angle_min:
+      return std::min(eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]).value - rest, 0.0);
+    case Kind::angle_max:
+      return std::max(eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]).value - rest, 0.0);
+    case Kind::colinear:
+      return eval_colinear(x[p[0]], x[p[1]], x[p[2]]).value - rest;
+    case Kind::direction:
+      return eval_direction(x[p[0]], x[p[1]], x[p[2]], x[p[3]]).value - rest;
+    case Kind::cocircular:
+      return eval_cocircular(x[p[0]], x[p[1]], x[p[2]], x[p[3]]).value - rest;
+    case Kind::cospherical:
+      return eval_cospherical(x[p[0]], x[p[1]], x[p[2]], x[p[3]], x[p[4]]).value - rest;
   }
   return 0.0;
 }

@@ -320,8 +320,9 @@ EMBRA_API embra_status embra_world_get_colliders(const embra_world* world, embra
  * `iterations` times. Put collisions last so they take precedence (the contact group's order is
  * 1000); give a group a higher weight to make it win over the others. Within one group the kinds
  * go in a fixed order: soft pins, welds, bending (edge angle, dihedral), tethers, stretch
- * (distance), volume, equal lengths, conical vertices, panels (planarity, offsets), contacts; a
- * later kind has the final word.
+ * (distance), volume, equal lengths, conical vertices, the geometry goals (length_min, angle_min,
+ * angle_max, colinear, direction, cocircular, cospherical, in that order), panels (planarity,
+ * offsets), contacts; a later kind has the final word.
  * ------------------------------------------------------------------------------------------- */
 
 #define EMBRA_GROUP_DEF_VERSION 1
@@ -473,7 +474,7 @@ enum {
                                         = rest (m; 0 = equal). The edges may share a particle (x1 =
                                         x2); an edge may not join a particle to itself. A set of
                                         edges held equal (gridshells): pair each with the next */
-  EMBRA_CONSTRAINT_CONICAL = 9       /* 5 particles, a vertex x0 of valence four and its neighbours
+  EMBRA_CONSTRAINT_CONICAL = 9,      /* 5 particles, a vertex x0 of valence four and its neighbours
                                         x1 x2 x3 x4 in order round it: a12 - a23 + a34 - a41 = rest
                                         (rad, [-2 pi, 2 pi]; 0 = conical), a_ij the angle at x0
                                         between x_i - x0 and x_j - x0. With every face planar
@@ -482,6 +483,38 @@ enum {
                                         builds it panels of constant thickness with planar joints.
                                         Added with embra_constraints_add (embra_constraint_def
                                         holds four particles) */
+  EMBRA_CONSTRAINT_LENGTH_MIN = 10,  /* 2 particles: |x0 - x1| >= rest (m, >= 0). Unilateral: pushes
+                                        only when shorter (a tether only pulls). A length range min
+                                        <= |x0 - x1| <= max is a length_min of rest min and a tether
+                                        of rest max on the same two particles. Coincident particles
+                                        have no direction to be pushed apart in: not moved */
+  EMBRA_CONSTRAINT_ANGLE_MIN = 11,   /* 3 particles: angle at x0 between x1 - x0 and x2 - x0 >= rest
+                                        (rad, [0, pi]). Unilateral: opens the corner only */
+  EMBRA_CONSTRAINT_ANGLE_MAX = 12,   /* 3 particles: the same angle <= rest (rad, [0, pi]).
+                                        Unilateral: closes only. An angle range is an angle_min and an
+                                        angle_max on the same corner */
+  EMBRA_CONSTRAINT_COLINEAR = 13,    /* 3 particles: distance of x1 from the line through x0 and x2
+                                        = rest (m, >= 0; 0 = the three on one line, x1 anywhere along
+                                        it). |(x1 - x0) x (x2 - x0)| / |x2 - x0|. A point set on one
+                                        line: each point with the set's two ends */
+  EMBRA_CONSTRAINT_DIRECTION = 14,   /* 4 particles: angle between the edges x0 -> x1 and x2 -> x3 =
+                                        rest (rad, [0, pi]; 0 = x0-x1 along x2-x3, pi = against it).
+                                        The reference edge x2-x3 is a fixed direction when both are
+                                        immovable (mass 0 or hard-pinned); movable, the two edges turn
+                                        toward each other (parallel edges). The edges may share a
+                                        particle (x1 = x2); an edge may not join a particle to itself */
+  EMBRA_CONSTRAINT_COCIRCULAR = 15,  /* 4 particles, a convex quad x0 x1 x2 x3 in order round it:
+                                        a0 - a1 + a2 - a3 = rest (rad, [-2 pi, 2 pi]; 0 = cyclic), a_k
+                                        the angle at x_k between its two neighbours. A planar quad
+                                        with opposite angles summing to pi has its corners on one
+                                        circle; planarity is a separate constraint
+                                        (EMBRA_CONSTRAINT_PLANARITY on the same quad) */
+  EMBRA_CONSTRAINT_COSPHERICAL = 16  /* 5 particles: signed distance of x4 from the sphere through
+                                        x0 x1 x2 x3 = rest (m; 0 = the five on one sphere, positive
+                                        outside). x0..x3 must not be flat. Added with
+                                        embra_constraints_add (embra_constraint_def holds four
+                                        particles). A point set on one sphere: four well-spread
+                                        points of it with each of the others */
 };
 /* Number of particles one constraint of `kind` takes, or 0 for an unknown kind. */
 EMBRA_API int32_t embra_constraint_arity(embra_constraint_kind kind);
@@ -492,7 +525,7 @@ typedef struct embra_constraint_def {
   embra_constraint_kind kind;
   embra_group_id group;      /* {0,0} = default group */
   int32_t particles[4];      /* the first embra_constraint_arity(kind) are used: a kind of more
-                                (EMBRA_CONSTRAINT_CONICAL) is added with embra_constraints_add */
+                                (CONICAL, COSPHERICAL) is added with embra_constraints_add */
   int32_t rest_from_current; /* 1 (default): measure rest from current positions; 0: use rest */
   int32_t reserved0;
   double rest;       /* rest value in the kind's unit, when rest_from_current is 0 */
@@ -519,6 +552,33 @@ EMBRA_API embra_constraint_batch_def embra_default_constraint_batch_def(void);
 /* Adds all constraints of the batch or none. */
 EMBRA_API embra_status embra_constraints_add(embra_world* world, const embra_constraint_batch_def* def);
 
+/* Planarity of a polygon of any number of corners: `particles`, `count` >= 4 corners in order
+ * round it, held in one plane by EMBRA_CONSTRAINT_PLANARITY constraints of rest 0 on windows of four
+ * consecutive corners: the quad itself for count 4, and for more all `count` windows (c_i,
+ * c_i+1, c_i+2, c_i+3), indices round the polygon, so that every corner is in four windows and none
+ * defines the plane. Consecutive windows share three corners, so all of them planar is the polygon
+ * planar. In `group` ({0,0} = default), with `compliance` (m/N, >= 0; 0 = hard). *out_added (may be
+ * NULL) is the number added, the last of the group's planarity constraints. All or none: refused for
+ * a corner outside the world or given twice, and for a window whose diagonals are parallel (four
+ * corners in line: no plane to pull them to). */
+EMBRA_API embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                                   int32_t count, double compliance, int32_t* out_added);
+
+/* A rigid point set by bracing (not shape matching): `particles`, `count` >= 3 points, keep their
+ * current shape, moving only as one rigid body, through constraints of existing kinds with rests
+ * measured now. A base of three or four of the points (the first, the one farthest from it, the one
+ * farthest from their line, the one farthest from their plane) is braced by the distances among
+ * its points, and every other point by its distances to each base point. A solid set (a point at
+ * least 1e-3 of the set's size off the plane of the first three base points) adds the base
+ * tetrahedron's volume (EMBRA_CONSTRAINT_TET_VOLUME: keeps its handedness, which distances alone
+ * cannot); a flat one holds each other point at its offset from the base's plane
+ * (EMBRA_CONSTRAINT_PLANE_OFFSET). Either way n points take 4 n - 9 constraints; *out_added (may
+ * be NULL) is that count. In `group` ({0,0} = default), with `compliance` (>= 0; 0 = hard). All or
+ * none: refused for a point outside the world or given twice, two points at one place, and a set on
+ * one line (no frame to hold). */
+EMBRA_API embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                           int32_t count, double compliance, int32_t* out_added);
+
 /* Edits without a rebuild. A constraint is named by its group ({0,0}: the default group), kind and
  * index among the group's constraints of that kind: those bodies generated first (in body order),
  * then the added ones in the order added, the numbering of embra_constraint_residual.index and
@@ -535,7 +595,7 @@ EMBRA_API embra_status embra_group_get_constraint_count(const embra_world* world
                                                         int32_t* out_generated);
 /* One constraint as embra_constraint_add would take it: kind, group, particles (-1 past the arity),
  * rest (before any body's rest scale) with rest_from_current 0, and compliance. Refused for a kind of
- * more particles than the def holds (EMBRA_CONSTRAINT_CONICAL: embra_world_save_json lists them). */
+ * more particles than the def holds (CONICAL, COSPHERICAL: embra_world_save_json lists them). */
 EMBRA_API embra_status embra_constraint_get(const embra_world* world, embra_group_id group, embra_constraint_kind kind,
                                             int32_t index, embra_constraint_def* out_def);
 /* Compliance >= 0 and finite, in the kind's unit per newton. */
@@ -778,7 +838,8 @@ typedef struct embra_constraint_residual {
   int32_t particles[4]; /* its particles (the first four of a conical vertex's five: the vertex and
                            its first three neighbours); -1 past the kind's arity */
   double residual;      /* |C + compliance/h^2 * lambda| in the kind's unit (embra_residual_unit) */
-  double violation;     /* |C|, in the same unit (a tether: how far overstretched) */
+  double violation;     /* |C|, in the same unit (a one-sided kind, e.g. a tether: how far on its
+                           wrong side, for a tether how far overstretched) */
   double force;         /* |lambda| / h^2 */
 } embra_constraint_residual;
 

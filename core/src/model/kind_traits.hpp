@@ -45,8 +45,12 @@ decltype(auto) visit_kind(Kind kind, F&& f) {
 }
 
 /// What most kinds share: C(x) - rest unwrapped, any finite rest, the rest not scaled, every
-/// operand a different particle.
+/// operand a different particle, two-sided (C(x) = rest).
 struct KindDefaults {
+  /// Which side of its rest the constraint holds: 0 both (value = rest), -1 below (value <= rest: its
+  /// multiplier only pulls, lambda <= 0), +1 above (value >= rest: lambda >= 0). A one-sided
+  /// constraint that holds and has no multiplier left does nothing and has no residual.
+  static constexpr int side = 0;
   static constexpr bool may_share(int, int) { return false; }
   static double deviation(double value, double rest) { return value - rest; }
   static void check_rest(double, const std::string&) {}
@@ -81,10 +85,18 @@ struct KindTraits<Kind::distance> : LengthTraits {
 };
 
 template <>
-struct KindTraits<Kind::tether> : LengthTraits {};
+struct KindTraits<Kind::tether> : LengthTraits {
+  static constexpr int side = -1;
+};
 
+/// |x0 - x1| >= rest: pushes only. With a tether on the same two particles, min <= |x0 - x1| <= max.
 template <>
-struct KindTraits<Kind::edge_angle> : KindDefaults {
+struct KindTraits<Kind::length_min> : LengthTraits {
+  static constexpr int side = 1;
+};
+
+/// The angle at x0 (edge angle and the angle range's two sides): a rest in [0, pi].
+struct AngleTraits : KindDefaults {
   static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
     return eval_edge_angle(x[p[0]], x[p[1]], x[p[2]]);
   }
@@ -97,6 +109,21 @@ struct KindTraits<Kind::edge_angle> : KindDefaults {
   static void check_rest(double rest, const std::string& name) {
     if (rest < 0.0 || rest > std::numbers::pi) invalid(name + " rest angle must be in [0, pi]");
   }
+};
+
+template <>
+struct KindTraits<Kind::edge_angle> : AngleTraits {};
+
+/// angle >= rest: opens only. With an angle_max on the same corner, min <= angle <= max.
+template <>
+struct KindTraits<Kind::angle_min> : AngleTraits {
+  static constexpr int side = 1;
+};
+
+/// angle <= rest: closes only.
+template <>
+struct KindTraits<Kind::angle_max> : AngleTraits {
+  static constexpr int side = -1;
 };
 
 template <>
@@ -197,6 +224,70 @@ struct KindTraits<Kind::conical> : KindDefaults {
   static void check_rest(double rest, const std::string& name) {
     if (!(std::abs(rest) <= 2.0 * std::numbers::pi)) invalid(name + " rest angle must be in [-2 pi, 2 pi]");
   }
+};
+
+/// Distance of x1 from the line x0-x2: a length >= 0 that scales with the body's overall rest scale.
+template <>
+struct KindTraits<Kind::colinear> : KindDefaults {
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_colinear(x[p[0]], x[p[1]], x[p[2]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    if (!((x[p[2]] - x[p[0]]).norm() > 0.0)) invalid(name + " is degenerate: x0 and x2 coincide (no line)");
+    return evaluate(p, x).value;
+  }
+  static void check_rest(double rest, const std::string& name) {
+    if (rest < 0.0) invalid(name + " rest distance must be >= 0");
+  }
+  static double scaled_rest(const ConstraintArray& a, size_t i, const BodyInfo& b) { return a.rest[i] * b.rest_scale; }
+};
+
+/// The angle between two edges; they may share a particle (x1 = x2: consecutive edges), but an edge
+/// may not join a particle to itself.
+template <>
+struct KindTraits<Kind::direction> : KindDefaults {
+  static constexpr bool may_share(int a, int b) { return a / 2 != b / 2; }
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_direction(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    if (!((x[p[1]] - x[p[0]]).norm() > 0.0) || !((x[p[3]] - x[p[2]]).norm() > 0.0))
+      invalid(name + " is degenerate: an edge's particles coincide (zero length)");
+    return evaluate(p, x).value;
+  }
+  static void check_rest(double rest, const std::string& name) {
+    if (rest < 0.0 || rest > std::numbers::pi) invalid(name + " rest angle must be in [0, pi]");
+  }
+};
+
+/// The cyclic-quad angle criterion: four angles in [0, pi] with alternating signs, in [-2 pi, 2 pi].
+template <>
+struct KindTraits<Kind::cocircular> : KindDefaults {
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_cocircular(x[p[0]], x[p[1]], x[p[2]], x[p[3]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    const auto e = evaluate(p, x);
+    if (!e.valid) invalid(name + " is degenerate: an edge has zero length or a corner's edges are in line");
+    return e.value;
+  }
+  static void check_rest(double rest, const std::string& name) {
+    if (!(std::abs(rest) <= 2.0 * std::numbers::pi)) invalid(name + " rest angle must be in [-2 pi, 2 pi]");
+  }
+};
+
+/// Signed distance of x4 from the sphere through x0..x3: a length that scales with the body.
+template <>
+struct KindTraits<Kind::cospherical> : KindDefaults {
+  static auto evaluate(const int32_t* p, const std::vector<Vec3>& x) {
+    return eval_cospherical(x[p[0]], x[p[1]], x[p[2]], x[p[3]], x[p[4]]);
+  }
+  static double measure_rest(const int32_t* p, const std::vector<Vec3>& x, const std::string& name) {
+    const auto e = evaluate(p, x);
+    if (!e.valid) invalid(name + " is degenerate: x0..x3 are flat (no sphere through them) or x4 is its centre");
+    return e.value;
+  }
+  static double scaled_rest(const ConstraintArray& a, size_t i, const BodyInfo& b) { return a.rest[i] * b.rest_scale; }
 };
 
 /// Whether any two operand slots of kind K may hold the same particle (KindTraits<K>::may_share).

@@ -13,9 +13,10 @@
 
 namespace embra {
 
-/// XPBD residual |C + alpha~ lambda| of every constraint of `a` (for a tether only while it pulls or
-/// is overstretched): the largest into `max`, the sum of squares added to `sum_sq`, and each into
-/// `*each` and its |C| (how far from its rest: for a tether, how far overstretched) into `*violation`
+/// XPBD residual |C + alpha~ lambda| of every constraint of `a` (for a one-sided kind, KindTraits::side,
+/// only while it acts or is violated): the largest into `max`, the sum of squares added to `sum_sq`,
+/// and each into `*each` and its |C| (how far from its rest: for a one-sided kind, how far on the
+/// wrong side, e.g. how far a tether is overstretched) into `*violation`
 /// (solver-array order) when given. Distances and dihedral angles are evaluated by the
 /// kernels' value passes into `values`.
 template <Kind K>
@@ -39,13 +40,14 @@ void residuals(ThreadPool& pool, const SolverArray& a, double inv_h2, const std:
       value = KindTraits<K>::evaluate(&a.ids[i * N], x).value;
     const double c = KindTraits<K>::deviation(value, a.rest[i]);
     double r = c + a.compliance[i] * inv_h2 * a.lambda[i];
-    if constexpr (K == Kind::tether)
-      if (a.lambda[i] == 0.0) r = std::max(c, 0.0);
+    constexpr int side = KindTraits<K>::side;  // one-sided: no residual while it holds with no multiplier
+    if constexpr (side != 0)
+      if (a.lambda[i] == 0.0) r = std::max(-side * c, 0.0);
     r = std::abs(r);
     max = std::max(max, r);
     sum_sq += r * r;
     if (each != nullptr) (*each)[i] = r;
-    if (violation != nullptr) (*violation)[i] = K == Kind::tether ? std::max(c, 0.0) : std::abs(c);
+    if (violation != nullptr) (*violation)[i] = side != 0 ? std::max(-side * c, 0.0) : std::abs(c);
   }
 }
 

@@ -65,7 +65,9 @@ void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std
   }
 }
 
-/// The generic pass, through constraint_math.hpp (edge angle, tet volume, equal length).
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume, equal length, ...). A
+/// one-sided kind (KindTraits::side) that holds with no multiplier left is skipped, and its
+/// accumulated multiplier is kept on its side (the tether kernel's clamp, kernels.cpp).
 template <Kind K>
 void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
   constexpr int N = arity(K);
@@ -86,11 +88,16 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
           }
     }
     const double c = KindTraits<K>::deviation(e.value, a.rest[i]);
+    constexpr int side = KindTraits<K>::side;
+    if constexpr (side != 0)
+      if (side * c >= 0.0 && a.lambda[i] == 0.0) continue;
     const double alpha = a.compliance[i] * inv_h2;
     double denom = alpha;
     for (int k = 0; k < N; ++k) denom += w[p[k]] * e.grad[k].squaredNorm();
     if (denom <= 0.0) continue;
-    const double dl = (-c - alpha * a.lambda[i]) / denom;
+    double dl = (-c - alpha * a.lambda[i]) / denom;
+    if constexpr (side > 0) dl = std::max(a.lambda[i] + dl, 0.0) - a.lambda[i];
+    if constexpr (side < 0) dl = std::min(a.lambda[i] + dl, 0.0) - a.lambda[i];
     a.lambda[i] += dl;
     for (int k = 0; k < N; ++k) x[p[k]] += (w[p[k]] * dl) * e.grad[k];
   }
@@ -169,6 +176,13 @@ void World::realign(const std::vector<Vec3>& predicted) {
     add_corrections<Kind::plane_offset>(g.solve[static_cast<int>(Kind::plane_offset)], x_, w_, corr);
     add_corrections<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], x_, w_, corr);
     add_corrections<Kind::conical>(g.solve[static_cast<int>(Kind::conical)], x_, w_, corr);
+    add_corrections<Kind::length_min>(g.solve[static_cast<int>(Kind::length_min)], x_, w_, corr);
+    add_corrections<Kind::angle_min>(g.solve[static_cast<int>(Kind::angle_min)], x_, w_, corr);
+    add_corrections<Kind::angle_max>(g.solve[static_cast<int>(Kind::angle_max)], x_, w_, corr);
+    add_corrections<Kind::colinear>(g.solve[static_cast<int>(Kind::colinear)], x_, w_, corr);
+    add_corrections<Kind::direction>(g.solve[static_cast<int>(Kind::direction)], x_, w_, corr);
+    add_corrections<Kind::cocircular>(g.solve[static_cast<int>(Kind::cocircular)], x_, w_, corr);
+    add_corrections<Kind::cospherical>(g.solve[static_cast<int>(Kind::cospherical)], x_, w_, corr);
     const SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
     for (size_t i = 0; i < weld.size(); ++i) {
       const Vec3 l(weld.lambda[3 * i], weld.lambda[3 * i + 1], weld.lambda[3 * i + 2]);
@@ -256,6 +270,14 @@ void World::project_group(Group& g, double h, bool first) {
   project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
   project_generic<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
   project_generic<Kind::conical>(g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_);
+  // The geometry goals: length and angle ranges, co-linear, direction, co-circular, co-spherical.
+  project_generic<Kind::length_min>(g.solve[static_cast<int>(Kind::length_min)], inv_h2, x_, w_);
+  project_generic<Kind::angle_min>(g.solve[static_cast<int>(Kind::angle_min)], inv_h2, x_, w_);
+  project_generic<Kind::angle_max>(g.solve[static_cast<int>(Kind::angle_max)], inv_h2, x_, w_);
+  project_generic<Kind::colinear>(g.solve[static_cast<int>(Kind::colinear)], inv_h2, x_, w_);
+  project_generic<Kind::direction>(g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_);
+  project_generic<Kind::cocircular>(g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_);
+  project_generic<Kind::cospherical>(g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_);
   project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.

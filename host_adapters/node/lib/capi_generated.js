@@ -67,6 +67,13 @@ const CONSTRAINT_PLANARITY = 6;
 const CONSTRAINT_PLANE_OFFSET = 7;
 const CONSTRAINT_EQUAL_LENGTH = 8;
 const CONSTRAINT_CONICAL = 9;
+const CONSTRAINT_LENGTH_MIN = 10;
+const CONSTRAINT_ANGLE_MIN = 11;
+const CONSTRAINT_ANGLE_MAX = 12;
+const CONSTRAINT_COLINEAR = 13;
+const CONSTRAINT_DIRECTION = 14;
+const CONSTRAINT_COCIRCULAR = 15;
+const CONSTRAINT_COSPHERICAL = 16;
 
 // --- EMBRA_PIN_SUPPORT_* ---
 const PIN_SUPPORT_POINT = 0;
@@ -119,7 +126,7 @@ const CUTS_CSV = 1;
 
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
-const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8, conical: 9 });
+const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8, conical: 9, length_min: 10, angle_min: 11, angle_max: 12, colinear: 13, direction: 14, cocircular: 15, cospherical: 16 });
 const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
@@ -542,6 +549,8 @@ const PROTOTYPES = {
   embra_constraint_add: 'embra_status embra_constraint_add(embra_world *world, const embra_constraint_def *def)',
   embra_default_constraint_batch_def: 'embra_constraint_batch_def embra_default_constraint_batch_def(void)',
   embra_constraints_add: 'embra_status embra_constraints_add(embra_world *world, const embra_constraint_batch_def *def)',
+  embra_polygon_planarity_add: 'embra_status embra_polygon_planarity_add(embra_world *world, embra_group_id group, const int32_t *particles, int32_t count, double compliance, _Out_ int32_t *out_added)',
+  embra_rigid_set_add: 'embra_status embra_rigid_set_add(embra_world *world, embra_group_id group, const int32_t *particles, int32_t count, double compliance, _Out_ int32_t *out_added)',
   embra_group_get_constraint_count: 'embra_status embra_group_get_constraint_count(const embra_world *world, embra_group_id group, embra_constraint_kind kind, _Out_ int32_t *out_count, _Out_ int32_t *out_generated)',
   embra_constraint_get: 'embra_status embra_constraint_get(const embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, _Out_ embra_constraint_def *out_def)',
   embra_constraint_set_compliance: 'embra_status embra_constraint_set_compliance(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, double compliance)',
@@ -641,17 +650,19 @@ module.exports = {
   ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE,
   CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER,
   CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, CONSTRAINT_CONICAL,
-  PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE, PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, COLLIDER_PLANE,
-  COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS,
-  RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE,
-  SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA,
-  AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS,
-  PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE,
-  PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES,
-  COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES,
-  PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts,
-  GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, SupportDef, PolylineSupportDef,
-  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
-  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
-  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  CONSTRAINT_LENGTH_MIN, CONSTRAINT_ANGLE_MIN, CONSTRAINT_ANGLE_MAX, CONSTRAINT_COLINEAR,
+  CONSTRAINT_DIRECTION, CONSTRAINT_COCIRCULAR, CONSTRAINT_COSPHERICAL, PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE,
+  PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE,
+  COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED,
+  SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING,
+  SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE,
+  PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS,
+  PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES,
+  CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
+  AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType,
+  ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef,
+  PinDef, SupportDef, PolylineSupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual,
+  GroupConflict, Reaction, GroupReport, SolveDef, SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef,
+  Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef,
+  SurfaceTensionDef, VortexDef,
 };

@@ -714,6 +714,42 @@ class World {
     return count;
   }
 
+  /**
+   * Holds a polygon of four or more corners (particle indices in order round it) in one plane
+   * (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four consecutive
+   * corners, all of them cyclically for more than four. options {compliance (default 0), group};
+   * returns how many were added.
+   */
+  addPolygonPlanarity(particles, opts) {
+    const o = options(opts, 'addPolygonPlanarity options');
+    const p = buf.intsIn(particles, 'particles');
+    if (p === null) throw new TypeError('particles: required');
+    const compliance = o.has('compliance') ? buf.number(take(o, 'compliance'), 'compliance') : 0;
+    const group = toId(o.has('group') ? take(o, 'group') : null, GroupId, 'group');
+    if (o.size) throw new TypeError(`addPolygonPlanarity: unknown option '${o.keys().next().value}'`);
+    const added = [0];
+    this.#call('embra_polygon_planarity_add', group, p, buf.int32(p.length, 'count'), compliance, added);
+    return added[0];
+  }
+
+  /**
+   * Keeps three or more points (particle indices) in their current shape, moving as one rigid body
+   * (embra_rigid_set_add): bracing by distance constraints to a base of three or four of them, with the
+   * base's volume (solid) or each point's offset from its plane (flat). options {compliance (default
+   * 0), group}; returns how many constraints were added (4 n - 9).
+   */
+  addRigidSet(particles, opts) {
+    const o = options(opts, 'addRigidSet options');
+    const p = buf.intsIn(particles, 'particles');
+    if (p === null) throw new TypeError('particles: required');
+    const compliance = o.has('compliance') ? buf.number(take(o, 'compliance'), 'compliance') : 0;
+    const group = toId(o.has('group') ? take(o, 'group') : null, GroupId, 'group');
+    if (o.size) throw new TypeError(`addRigidSet: unknown option '${o.keys().next().value}'`);
+    const added = [0];
+    this.#call('embra_rigid_set_add', group, p, buf.int32(p.length, 'count'), compliance, added);
+    return added[0];
+  }
+
   // Edits of one constraint, named as the diagnostics name it: group (null: the default group), kind and
   // index among the group's constraints of that kind (those bodies generated first, then the added ones in
   // the order added). Only added constraints are edited; a body's follow its material (setMaterial).

@@ -69,6 +69,13 @@ CONSTRAINT_PLANARITY = 6
 CONSTRAINT_PLANE_OFFSET = 7
 CONSTRAINT_EQUAL_LENGTH = 8
 CONSTRAINT_CONICAL = 9
+CONSTRAINT_LENGTH_MIN = 10
+CONSTRAINT_ANGLE_MIN = 11
+CONSTRAINT_ANGLE_MAX = 12
+CONSTRAINT_COLINEAR = 13
+CONSTRAINT_DIRECTION = 14
+CONSTRAINT_COCIRCULAR = 15
+CONSTRAINT_COSPHERICAL = 16
 
 # --- EMBRA_PIN_SUPPORT_* ---
 PIN_SUPPORT_POINT = 0
@@ -121,7 +128,7 @@ CUTS_CSV = 1
 
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
-CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8, "conical": 9}
+CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8, "conical": 9, "length_min": 10, "angle_min": 11, "angle_max": 12, "colinear": 13, "direction": 14, "cocircular": 15, "cospherical": 16}
 PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
@@ -653,6 +660,8 @@ PROTOTYPES = {
     "embra_constraint_add": (c_int32, [c_void_p, POINTER(ConstraintDef)]),
     "embra_default_constraint_batch_def": (ConstraintBatchDef, []),
     "embra_constraints_add": (c_int32, [c_void_p, POINTER(ConstraintBatchDef)]),
+    "embra_polygon_planarity_add": (c_int32, [c_void_p, GroupId, POINTER(c_int32), c_int32, c_double, POINTER(c_int32)]),
+    "embra_rigid_set_add": (c_int32, [c_void_p, GroupId, POINTER(c_int32), c_int32, c_double, POINTER(c_int32)]),
     "embra_group_get_constraint_count": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_int32), POINTER(c_int32)]),
     "embra_constraint_get": (c_int32, [c_void_p, GroupId, c_int32, c_int32, POINTER(ConstraintDef)]),
     "embra_constraint_set_compliance": (c_int32, [c_void_p, GroupId, c_int32, c_int32, c_double]),

@@ -412,7 +412,6 @@ class World:
         self._call("embra_body_get_masses", b, None, 0, byref(n))
         out, pointer, capacity, keep = buf.doubles_out(n.value, None, "masses", width=1)
         self._call("embra_body_get_masses", b, pointer, buf.int32(capacity, "capacity"), byref(n))
-        del keep
         return out
 
     def set_body_masses(self, body, masses):
@@ -425,7 +424,6 @@ class World:
             raise ValueError(f"masses: expected one mass per particle, a 1-D array, got shape {tuple(shape)}")
         p, n, keep = buf.doubles_in(masses, "masses")
         self._call("embra_body_set_masses", _id(body, BodyId, "body"), p, buf.int32(n, "count"))
-        del keep
 
     def set_rest_scale(self, body, scale=1.0, scale_u=1.0, scale_v=1.0):
         self._call("embra_body_set_rest_scale", _id(body, BodyId, "body"), float(scale), float(scale_u),
@@ -538,7 +536,6 @@ class World:
             self._call("embra_panel_mesh_get_vertex_errors", b, m, None, 0, byref(n))
         result, pointer, capacity, keep = buf.doubles_out(n.value, out, "out", width=1)
         self._call("embra_panel_mesh_get_vertex_errors", b, m, pointer, capacity, byref(n))
-        del keep
         return result
 
     def export_cuts(self, body, format="json"):
@@ -602,6 +599,27 @@ class World:
         d.group = _id(group, GroupId, "group")
         self._call("embra_constraints_add", byref(d))
         return count
+
+    def add_rigid_set(self, particles, compliance=0.0, group=None):
+        """Keeps three or more points (particle indices) in their current shape, moving as one rigid
+        body (embra_rigid_set_add): bracing by distance constraints to a base of three or four of
+        them, with the base's volume (solid) or each point's offset from its plane (flat). Returns
+        how many constraints were added (4 n - 9)."""
+        p, n, keep = buf.ints_in(particles, "particles")
+        added = c_int32(0)
+        self._call("embra_rigid_set_add", _id(group, GroupId, "group"), p, buf.int32(n, "count"), float(compliance),
+                   byref(added))
+        return added.value
+
+    def add_polygon_planarity(self, particles, compliance=0.0, group=None):
+        """Holds a polygon of four or more corners (particle indices in order round it) in one plane
+        (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four
+        consecutive corners, all of them cyclically for more than four. Returns how many were added."""
+        p, n, keep = buf.ints_in(particles, "particles")
+        added = c_int32(0)
+        self._call("embra_polygon_planarity_add", _id(group, GroupId, "group"), p, buf.int32(n, "count"),
+                   float(compliance), byref(added))
+        return added.value
 
     # Edits of one constraint, named as the diagnostics name it: group (None: the default group), kind
     # and index among the group's constraints of that kind (those bodies generated first, then the
@@ -688,7 +706,6 @@ class World:
         d.points, d.point_count = p, buf.int32(n // 3, "point count")
         pin = PinId()
         self._call("embra_polyline_support_create", byref(d), byref(pin))
-        del keep
         return pin
 
     def destroy_pin(self, pin):
@@ -941,7 +958,6 @@ class World:
         count = buf.int32(count, "count")
         result, pointer, capacity, keep = buf.doubles_out(max(count, 0), out, "out")
         self._call(name, pointer, capacity, first, count)
-        del keep
         return result
 
     def positions(self, first=0, count=None, out=None):
@@ -959,7 +975,6 @@ class World:
         if n % 3:
             raise ValueError(f"xyz: {n} numbers is not a whole number of xyz triples")
         self._call(name, p, buf.int32(first, "first"), buf.int32(n // 3, "count"))
-        del keep
 
     def set_positions(self, xyz, first=0):
         """Moves particles [first, first + len) to xyz (m); velocities are kept."""

@@ -480,6 +480,68 @@ namespace Embra.Tests
                 }
             }
         }
+
+        /// <summary>A hexagon with its corners up and down in turn, held planar: every corner ends on the
+        /// plane through corners 0, 2 and 4, and a corner given twice is refused.</summary>
+        [Test]
+        public void PolygonPlanarityFlattensASkewHexagon()
+        {
+            var solver = Library.DefaultSolverDef();
+            unsafe { solver.Gravity[2] = 0.0; }
+            solver.Substeps = 4;
+            solver.Iterations = 10;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                var xyz = new double[18];
+                for (int k = 0; k < 6; ++k)
+                {
+                    xyz[3 * k] = Math.Cos(k * Math.PI / 3);
+                    xyz[3 * k + 1] = Math.Sin(k * Math.PI / 3);
+                    xyz[3 * k + 2] = k % 2 == 0 ? 0.2 : -0.2;
+                }
+                w.CreateBody(xyz, masses: new[] { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0 }, def: def);
+                Assert.AreEqual(6, w.AddPolygonPlanarity(new[] { 0, 1, 2, 3, 4, 5 }));
+                w.Step(200);
+                var p = w.GetPositions();
+                Func<int, int, double> at = (k, i) => p[3 * k + i] - p[i];  // corner k from corner 0
+                double nx = at(2, 1) * at(4, 2) - at(2, 2) * at(4, 1), ny = at(2, 2) * at(4, 0) - at(2, 0) * at(4, 2),
+                       nz = at(2, 0) * at(4, 1) - at(2, 1) * at(4, 0);
+                double len = Math.Sqrt(nx * nx + ny * ny + nz * nz);
+                for (int k = 0; k < 6; ++k)
+                    Assert.AreEqual(0.0, (at(k, 0) * nx + at(k, 1) * ny + at(k, 2) * nz) / len, 1e-9, "corner " + k);
+                Assert.Throws<EmbraArgumentException>(() => w.AddPolygonPlanarity(new[] { 0, 1, 2, 1 }));
+            }
+        }
+
+        /// <summary>Six points braced rigid (4 n - 9 = 15 constraints), one pinned, fall and turn under
+        /// gravity with every pairwise distance kept to 1e-6 m; a point given twice is refused.</summary>
+        [Test]
+        public void RigidSetKeepsItsShape()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 40;
+            solver.Tethers = 0;
+            var xyz = new double[] { 0, 0, 1, 0.4, 0, 1, 0, 0.4, 1, 0, 0, 1.4, 0.3, 0.3, 1.3, -0.2, 0.1, 1.2 };
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(xyz, masses: new[] { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0 }, def: def);
+                Assert.AreEqual(15, w.AddRigidSet(new[] { 0, 1, 2, 3, 4, 5 }));
+                w.CreatePin(0, new[] { 0.0, 0.0, 1.0 });
+                w.Step(60);
+                var p = w.GetPositions();
+                Func<double[], int, int, double> d = (x, i, j) =>
+                    Math.Sqrt(Math.Pow(x[3 * i] - x[3 * j], 2) + Math.Pow(x[3 * i + 1] - x[3 * j + 1], 2) +
+                              Math.Pow(x[3 * i + 2] - x[3 * j + 2], 2));
+                for (int i = 0; i < 6; ++i)
+                    for (int j = i + 1; j < 6; ++j) Assert.AreEqual(d(xyz, i, j), d(p, i, j), 1e-6, i + "-" + j);
+                Assert.Throws<EmbraArgumentException>(() => w.AddRigidSet(new[] { 0, 1, 1 }));
+            }
+        }
     }
 
     public class SolveTests
@@ -1629,6 +1691,13 @@ namespace Embra.Tests
             Assert.AreEqual(ColliderDef.CurrentVersion, Native.embra_default_collider_def().Version);
             Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Dihedral));
             Assert.AreEqual(5, Library.ConstraintArity(ConstraintKind.Conical));
+            Assert.AreEqual(2, Library.ConstraintArity(ConstraintKind.LengthMin));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.AngleMin));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.AngleMax));
+            Assert.AreEqual(3, Library.ConstraintArity(ConstraintKind.Colinear));
+            Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Direction));
+            Assert.AreEqual(4, Library.ConstraintArity(ConstraintKind.Cocircular));
+            Assert.AreEqual(5, Library.ConstraintArity(ConstraintKind.Cospherical));
             Assert.AreEqual(Native.AbiVersion, Library.AbiVersion);
             var parts = Library.VersionString.Split('.').Select(int.Parse).ToArray();
             Assert.AreEqual(parts[0] * 10000 + parts[1] * 100 + parts[2], Library.Version);

@@ -34,7 +34,8 @@ test('defaults are the documented ones', () => {
   assert.deepEqual([m.mass, m.density, m.stretch_compliance, m.bend_compliance], [0, 1, 0, 1]);
   assert.deepEqual([m.friction_static, m.friction_dynamic], [0.5, 0.3]);
   assert.deepEqual(['distance', 'edge_angle', 'dihedral', 'tet_volume', 'weld', 'tether', 'planarity',
-    'plane_offset', 'equal_length', 'conical'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4, 4, 5]);
+    'plane_offset', 'equal_length', 'conical', 'length_min', 'angle_min', 'angle_max', 'colinear', 'direction',
+    'cocircular', 'cospherical'].map(embra.constraintArity), [2, 3, 4, 4, 2, 2, 4, 4, 4, 5, 2, 3, 3, 3, 4, 4, 5]);
   const b = embra.defaultBodyDef();
   assert.equal(b.generate, embra.GENERATE.stretch | embra.GENERATE.bend | embra.GENERATE.volume);
   assert.ok(b.stretch_group instanceof embra.GroupId && b.stretch_group.equals(new embra.GroupId()));
@@ -101,6 +102,43 @@ test('equal length: four links between fixed ends, neighbours held equal, end a 
   w.step(200);
   const p = w.positions();
   for (let i = 0; i < 4; i++) assert.ok(Math.abs(dist(p, i, i + 1) - 0.25) < 1e-9, `link ${i}`);
+  w.close();
+});
+
+test('polygon planarity: a hexagon with its corners up and down in turn ends on one plane', () => {
+  const xyz = [];
+  for (let k = 0; k < 6; k++) xyz.push([Math.cos(k * Math.PI / 3), Math.sin(k * Math.PI / 3), k % 2 ? -0.2 : 0.2]);
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 10 });
+  w.createBody(xyz, { generate: 0, masses: [1, 1, 1, 1, 1, 1] });
+  assert.equal(w.addPolygonPlanarity([0, 1, 2, 3, 4, 5]), 6);
+  w.step(200);
+  const p = w.positions();
+  const v = (k) => [0, 1, 2].map((i) => p[3 * k + i] - p[i]);  // corner k from corner 0
+  const a = v(2), b = v(4);
+  const n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const len = Math.hypot(...n);
+  for (let k = 0; k < 6; k++) {
+    const d = v(k);
+    const off = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / len;  // from the plane through 0, 2, 4
+    assert.ok(Math.abs(off) < 1e-9, `corner ${k}: ${off}`);
+  }
+  assert.throws(() => w.addPolygonPlanarity([0, 1, 2, 1]), /twice/);
+  w.close();
+});
+
+test('rigid set: six points braced (4 n - 9 constraints) fall and turn with every distance kept', () => {
+  const xyz = [[0, 0, 1], [0.4, 0, 1], [0, 0.4, 1], [0, 0, 1.4], [0.3, 0.3, 1.3], [-0.2, 0.1, 1.2]];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 40, tethers: 0 });
+  w.createBody(xyz, { generate: 0, masses: [1, 1, 1, 1, 1, 1] });
+  assert.equal(w.addRigidSet([0, 1, 2, 3, 4, 5]), 15);
+  w.createPin(0, xyz[0]);
+  w.step(60);
+  const p = w.positions();
+  const d0 = (i, j) => Math.hypot(...[0, 1, 2].map((k) => xyz[i][k] - xyz[j][k]));
+  for (let i = 0; i < 6; i++) {
+    for (let j = i + 1; j < 6; j++) assert.ok(Math.abs(dist(p, i, j) - d0(i, j)) < 1e-6, `${i}-${j}`);
+  }
+  assert.throws(() => w.addRigidSet([0, 1, 1]), /twice/);
   w.close();
 });
 

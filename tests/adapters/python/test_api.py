@@ -60,8 +60,9 @@ def test_defaults_are_the_documented_ones():
     assert (m.friction_static, m.friction_dynamic) == (0.5, 0.3)
     assert [embra.constraint_arity(k) for k in ("distance", "edge_angle", "dihedral", "tet_volume", "weld",
                                                 "tether", "planarity", "plane_offset", "equal_length",
-                                                "conical")] == \
-        [2, 3, 4, 4, 2, 2, 4, 4, 4, 5]
+                                                "conical", "length_min", "angle_min", "angle_max",
+                                                "colinear", "direction", "cocircular", "cospherical")] == \
+        [2, 3, 4, 4, 2, 2, 4, 4, 4, 5, 2, 3, 3, 3, 4, 4, 5]
 
 
 def test_free_fall_is_symplectic_euler_in_closed_form():
@@ -89,6 +90,48 @@ def test_equal_length_splits_a_pinned_line_evenly():
         p = flat(w.positions())
         for i in range(4):
             assert abs(math.dist(p[3 * i:3 * i + 3], p[3 * i + 3:3 * i + 6]) - 0.25) < 1e-9
+
+
+def test_polygon_planarity_flattens_a_skew_hexagon():
+    """A hexagon with its corners up and down in turn, held planar (six windows of four corners):
+    every corner ends on the plane through corners 0, 2 and 4, and a range 0.3 <= |x0 - x3| (a
+    length_min) is met."""
+    xyz = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3), 0.2 if k % 2 == 0 else -0.2) for k in range(6)]
+    with embra.World(gravity=(0.0, 0.0, 0.0), substeps=4, iterations=10) as w:
+        w.create_body(xyz, generate=0, masses=[1.0] * 6)
+        assert w.add_polygon_planarity(range(6)) == 6
+        assert w.add_constraints("length_min", [(0, 3)], rest=[2.5]) == 1
+        w.step(60)
+        p = [flat(w.positions())[3 * k:3 * k + 3] for k in range(6)]
+        a = [p[2][i] - p[0][i] for i in range(3)]
+        b = [p[4][i] - p[0][i] for i in range(3)]
+        n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        ln = math.sqrt(sum(v * v for v in n))
+        for k in range(6):
+            assert abs(sum((p[k][i] - p[0][i]) * n[i] for i in range(3)) / ln) < 1e-9
+        assert math.dist(p[0], p[3]) >= 2.5 - 1e-9
+        with pytest.raises(embra.EmbraError, match="twice"):
+            w.add_polygon_planarity([0, 1, 2, 1])
+
+
+def test_rigid_set_keeps_its_shape_while_it_falls_and_turns():
+    """Six points braced rigid (4 n - 9 = 15 constraints), one corner pinned, 60 frames of gravity at
+    4 x 40 iterations: every pairwise distance as it was to 1e-6 m; points on one line are refused."""
+    xyz = [(0, 0, 1), (0.4, 0, 1), (0, 0.4, 1), (0, 0, 1.4), (0.3, 0.3, 1.3), (-0.2, 0.1, 1.2)]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=4, iterations=40, tethers=0) as w:
+        w.create_body(xyz, generate=0, masses=[1.0] * 6)
+        assert w.add_rigid_set(range(6)) == 15
+        w.create_pin(0, xyz[0])
+        w.step(60)
+        p = [flat(w.positions())[3 * k:3 * k + 3] for k in range(6)]
+        assert math.dist(p[4], xyz[4]) > 0.05  # it turned
+        for i in range(6):
+            for j in range(i + 1, 6):
+                assert abs(math.dist(p[i], p[j]) - math.dist(xyz[i], xyz[j])) < 1e-6
+    with embra.World() as w:
+        w.create_body([(0, 0, 0), (1, 0, 0), (2, 0, 0)], generate=0, masses=[1.0] * 3)
+        with pytest.raises(embra.EmbraError, match="line"):
+            w.add_rigid_set([0, 1, 2])
 
 
 def test_statics_two_bar_truss_forces_and_reactions():

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
 
 #include <array>
 #include <cmath>
@@ -242,6 +244,105 @@ inline ConstraintEval<5> eval_conical(const Vec3& x0, const Vec3& x1, const Vec3
     e.grad[1 + (k + 1) % 4] += sign * a.grad[2];
   }
   e.value = value;
+  e.valid = true;
+  return e;
+}
+
+/// Distance of x1 from the line through x0 and x2 (co-linear points: 0), |(x1 - x0) x (x2 - x0)| /
+/// |x2 - x0|. With a = x1 - x0, b = x2 - x0, n = a x b and L = |b|: grad_1 = (b x n^) / L,
+/// grad_2 = (n^ x a) / L - C b / L^2, grad_0 = -(grad_1 + grad_2). A length, so as well conditioned
+/// as the distance; not valid when x0 and x2 coincide or x1 is on the line (where |n| has no
+/// gradient: it holds there already).
+inline ConstraintEval<3> eval_colinear(const Vec3& x0, const Vec3& x1, const Vec3& x2) {
+  ConstraintEval<3> e;
+  const Vec3 a = x1 - x0, b = x2 - x0;
+  const Vec3 n = a.cross(b);
+  const double len = b.norm(), nn = n.norm();
+  if (len <= 1e-300) return e;
+  e.value = nn / len;
+  if (nn <= 1e-300) return e;
+  const Vec3 nh = n / nn;
+  const Vec3 g1 = b.cross(nh) / len;
+  const Vec3 g2 = nh.cross(a) / len - (e.value / (len * len)) * b;
+  e.grad = {-(g1 + g2), g1, g2};
+  e.valid = true;
+  return e;
+}
+
+/// The angle between the edges x0 -> x1 and x2 -> x3, in [0, pi] (0: the same direction, pi:
+/// opposite). With x2 and x3 immovable the reference edge is a fixed direction. The gradients are
+/// eval_edge_angle's at a common origin: grad_1 = -grad_0 the first edge's, grad_3 = -grad_2 the
+/// second's; not valid when an edge has zero length or the edges are parallel (sin < 1e-9: where it
+/// holds, for a rest of 0 or pi).
+inline ConstraintEval<4> eval_direction(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  ConstraintEval<4> e;
+  const auto a = eval_edge_angle(Vec3::Zero(), x1 - x0, x3 - x2);
+  e.value = a.value;
+  if (!a.valid) return e;
+  e.grad = {-a.grad[1], a.grad[1], -a.grad[2], a.grad[2]};
+  e.valid = true;
+  return e;
+}
+
+/// The angle criterion of a cyclic quad x0 x1 x2 x3 (in order round it): C = a0 - a1 + a2 - a3, a_k
+/// the angle at corner x_k between its two neighbours (eval_edge_angle). A planar convex quad has
+/// a0 + a1 + a2 + a3 = 2 pi, and its corners lie on one circle exactly when opposite angles sum to pi,
+/// that is when C = 0. Planarity is a separate constraint (EMBRA_CONSTRAINT_PLANARITY): off the plane
+/// C = 0 does not make the points co-circular. Not valid when an edge has zero length or a corner's
+/// two edges are in line.
+inline ConstraintEval<4> eval_cocircular(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  ConstraintEval<4> e;
+  const Vec3* x[4] = {&x0, &x1, &x2, &x3};
+  for (Vec3& g : e.grad) g.setZero();
+  double value = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const int prev = (k + 3) % 4, next = (k + 1) % 4;
+    const auto a = eval_edge_angle(*x[k], *x[prev], *x[next]);
+    if (!a.valid) return ConstraintEval<4>{};
+    const double sign = k % 2 == 0 ? 1.0 : -1.0;
+    value += sign * a.value;
+    e.grad[k] += sign * a.grad[0];
+    e.grad[prev] += sign * a.grad[1];
+    e.grad[next] += sign * a.grad[2];
+  }
+  e.value = value;
+  e.valid = true;
+  return e;
+}
+
+/// Signed distance of x4 from the sphere through x0, x1, x2, x3 (co-spherical points: 0; positive
+/// outside): C = |x4 - c| - |x0 - c|, c the centre, solving (x_i - x0) . c = (|x_i|^2 - |x0|^2) / 2
+/// for i = 1, 2, 3 (written about x0). A length, well conditioned while the tetrahedron x0..x3 is.
+/// With A the matrix of rows a_i = x_i - x0, n4 = (x4 - c) / |x4 - c|, n0 = (x0 - c) / R and q the
+/// solution of A^T q = n0 - n4 (the centre's motion, dc = A^-1 r with r_i = (x_i - c) . dx_i for
+/// i = 1..3, and r_i = (c - x0) . dx0 for all i from x0):
+///   grad_4 = n4,  grad_i = q_i (x_i - c) (i = 1, 2, 3),  grad_0 = -n0 + (q_1 + q_2 + q_3) (c - x0).
+/// Not valid when the tetrahedron is flat (|det A| <= 1e-12 of its longest edge cubed) or x4 is
+/// the centre.
+inline ConstraintEval<5> eval_cospherical(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3,
+                                          const Vec3& x4) {
+  ConstraintEval<5> e;
+  Eigen::Matrix3d a;
+  a.row(0) = (x1 - x0).transpose();
+  a.row(1) = (x2 - x0).transpose();
+  a.row(2) = (x3 - x0).transpose();
+  const double scale = std::max({a.row(0).norm(), a.row(1).norm(), a.row(2).norm()});
+  const double det = a.determinant();
+  if (!(std::abs(det) > 1e-12 * scale * scale * scale)) return e;
+  // About x0: a_i . (c - x0) = |a_i|^2 / 2.
+  const Vec3 rhs(0.5 * a.row(0).squaredNorm(), 0.5 * a.row(1).squaredNorm(), 0.5 * a.row(2).squaredNorm());
+  const Eigen::Matrix3d inv = a.inverse();
+  const Vec3 c = x0 + inv * rhs;
+  const double r = (x0 - c).norm(), d = (x4 - c).norm();
+  e.value = d - r;
+  if (!(d > 1e-300) || !(r > 1e-300)) return e;
+  const Vec3 n4 = (x4 - c) / d, n0 = (x0 - c) / r;
+  const Vec3 q = inv.transpose() * (n0 - n4);
+  e.grad[4] = n4;
+  e.grad[1] = q[0] * (x1 - c);
+  e.grad[2] = q[1] * (x2 - c);
+  e.grad[3] = q[2] * (x3 - c);
+  e.grad[0] = -n0 + (q[0] + q[1] + q[2]) * (c - x0);
   e.valid = true;
   return e;
 }

@@ -17,18 +17,26 @@ namespace embra {
 
 // X(name, number, arity, multipliers, unit, description). The numbers are part of the C ABI; the
 // unit is that of the constraint's value and residual (model units: m for metres).
-#define EMBRA_CONSTRAINT_KINDS(X)                                                                             \
-  X(distance, 0, 2, 1, "m", "|x0 - x1| = rest (stretch)")                                                     \
-  X(edge_angle, 1, 3, 1, "rad", "angle at x0 between x1 - x0 and x2 - x0 (shear)")                            \
-  X(dihedral, 2, 4, 1, "rad", "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                               \
-  X(tet_volume, 3, 4, 1, "m^3", "signed volume of (x0,x1,x2,x3) = rest")                                      \
-  X(weld, 4, 2, 3, "m", "x0 = x1")                                                                            \
-  X(tether, 5, 2, 1, "m", "|x0 - x1| <= rest (long-range attachment, unilateral)")                            \
-  X(planarity, 6, 4, 1, "m", "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")      \
-  X(plane_offset, 7, 4, 1, "m", "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)") \
-  X(equal_length, 8, 4, 1, "m", "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")                \
-  X(conical, 9, 5, 1, "rad",                                                                                  \
-    "angles at x0 between its neighbours x1..x4 in order round it: a12 - a23 + a34 - a41 = rest (0: conical)")
+#define EMBRA_CONSTRAINT_KINDS(X)                                                                              \
+  X(distance, 0, 2, 1, "m", "|x0 - x1| = rest (stretch)")                                                      \
+  X(edge_angle, 1, 3, 1, "rad", "angle at x0 between x1 - x0 and x2 - x0 (shear)")                             \
+  X(dihedral, 2, 4, 1, "rad", "angle between (x0,x1,x2) and (x1,x0,x3) (bend)")                                \
+  X(tet_volume, 3, 4, 1, "m^3", "signed volume of (x0,x1,x2,x3) = rest")                                       \
+  X(weld, 4, 2, 3, "m", "x0 = x1")                                                                             \
+  X(tether, 5, 2, 1, "m", "|x0 - x1| <= rest (long-range attachment, unilateral)")                             \
+  X(planarity, 6, 4, 1, "m", "distance between the diagonals x0-x2 and x1-x3 = rest (0: a planar quad)")       \
+  X(plane_offset, 7, 4, 1, "m", "signed distance of x0 from the plane (x1, x2, x3) = rest (slides along it)")  \
+  X(equal_length, 8, 4, 1, "m", "|x0 - x1| - |x2 - x3| = rest (0: two edges of equal length)")                 \
+  X(conical, 9, 5, 1, "rad",                                                                                   \
+    "angles at x0 between its neighbours x1..x4 in order round it: a12 - a23 + a34 - a41 = rest (0: conical)") \
+  X(length_min, 10, 2, 1, "m", "|x0 - x1| >= rest (unilateral: pushes only; with a tether, a length range)")   \
+  X(angle_min, 11, 3, 1, "rad", "angle at x0 between x1 - x0 and x2 - x0 >= rest (unilateral)")                \
+  X(angle_max, 12, 3, 1, "rad", "angle at x0 between x1 - x0 and x2 - x0 <= rest (unilateral)")                \
+  X(colinear, 13, 3, 1, "m", "distance of x1 from the line through x0 and x2 = rest (0: co-linear)")           \
+  X(direction, 14, 4, 1, "rad", "angle between x1 - x0 and x3 - x2 = rest (0: edge x0-x1 along x2-x3)")        \
+  X(cocircular, 15, 4, 1, "rad",                                                                               \
+    "quad x0..x3, a_k its angle at x_k: a0 - a1 + a2 - a3 = rest (0 and planar: on one circle)")               \
+  X(cospherical, 16, 5, 1, "m", "signed distance of x4 from the sphere through x0..x3 = rest (0: on it)")
 
 /// Constraint kinds. The numbering is part of the C ABI (embra_constraint_kind).
 enum class Kind : int32_t {
