@@ -99,7 +99,7 @@ static void test_struct_layout(void) {
   CHECK_INT(offsetof(embra_solver_def, self_collision), 72);
   CHECK_INT(offsetof(embra_solver_def, chain_solve), 76);
   CHECK_INT(offsetof(embra_solver_def, threads), 80);
-  CHECK_INT(offsetof(embra_solver_def, reserved0), 84);
+  CHECK_INT(offsetof(embra_solver_def, global_solve), 84);
 
   CHECK_INT(sizeof(embra_world_counts), 6 * 4 + 8);
   CHECK_INT(offsetof(embra_world_counts, constraints), 24);

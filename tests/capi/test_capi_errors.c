@@ -561,8 +561,10 @@ static void test_solver_and_gravity(void) {
   d.version = 3;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_world_set_solver(W, &d));
   d = embra_default_solver_def();
-  d.reserved0 = 1;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "reserved0", embra_world_set_solver(W, &d));
+  d.global_solve = 2;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "global_solve", embra_world_set_solver(W, &d));
+  d.global_solve = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "global_solve", embra_world_set_solver(W, &d));
   d = embra_default_solver_def();
   d.threads = -1;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "threads", embra_world_set_solver(W, &d));

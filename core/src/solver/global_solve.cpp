@@ -98,7 +98,7 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
   // A row of one function C (value c) with gradients `grad` over particles p[0..n); `lambda`: its
   // multiplier; geometric_over: 1 / |d| for a length (its geometric stiffness), else 0.
   const auto row = [&]<int N>(const int32_t* p, const std::array<Vec3, N>& grad, bool valid, double c,
-                              double compliance, bool one_sided, double& lambda, double geometric_over, double slack) {
+                              double compliance, int side, double& lambda, double geometric_over, double slack) {
     if (pass == Pass::setup) {
       double eff = 0.0;
       for (int a = 0; a < N; ++a) eff += w_[p[a]] * grad[a].squaredNorm();
@@ -118,9 +118,13 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
       return;
     }
     const double alpha = gs.alpha[r], eff = gs.eff[r];
-    // A one-sided row's multiplier only pulls (lambda <= 0): the step's is clamped where it is used.
-    const double l = pass == Pass::clear ? 0.0 : one_sided ? std::min(lambda + dl(r), 0.0) : lambda + dl(r);
-    const bool active = valid && (!one_sided || c > 0.0 || l < 0.0) && !(c < -slack);
+    // A one-sided row (KindTraits::side) holds one side of its rest, its multiplier of one sign only
+    // (side -1, value <= rest: lambda <= 0; side +1: lambda >= 0): the step's is clamped where it is
+    // used, and the row is active while its side is violated or its multiplier acts.
+    double l = pass == Pass::clear ? 0.0 : lambda + dl(r);
+    if (side < 0) l = std::min(l, 0.0);
+    if (side > 0) l = std::max(l, 0.0);
+    const bool active = valid && (side == 0 || side * c < 0.0 || side * l > 0.0) && !(c < -slack);
     const int64_t at = rows0 + r;
     if (store) lambda = l;
     if (active) {
@@ -153,13 +157,12 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
   };
   const auto each_array = [&]<Kind K>(KindTag<K>, SolverArray& arr) {
     constexpr int N = arity(K);
-    constexpr bool one_sided = K == Kind::tether;
     constexpr bool length = K == Kind::distance || K == Kind::tether;
     for (size_t i = 0; i < arr.size(); ++i) {
       const int32_t* p = &arr.ids[i * N];
       auto e = KindTraits<K>::evaluate(p, x);
       const double c = KindTraits<K>::deviation(e.value, arr.rest[i]);
-      row.template operator()<N>(p, e.grad, e.valid, c, arr.compliance[i], one_sided, arr.lambda[i],
+      row.template operator()<N>(p, e.grad, e.valid, c, arr.compliance[i], KindTraits<K>::side, arr.lambda[i],
                                  length && e.valid ? 1.0 / e.value : 0.0,
                                  K == Kind::distance ? kSlack * arr.rest[i] : kNoSlack);
     }
@@ -177,8 +180,7 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
       const Vec3 d = x[p[0]] - x[p[1]];
       for (int k = 0; k < 3; ++k) {
         const std::array<Vec3, 2> grad = {Vec3::Unit(k), -Vec3::Unit(k)};
-        row.template operator()<2>(p, grad, true, d[k], weld.compliance[i], false, weld.lambda[3 * i + k], 0.0,
-                                   kNoSlack);
+        row.template operator()<2>(p, grad, true, d[k], weld.compliance[i], 0, weld.lambda[3 * i + k], 0.0, kNoSlack);
       }
     }
     // Soft pins and supports: held(x - target) = 0, a row per axis; held is the projection P (the
@@ -206,8 +208,7 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
       }
       for (int k = 0; k < 3; ++k) {
         const std::array<Vec3, 1> grad = {Vec3(proj.row(k).transpose())};
-        row.template operator()<1>(&pin.particle, grad, true, held[k], pin.compliance, false, pin.lambda[k], 0.0,
-                                   kNoSlack);
+        row.template operator()<1>(&pin.particle, grad, true, held[k], pin.compliance, 0, pin.lambda[k], 0.0, kNoSlack);
       }
     }
   }
