@@ -42,7 +42,7 @@ namespace Embra
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
-    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3, Axes = 4 }
 
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }

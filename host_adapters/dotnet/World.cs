@@ -697,7 +697,9 @@ namespace Embra
         /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
         /// <summary>A frictionless sliding support (embra_support_create): `particle` held on the plane
         /// through `target` (m) normal to `axis` (PinSupport.Plane) or on the line through it along `axis`
-        /// (PinSupport.Line); axis null = {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
+        /// (PinSupport.Line); or a per-axis anchor (PinSupport.Axes, a roller): the world coordinates whose
+        /// `axis` component is 1 held at the target's, those with 0 free ({0, 0, 1}: z held); axis null =
+        /// {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
         public PinId CreateSupport(int particle, double[] target, PinSupport support = PinSupport.Plane, double[] axis = null,
                                    double compliance = 0.0, GroupId group = default(GroupId))
         {

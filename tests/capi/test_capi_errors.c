@@ -1247,7 +1247,7 @@ static void test_pins(void) {
     sd.particle = g_ref.n;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
     GOOD_SUPPORT();
-    sd.support = 4;
+    sd.support = EMBRA_PIN_SUPPORT_AXES + 1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
     sd.support = -1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
@@ -1948,6 +1948,79 @@ static void test_polyline_supports(void) {
   embra_world_destroy(s.w);
 }
 
+/* Per-axis anchors (EMBRA_PIN_SUPPORT_AXES): the axis flags checked; a refused call leaves the saved
+ * scene as it was. */
+static void test_anchor_supports(void) {
+  scene s;
+  char* before;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0}, dead;
+  const double not_flags[] = {0.5, 2.0, -1.0, 1e-300, 1.0 + 1e-15};
+  int i, k;
+  CHECK(scene_build(&s));
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_AXES; /* the default axis {0, 0, 1}: z held */
+  CHECK_OK(embra_support_create(s.w, &sd, &dead));
+  CHECK_OK(embra_pin_destroy(s.w, dead));
+  sd.axis[0] = 1.0;
+  CHECK_OK(embra_support_create(s.w, &sd, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"axes\"") != NULL);
+#define GOOD_ANCHOR()                    \
+  do {                                   \
+    sd = embra_default_support_def();    \
+    sd.particle = s.point;               \
+    sd.support = EMBRA_PIN_SUPPORT_AXES; \
+  } while (0)
+  GOOD_ANCHOR();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_support_create(NULL, &sd, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_support_create(s.w, NULL, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_support_create(s.w, &sd, NULL));
+  sd.particle = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_support_create(s.w, &sd, &out));
+  sd.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_support_create(s.w, &sd, &out));
+  GOOD_ANCHOR();
+  sd.axis[2] = 0.0; /* nothing held */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "holds no coordinate", before, s.w, embra_support_create(s.w, &sd, &out));
+  for (k = 0; k < 3; ++k)
+    for (i = 0; i < (int)(sizeof not_flags / sizeof not_flags[0]); ++i) {
+      GOOD_ANCHOR();
+      sd.axis[k] = not_flags[i];
+      CAPI_CONTEXT("axis[%d] = %.17g", k, not_flags[i]);
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "1 (that coordinate held) or 0", before, s.w,
+                    embra_support_create(s.w, &sd, &out));
+    }
+  for (i = 0; i < 3; ++i) {
+    GOOD_ANCHOR();
+    sd.axis[i] = bad_value(i);
+    CAPI_CONTEXT("axis[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "axis", before, s.w, embra_support_create(s.w, &sd, &out));
+    GOOD_ANCHOR();
+    sd.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_support_create(s.w, &sd, &out));
+  }
+  CAPI_CONTEXT("compliance, group, stale pin");
+  GOOD_ANCHOR();
+  sd.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_support_create(s.w, &sd, &out));
+  sd.compliance = NAN;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_support_create(s.w, &sd, &out));
+  GOOD_ANCHOR();
+  sd.group = s.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_support_create(s.w, &sd, &out));
+  {
+    const double t[3] = {0.0, 0.0, 0.0};
+    REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w, embra_pin_set_target(s.w, dead, t));
+  }
+#undef GOOD_ANCHOR
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -1975,6 +2048,7 @@ int main(void) {
   RUN(test_statics);
   RUN(test_distributed_loads);
   RUN(test_polyline_supports);
+  RUN(test_anchor_supports);
   RUN(test_step);
   return capi_test_finish();
 }

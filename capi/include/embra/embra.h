@@ -558,23 +558,26 @@ typedef struct embra_pin_def {
 EMBRA_API embra_pin_def embra_default_pin_def(void);
 /* A particle takes at most one hard pin. */
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
-/* Sliding supports: a pin that holds its particle on a plane or a line through the target, and
- * lets it slide along it, frictionless. A per-axis anchor (a roller) is one of them: one
- * coordinate held is a plane with that axis as its normal ({0, 0, 1}: z held, x and y free), two
- * held a line along the third. A support is a pin (an embra_pin_id: embra_pin_destroy,
- * embra_pin_set_target, embra_world_get_pins and the scene's "pins" take it), projected in its
- * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
- * the plane or across the line. */
+/* Sliding supports: a pin that holds its particle on a plane or a line through the target, or on a
+ * polyline, and lets it slide along it, frictionless; or a per-axis anchor (EMBRA_PIN_SUPPORT_AXES,
+ * Kangaroo's AnchorXYZ, a roller) that holds chosen world coordinates of its particle at the
+ * target's and leaves the others free ({0, 0, 1}: z held, x and y free). A support is a pin (an
+ * embra_pin_id: embra_pin_destroy, embra_pin_set_target, embra_world_get_pins and the scene's
+ * "pins" take it), projected in its group like a constraint, never kinematic; its reaction
+ * (embra_world_get_reactions) is normal to the plane or across the line, and for an axes support
+ * has only the held components (the free ones exactly 0). */
 enum {
-  EMBRA_PIN_SUPPORT_POINT = 0,   /* the particle held at the target: embra_pin_create's pin */
-  EMBRA_PIN_SUPPORT_PLANE = 1,   /* on the plane through the target, normal `axis` */
-  EMBRA_PIN_SUPPORT_LINE = 2,    /* on the line through the target, along `axis` */
-  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of a polyline, made by
+  EMBRA_PIN_SUPPORT_POINT = 0,    /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1,    /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2,     /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POLYLINE = 3, /* on the closest point of a polyline, made by
                                     embra_polyline_support_create (below): inside a segment it
                                     slides along it and its reaction is normal to the segment; at
                                     a vertex it is held there until pulled along a segment. The
                                     closest point is searched over every segment at every
                                     projection (cost linear in the points) */
+  EMBRA_PIN_SUPPORT_AXES = 4      /* a per-axis anchor: the world coordinates whose `axis` component is
+                                     1 held at the target's, those whose component is 0 free */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
@@ -583,9 +586,10 @@ typedef struct embra_support_def {
   int32_t particle; /* world particle index */
   int32_t support;  /* EMBRA_PIN_SUPPORT_*; default EMBRA_PIN_SUPPORT_PLANE */
   int32_t reserved0;
-  double target[3];     /* m: a point of the plane or line */
+  double target[3];     /* m: a point of the plane or line; where an axes support holds */
   double axis[3];       /* the plane's normal or the line's direction: finite, of any nonzero length
-                           (kept as a unit vector); default {0, 0, 1} */
+                           (kept as a unit vector); for EMBRA_PIN_SUPPORT_AXES the held coordinates:
+                           each component 1 (held) or 0 (free), not all 0; default {0, 0, 1} */
   double compliance;    /* 0 (default) = hard (projected with compliance 0); > 0: m/N */
   embra_group_id group; /* its group; {0,0} = default group */
 } embra_support_def;
@@ -593,7 +597,8 @@ typedef struct embra_support_def {
 EMBRA_API embra_support_def embra_default_support_def(void);
 /* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
  * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
- * (or one too short to normalise), a negative or non-finite compliance, a stale group;
+ * (or one too short to normalise), an axes support's axis with a component other than 0 or 1 or
+ * with none 1, a negative or non-finite compliance, a stale group;
  * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create). */
 EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
 

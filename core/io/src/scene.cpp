@@ -658,7 +658,7 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
 
 /// The pin supports' names in the scene format, by PinSupport.
-constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline"};
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline", "axes"};
 static_assert(std::size(kPinSupportNames) == kPinSupportCount);
 
 /// The area load modes' names in the scene format, by AreaLoadMode.

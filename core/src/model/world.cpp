@@ -1314,7 +1314,8 @@ Id World::create_pin(const PinDesc& desc) {
   check_non_negative(desc.compliance, "pin compliance");
   const int32_t support = static_cast<int32_t>(desc.support);
   if (support < 0 || support >= kPinSupportCount)
-    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1), line (2) or polyline (3)");
+    invalid("pin support " + std::to_string(support) +
+            " is not point (0), plane (1), line (2), polyline (3) or axes (4)");
   for (int k = 0; k < 3; ++k) check_finite(desc.axis[k], "pin axis");
   const bool polyline = desc.support == PinSupport::polyline;
   if (polyline) {
@@ -1335,8 +1336,17 @@ Id World::create_pin(const PinDesc& desc) {
   } else if (!desc.curve.empty()) {
     invalid("polyline points are given for a support that is not a polyline");
   }
+  const bool axes = desc.support == PinSupport::axes;
+  if (axes) {
+    for (int k = 0; k < 3; ++k)
+      if (desc.axis[k] != 0.0 && desc.axis[k] != 1.0)
+        invalid("an axes support's axis[" + std::to_string(k) + "] is " + std::to_string(desc.axis[k]) +
+                ": each component is 1 (that coordinate held) or 0 (free)");
+    if (desc.axis == Vec3::Zero())
+      invalid("an axes support holds no coordinate (axis is {0, 0, 0}): hold at least one");
+  }
   const double axis_length = desc.axis.norm();
-  if (desc.support != PinSupport::point && !polyline &&
+  if (desc.support != PinSupport::point && !polyline && !axes &&
       !(axis_length > 0.0 && std::isfinite(axis_length) && (desc.axis / axis_length).allFinite()))
     invalid(std::string("pin axis is zero (or too short to normalise): a ") +
             (desc.support == PinSupport::plane ? "plane" : "line") + " support needs a direction (its " +
@@ -1355,7 +1365,8 @@ Id World::create_pin(const PinDesc& desc) {
   p.compliance = desc.compliance;
   p.group = gid;
   p.support = desc.support;
-  if (desc.support != PinSupport::point && !polyline) p.axis = desc.axis / axis_length;
+  if (desc.support != PinSupport::point && !polyline)
+    p.axis = axes ? Vec3(desc.axis.cwiseAbs()) : Vec3(desc.axis / axis_length);  // -0 as 0
   p.curve = desc.curve;
   p.closed = polyline && desc.closed;
   const Id id = slots::create(pins_, p);

@@ -209,7 +209,8 @@ void World::project_group(Group& g, double h, bool first) {
     const double alpha = p.compliance * inv_h2;
     if (w + alpha <= 0.0) continue;
     // The held part only (all of it for a point): a support's multiplier stays along its normal
-    // (plane) or across its line, so the particle slides freely the other ways.
+    // (plane), across its line, or in its held coordinates (axes), so the particle slides freely the
+    // other ways.
     if (p.support == PinSupport::polyline) {
       // Held on the closest point of the curve: inside a segment, the multiplier keeps only its part
       // across the segment (it slides along it freely); at a vertex, all of it.

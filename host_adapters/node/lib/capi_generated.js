@@ -73,6 +73,7 @@ const PIN_SUPPORT_POINT = 0;
 const PIN_SUPPORT_PLANE = 1;
 const PIN_SUPPORT_LINE = 2;
 const PIN_SUPPORT_POLYLINE = 3;
+const PIN_SUPPORT_AXES = 4;
 
 // --- embra_collider_shape ---
 const COLLIDER_PLANE = 0;
@@ -120,7 +121,7 @@ const CUTS_CSV = 1;
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8, conical: 9 });
-const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3 });
+const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3, axes: 4 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
@@ -641,17 +642,17 @@ module.exports = {
   ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE,
   CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER,
   CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, CONSTRAINT_CONICAL,
-  PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE, PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, COLLIDER_PLANE,
-  COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS,
-  RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE,
-  SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA,
-  AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS,
-  PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE,
-  PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES,
-  COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES,
-  PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts,
-  GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, SupportDef, PolylineSupportDef,
-  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
-  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
-  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE, PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, PIN_SUPPORT_AXES,
+  COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH,
+  RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE,
+  SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING, SOLVE_DRIFTING,
+  AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS,
+  PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
+  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
+  PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES,
+  PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
+  SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, PinDef, SupportDef,
+  PolylineSupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction,
+  GroupReport, SolveDef, SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances,
+  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -783,7 +783,9 @@ class World {
   /**
    * A frictionless sliding support (embra_support_create): `particle` held on the plane through
    * `target` (m) normal to `axis` (support 'plane', the default) or on the line through it along
-   * `axis` ('line'). Options: support, axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
+   * `axis` ('line'); or a per-axis anchor ('axes', a roller): the world coordinates whose `axis`
+   * component is 1 held at the target's, those with 0 free ([0, 0, 1]: z held). Options: support,
+   * axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
    * Returns its PinId.
    */
   createSupport(particle, target, opts) {

@@ -75,6 +75,7 @@ PIN_SUPPORT_POINT = 0
 PIN_SUPPORT_PLANE = 1
 PIN_SUPPORT_LINE = 2
 PIN_SUPPORT_POLYLINE = 3
+PIN_SUPPORT_AXES = 4
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -122,7 +123,7 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8, "conical": 9}
-PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3, "axes": 4}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}

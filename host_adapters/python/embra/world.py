@@ -656,8 +656,10 @@ class World:
 
     def create_support(self, particle, target, support="plane", axis=(0.0, 0.0, 1.0), compliance=0.0, group=None):
         """A frictionless sliding support (embra_support_create): `particle` held on the plane through
-        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line");
-        compliance 0 = hard, > 0 m/N; projected in `group`. Returns its PinId."""
+        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line"); or a
+        per-axis anchor ("axes", a roller): the world coordinates whose `axis` component is 1 held at
+        the target's, those with 0 free ((0, 0, 1): z held); compliance 0 = hard, > 0 m/N; projected
+        in `group`. Returns its PinId."""
         d = lib.embra_default_support_def()
         d.particle = buf.int32(particle, "particle")
         d.support = _enum(support, PIN_SUPPORTS, "support")

@@ -750,6 +750,48 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A roller (an axes support holding z) under gravity and a horizontal point load: z stays at
+        /// the target's, x and y follow (F / m) h^2 n (n + 1) / 2, and the reaction holds the weight in z
+        /// with x and y exactly 0; an axis that is not 0/1 flags is refused.</summary>
+        [Test]
+        public void AxesSupportHoldsZAndLetsXAndYAccelerate()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0.3, -0.4, 1.2 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateSupport(0, new double[] { 0.3, -0.4, 1.2 }, PinSupport.Axes, new double[] { 0, 0, 1 });
+                w.SetLoads(new double[] { 1.5, 0.5, 0.0 });
+                for (int f = 0; f < 30; ++f)
+                {
+                    w.Step();
+                    Assert.AreEqual(1.2, w.GetPositions()[2], 1e-12);
+                }
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                Assert.AreEqual(0.75 * h * h * steps * (steps + 1) / 2, p[0] - 0.3, 1e-12);
+                Assert.AreEqual(0.25 * h * h * steps * (steps + 1) / 2, p[1] + 0.4, 1e-12);
+                Reaction r0 = w.Reactions()[0];
+                Assert.AreEqual(pin, r0.Pin);
+                unsafe
+                {
+                    Assert.AreEqual(0.0, r0.Force[0]);
+                    Assert.AreEqual(0.0, r0.Force[1]);
+                    Assert.AreEqual(2 * 9.81, r0.Force[2], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Axes, new double[] { 0, 0.5, 1 }));
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Axes, new double[] { 0, 0, 0 }));
+            }
+        }
+
         /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
         /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
         [Test]

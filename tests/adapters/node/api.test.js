@@ -214,6 +214,30 @@ test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along 
   w.close();
 });
 
+test('an axes support (roller) holds z and lets x and y accelerate at F / m', () => {
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0.3, -0.4, 1.2]], { generate: 0, masses: [2] });
+  const pin = w.createSupport(0, [0.3, -0.4, 1.2], { support: 'axes', axis: [0, 0, 1] });
+  w.setLoads([[1.5, 0.5, 0]]);
+  for (let f = 0; f < 30; f++) {
+    w.step();
+    assert.ok(Math.abs(w.positions()[2] - 1.2) < 1e-12);
+  }
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  assert.ok(Math.abs(p[0] - 0.3 - 0.75 * h * h * steps * (steps + 1) / 2) < 1e-12);
+  assert.ok(Math.abs(p[1] + 0.4 - 0.25 * h * h * steps * (steps + 1) / 2) < 1e-12);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  assert.strictEqual(r[0].force[0], 0);
+  assert.strictEqual(r[0].force[1], 0);
+  assert.ok(Math.abs(r[0].force[2] - 2 * 9.81) < 1e-9 * 9.81);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'axes', axis: [0, 0.5, 1] }), embra.EmbraError);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'axes', axis: [0, 0, 0] }), embra.EmbraError);
+  w.close();
+});
+
 test('bulk rest and compliance arrays', () => {
   const w = new embra.World({ gravity: [0, 0, 0], iterations: 50 });
   w.createBody([[0, 0, 0], [1, 0, 0], [2, 0, 0]], { generate: 0, mass: 3.0 });

@@ -215,6 +215,33 @@ def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
             w.create_support(0, (0.0, 0.0, 0.0), "curve")
 
 
+def test_axes_support_holds_z_and_lets_x_and_y_accelerate_at_f_over_m():
+    """A roller (per-axis anchor holding z) under gravity and a horizontal point load: z stays at the
+    target's, x and y follow s_n = (F / m) h^2 n (n + 1) / 2 (symplectic Euler), and the reaction
+    holds the weight in z with x and y exactly 0; an axis that is not 0/1 flags is refused."""
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.3, -0.4, 1.2)], generate=0, masses=[2.0])
+        pin = w.create_support(0, (0.3, -0.4, 1.2), "axes", axis=(0, 0, 1))
+        w.set_loads([(1.5, 0.5, 0.0)])
+        steps, h = 300, (1.0 / 60.0) / 10
+        for _ in range(30):
+            w.step()
+            assert abs(list(flat(w.positions()))[2] - 1.2) < 1e-12
+        p = list(flat(w.positions()))
+        for k, a in ((0, 0.75), (1, 0.25)):
+            exact = a * h * h * steps * (steps + 1) / 2
+            assert abs(p[k] - (0.3, -0.4)[k] - exact) < 1e-12
+        r = w.reactions()[0]
+        assert r["pin"] == pin
+        assert r["force"][0] == 0.0 and r["force"][1] == 0.0
+        assert abs(r["force"][2] - 2.0 * 9.81) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "axes", axis=(0.0, 0.5, 1.0))
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "axes", axis=(0.0, 0.0, 0.0))
+        assert w.counts().pins == 1
+
+
 def test_groups_bulk_constraints_and_reports():
     """A chain of 5 links added in bulk, hard, hanging from a pin: every link at its rest length."""
     xyz = [(0.1 * i, 0.0, 0.0) for i in range(6)]
