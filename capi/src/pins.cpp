@@ -99,6 +99,23 @@ embra_status embra_polyline_support_create(embra_world* world, const embra_polyl
   });
 }
 
+embra_status embra_polyline_support_get_points(const embra_world* world, embra_pin_id pin, double* out_points,
+                                               int32_t capacity, int32_t* out_count) {
+  return guard("embra_polyline_support_get_points", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const embra::Pin& p = world->world.pin(to_id(pin));
+    if (p.support != embra::PinSupport::polyline)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT,
+             "pin " + num(static_cast<int64_t>(pin.index)) + " is not a polyline support");
+    const int32_t n = static_cast<int32_t>(p.curve.size());
+    if (fits(out_points, capacity, n, "polyline points"))
+      for (int32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) out_points[3 * i + k] = p.curve[static_cast<size_t>(i)][k];
+    *out_count = n;
+  });
+}
+
 embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin) {
   return guard("embra_pin_destroy", world, [&] {
     world->world.destroy_pin(to_id(pin));

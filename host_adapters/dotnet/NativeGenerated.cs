@@ -613,6 +613,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern PolylineSupportDef embra_default_polyline_support_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_create(IntPtr world, ref PolylineSupportDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_get_points(IntPtr world, PinId pin, [Out] double[] points, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);

@@ -761,6 +761,18 @@ namespace Embra
 
         public void DestroyPin(PinId pin) { Call(w => Native.embra_pin_destroy(w, pin)); }
 
+        /// <summary>A polyline support's points as created (embra_polyline_support_get_points): xyz per
+        /// point, m, offsets from its target; SetPinTarget moves the target, not these, so the curve's
+        /// world points are PinTarget(pin) plus each. Refused for a pin that is not one.</summary>
+        public double[] PolylineSupportPoints(PinId pin)
+        {
+            int n = 0;
+            Call(w => Native.embra_polyline_support_get_points(w, pin, null, 0, out n));
+            var out_ = new double[3 * n];
+            Call(w => Native.embra_polyline_support_get_points(w, pin, out_, n, out n));
+            return out_;
+        }
+
         public void SetPinTarget(PinId pin, double[] target)
         {
             Three(target, "target");

@@ -2021,6 +2021,77 @@ static void test_anchor_supports(void) {
   embra_world_destroy(s.w);
 }
 
+/* A polyline support's points read back (embra_polyline_support_get_points): exactly as created, and
+ * unchanged by embra_pin_set_target, which moves the curve with the target; every refusal leaves the
+ * saved scene as it was. */
+static void test_polyline_support_points(void) {
+  scene s;
+  char* before;
+  embra_polyline_support_def pd;
+  embra_support_def sd;
+  embra_pin_id poly, plane;
+  const double pts[3 * 4] = {0.1, -0.2, 0.3, 1.0 / 3.0, 0.25, -0.125, 0.7, 0.9, 0.05, -0.4, 0.6, 0.2};
+  const double moved[3] = {0.5, -1.25, 2.0};
+  double got[3 * 4], target[3], big[3 * 6];
+  int32_t n = -1;
+  CHECK(scene_build(&s));
+  pd = embra_default_polyline_support_def();
+  pd.particle = s.point;
+  pd.target[0] = 0.25;
+  pd.target[1] = 0.25;
+  pd.target[2] = 0.6;
+  pd.points = pts;
+  pd.point_count = 4;
+  pd.closed = 1;
+  CHECK_OK(embra_polyline_support_create(s.w, &pd, &poly));
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  CHECK_OK(embra_support_create(s.w, &sd, &plane));
+  /* Two calls: the count, then the points, bit for bit as created. */
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, NULL, 0, &n));
+  CHECK_INT(n, 4);
+  memset(got, 0, sizeof got);
+  n = -1;
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, got, 4, &n));
+  CHECK_INT(n, 4);
+  CHECK(memcmp(got, pts, sizeof pts) == 0);
+  n = -1;
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, big, 6, &n)); /* a larger buffer is fine */
+  CHECK_INT(n, 4);
+  CHECK(memcmp(big, pts, sizeof pts) == 0);
+  /* Moving the target moves the curve: the offsets read back unchanged, the target is the new one. */
+  CHECK_OK(embra_pin_set_target(s.w, poly, moved));
+  CHECK_OK(embra_world_step(s.w));
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, got, 4, &n));
+  CHECK(memcmp(got, pts, sizeof pts) == 0);
+  CHECK_OK(embra_pin_get_target(s.w, poly, target));
+  CHECK(memcmp(target, moved, sizeof moved) == 0);
+  before = saved_json(s.w);
+  CHECK(before != NULL);
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w,
+                embra_polyline_support_get_points(NULL, poly, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, 4, NULL));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, -1, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, NULL, 4, &n));
+  memset(got, 0, sizeof got);
+  REFUSED_SAVED(EMBRA_ERROR_BUFFER_TOO_SMALL, "4 needed", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, 3, &n));
+  CHECK(got[0] == 0.0 && got[8] == 0.0); /* nothing written */
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_dead, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_wrong_gen, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not a polyline support", before, s.w,
+                embra_polyline_support_get_points(s.w, plane, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not a polyline support", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_soft, got, 4, &n));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -2049,6 +2120,7 @@ int main(void) {
   RUN(test_distributed_loads);
   RUN(test_polyline_supports);
   RUN(test_anchor_supports);
+  RUN(test_polyline_support_points);
   RUN(test_step);
   return capi_test_finish();
 }

@@ -625,6 +625,14 @@ EMBRA_API embra_polyline_support_def embra_default_polyline_support_def(void);
  * or 1, a negative or non-finite compliance, a stale group. */
 EMBRA_API embra_status embra_polyline_support_create(embra_world* world, const embra_polyline_support_def* def,
                                                      embra_pin_id* out_pin);
+/* A polyline support's points as created: m, offsets from its target, point k at out_points[3 k ..
+ * 3 k + 2]. embra_pin_set_target moves the target and so the whole curve, and leaves these offsets
+ * as they are: the curve's world points are the target (embra_pin_get_target) plus these. Two-call
+ * pattern: out_points NULL and capacity 0 only write *out_count; a smaller capacity is
+ * EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. Capacity in points. Refused: a stale pin, a pin that
+ * is not a polyline support. */
+EMBRA_API embra_status embra_polyline_support_get_points(const embra_world* world, embra_pin_id pin, double* out_points,
+                                                         int32_t capacity, int32_t* out_count);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The

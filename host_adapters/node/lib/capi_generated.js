@@ -555,6 +555,7 @@ const PROTOTYPES = {
   embra_support_create: 'embra_status embra_support_create(embra_world *world, const embra_support_def *def, _Out_ embra_pin_id *out_pin)',
   embra_default_polyline_support_def: 'embra_polyline_support_def embra_default_polyline_support_def(void)',
   embra_polyline_support_create: 'embra_status embra_polyline_support_create(embra_world *world, const embra_polyline_support_def *def, _Out_ embra_pin_id *out_pin)',
+  embra_polyline_support_get_points: 'embra_status embra_polyline_support_get_points(const embra_world *world, embra_pin_id pin, double *out_points, int32_t capacity, _Out_ int32_t *out_count)',
   embra_pin_destroy: 'embra_status embra_pin_destroy(embra_world *world, embra_pin_id pin)',
   embra_pin_set_target: 'embra_status embra_pin_set_target(embra_world *world, embra_pin_id pin, const double *target)',
   embra_pin_get_target: 'embra_status embra_pin_get_target(const embra_world *world, embra_pin_id pin, double *out_target)',

@@ -831,6 +831,22 @@ class World {
     return new PinId(pin.index, pin.generation);
   }
 
+  /**
+   * A polyline support's points as created (embra_polyline_support_get_points): an array of
+   * [x, y, z] offsets from its target (m); setPinTarget moves the target, not these, so the curve's
+   * world points are pinTarget(pin) plus each. Refused for a pin that is not one.
+   */
+  polylineSupportPoints(pin) {
+    const p = toId(pin, PinId, 'pin');
+    const n = [0];
+    this.#call('embra_polyline_support_get_points', p, null, 0, n);
+    const out = new Float64Array(3 * n[0]);
+    this.#call('embra_polyline_support_get_points', p, out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) result.push([out[3 * k], out[3 * k + 1], out[3 * k + 2]]);
+    return result;
+  }
+
   destroyPin(pin) {
     this.#call('embra_pin_destroy', toId(pin, PinId, 'pin'));
   }

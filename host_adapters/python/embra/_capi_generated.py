@@ -666,6 +666,7 @@ PROTOTYPES = {
     "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
     "embra_default_polyline_support_def": (PolylineSupportDef, []),
     "embra_polyline_support_create": (c_int32, [c_void_p, POINTER(PolylineSupportDef), POINTER(PinId)]),
+    "embra_polyline_support_get_points": (c_int32, [c_void_p, PinId, POINTER(c_double), c_int32, POINTER(c_int32)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),

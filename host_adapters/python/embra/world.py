@@ -693,6 +693,17 @@ class World:
         del keep
         return pin
 
+    def polyline_support_points(self, pin):
+        """A polyline support's points as created (embra_polyline_support_get_points): a list of
+        (x, y, z) offsets from its target (m); set_pin_target moves the target, not these, so the
+        curve's world points are pin_target(pin) plus each. Refused for a pin that is not one."""
+        p = _id(pin, PinId, "pin")
+        n = c_int32()
+        self._call("embra_polyline_support_get_points", p, None, 0, byref(n))
+        out = (c_double * max(3 * n.value, 1))()
+        self._call("embra_polyline_support_get_points", p, out, n.value, byref(n))
+        return [tuple(out[3 * i:3 * i + 3]) for i in range(n.value)]
+
     def destroy_pin(self, pin):
         self._call("embra_pin_destroy", _id(pin, PinId, "pin"))
 

@@ -750,6 +750,32 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>PolylineSupportPoints reads the points exactly as created; SetPinTarget moves the
+        /// target (and so the curve) and leaves them as they are.</summary>
+        [Test]
+        public void PolylineSupportPointsReadBackAndMoveWithTheTarget()
+        {
+            var pts = new double[] { 0, 0, 0, 1.0 / 3.0, 0.1, -0.2, 0.7, -0.4, 0.05 };
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 2;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0 }, masses: new[] { 1.0, 1.0 }, def: def);
+                var pin = w.CreatePolylineSupport(0, pts);
+                var plane = w.CreateSupport(1, new double[] { 0, 0, 0 }, PinSupport.Plane, null, 1.0);
+                CollectionAssert.AreEqual(pts, w.PolylineSupportPoints(pin));
+                w.SetPinTarget(pin, new double[] { 0.25, -1.5, 2.0 });
+                w.Step();
+                CollectionAssert.AreEqual(pts, w.PolylineSupportPoints(pin));
+                CollectionAssert.AreEqual(new double[] { 0.25, -1.5, 2.0 }, w.PinTarget(pin));
+                Assert.Throws<EmbraArgumentException>(() => w.PolylineSupportPoints(plane));
+            }
+        }
+
         /// <summary>A roller (an axes support holding z) under gravity and a horizontal point load: z stays at
         /// the target's, x and y follow (F / m) h^2 n (n + 1) / 2, and the reaction holds the weight in z
         /// with x and y exactly 0; an axis that is not 0/1 flags is refused.</summary>

@@ -193,6 +193,33 @@ test('a polyline support holds a bead on a circle while it swings', () => {
   w.close();
 });
 
+test('polylineSupportPoints reads the points as created; setPinTarget moves the curve', () => {
+  const pts = [[0, 0, 0], [1 / 3, 0.1, -0.2], [0.7, -0.4, 0.05]];
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 2, tethers: 0 });
+  w.createBody([[0, 0, 0], [1, 0, 0]], { generate: 0, masses: [1, 1] });
+  const pin = w.createPolylineSupport(0, pts);
+  const plane = w.createSupport(1, [0, 0, 0], { compliance: 1 });
+  assert.deepStrictEqual(w.polylineSupportPoints(pin), pts);
+  const shift = [0.25, -1.5, 2];
+  w.setPinTarget(pin, shift);
+  w.step(2);
+  assert.deepStrictEqual(w.polylineSupportPoints(pin), pts);
+  const q = Array.from(w.positions()).slice(0, 3);
+  // On the moved curve: the distance to its nearest segment.
+  let best = Infinity;
+  for (let s = 0; s + 1 < pts.length; s++) {
+    const a = pts[s].map((c, k) => c + shift[k]);
+    const b = pts[s + 1].map((c, k) => c + shift[k]);
+    const e = [0, 1, 2].map((k) => b[k] - a[k]);
+    const t = Math.min(1, Math.max(0, [0, 1, 2].reduce((acc, k) => acc + (q[k] - a[k]) * e[k], 0) /
+      e.reduce((acc, c) => acc + c * c, 0)));
+    best = Math.min(best, Math.hypot(...[0, 1, 2].map((k) => q[k] - a[k] - t * e[k])));
+  }
+  assert.ok(best < 1e-9);
+  assert.throws(() => w.polylineSupportPoints(plane), embra.EmbraError);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];

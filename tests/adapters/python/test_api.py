@@ -190,6 +190,26 @@ def test_polyline_support_holds_a_bead_on_a_circle():
         assert w.counts().pins == 1
 
 
+def test_polyline_support_points_read_back_and_move_with_the_target():
+    """polyline_support_points returns the points exactly as created; set_pin_target moves the
+    target (and so the curve) and leaves them as they are: the particle follows the moved curve."""
+    pts = [(0.0, 0.0, 0.0), (1.0 / 3.0, 0.1, -0.2), (0.7, -0.4, 0.05)]
+    with embra.World(gravity=(0.0, 0.0, 0.0), substeps=4, iterations=2, tethers=0) as w:
+        w.create_body([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0)], generate=0, masses=[1.0, 1.0])
+        pin = w.create_polyline_support(0, pts, target=(0.0, 0.0, 0.0))
+        plane = w.create_support(1, (0.0, 0.0, 0.0), "plane", compliance=1.0)
+        assert w.polyline_support_points(pin) == pts
+        shift = (0.25, -1.5, 2.0)
+        w.set_pin_target(pin, shift)
+        w.step(2)
+        assert w.polyline_support_points(pin) == pts
+        q = list(flat(w.positions()))[:3]
+        curve = [[shift[k] + p[k] for k in range(3)] for p in pts]
+        assert _distance_to_polyline(curve, False, q) < 1e-9
+        with pytest.raises(embra.EmbraError):
+            w.polyline_support_points(plane)
+
+
 def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
     """A particle on a frictionless plane inclined at 30 degrees: s_n = g sin(theta) h^2 n (n + 1) / 2
     down the slope after n substeps (symplectic Euler, the plane projected exactly), and the
