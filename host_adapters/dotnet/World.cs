@@ -745,6 +745,36 @@ namespace Embra
             return pin;
         }
 
+        /// <summary>A frictionless support on a triangle mesh (embra_mesh_support_create): the particle held
+        /// on the closest point of the mesh (`vertices` xyz per vertex, m, offsets from `target`, so
+        /// SetPinTarget moves the mesh; `triangles` three 0-based indices each). Compliance 0 = hard, else
+        /// m/N.</summary>
+        public PinId CreateMeshSupport(int particle, double[] vertices, int[] triangles, double[] target = null,
+                                       double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(vertices != null && vertices.Length % 3 == 0, "vertices: a whole number of xyz triples is required");
+            Need(triangles != null && triangles.Length % 3 == 0, "triangles: a whole number of index triples is required");
+            if (target != null) Three(target, "target");
+            var def = Native.embra_default_mesh_support_def();
+            def.Particle = particle;
+            if (target != null)
+                for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            def.Compliance = compliance;
+            def.Group = group;
+            var pin = new PinId();
+            fixed (double* v = vertices)
+            fixed (int* t = triangles)
+            {
+                def.Vertices = (IntPtr)v;
+                def.VertexCount = vertices.Length / 3;
+                def.Triangles = (IntPtr)t;
+                def.TriangleCount = triangles.Length / 3;
+                var d = def;
+                Call(w => Native.embra_mesh_support_create(w, ref d, out pin));
+            }
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");

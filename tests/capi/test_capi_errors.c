@@ -1247,7 +1247,7 @@ static void test_pins(void) {
     sd.particle = g_ref.n;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
     GOOD_SUPPORT();
-    sd.support = EMBRA_PIN_SUPPORT_AXES + 1;
+    sd.support = EMBRA_PIN_SUPPORT_MESH + 1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
     sd.support = -1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
@@ -2092,6 +2092,135 @@ static void test_polyline_support_points(void) {
   embra_world_destroy(s.w);
 }
 
+/* Mesh supports: the mesh checked whole; a refused call leaves the saved scene as it was. */
+static void test_mesh_supports(void) {
+  scene s;
+  char* before;
+  embra_mesh_support_def md;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0};
+  /* A tetrahedron round the target: 4 vertices, 4 triangles, counter-clockwise from outside. */
+  double verts[3 * 4] = {0.3, 0, 0, -0.1, 0.25, 0, -0.1, -0.25, 0, 0, 0, 0.4};
+  int32_t tris[3 * 4] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+  int i, k;
+  CHECK(scene_build(&s));
+  md = embra_default_mesh_support_def();
+  CHECK(md.version == EMBRA_MESH_SUPPORT_DEF_VERSION && md.vertex_count == 0 && md.triangle_count == 0);
+  CHECK(md.vertices == NULL && md.triangles == NULL && md.compliance == 0.0 && md.target[0] == 0.0);
+  md.particle = s.point;
+  md.target[0] = 0.25;
+  md.target[1] = 0.25;
+  md.target[2] = 0.5;
+  md.vertices = verts;
+  md.vertex_count = 4;
+  md.triangles = tris;
+  md.triangle_count = 4;
+  md.compliance = 1e-5;
+  CHECK_OK(embra_mesh_support_create(s.w, &md, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"mesh\"") != NULL);
+#define GOOD_MESH()                        \
+  do {                                     \
+    md = embra_default_mesh_support_def(); \
+    md.particle = s.point;                 \
+    md.vertices = verts;                   \
+    md.vertex_count = 4;                   \
+    md.triangles = tris;                   \
+    md.triangle_count = 4;                 \
+  } while (0)
+  GOOD_MESH();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_mesh_support_create(NULL, &md, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_mesh_support_create(s.w, NULL, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_mesh_support_create(s.w, &md, NULL));
+  md.version = 2;
+  REFUSED_SAVED(EMBRA_ERROR_VERSION, "version", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.vertices = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertices", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.triangles = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangles", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.vertex_count = 2;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertices", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.vertex_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertex_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.vertex_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertex_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.triangle_count = 0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangles", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.triangle_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangle_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.triangle_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangle_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.particle = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.group = s.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  for (i = 0; i < 3; ++i) {
+    GOOD_MESH();
+    md.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    for (k = 0; k < 12; k += 5) {
+      double bad[3 * 4];
+      memcpy(bad, verts, sizeof bad);
+      bad[k] = bad_value(i);
+      CAPI_CONTEXT("vertices[%d] = %s", k, bad_name(i));
+      GOOD_MESH();
+      md.vertices = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    }
+  }
+  CAPI_CONTEXT("indices out of range");
+  for (k = 0; k < 12; k += 7) {
+    int32_t bad[3 * 4];
+    const int32_t wrong[2] = {4, -1};
+    for (i = 0; i < 2; ++i) {
+      memcpy(bad, tris, sizeof bad);
+      bad[k] = wrong[i];
+      GOOD_MESH();
+      md.triangles = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    }
+  }
+  CAPI_CONTEXT("degenerate triangles");
+  {
+    int32_t repeated[3 * 4];
+    double flat[3 * 4];
+    memcpy(repeated, tris, sizeof repeated);
+    repeated[5] = repeated[4]; /* triangle 1 = (0, 1, 1) */
+    GOOD_MESH();
+    md.triangles = repeated;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero area", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    memcpy(flat, verts, sizeof flat);
+    flat[9] = 0.1; /* vertex 3 onto the line through vertices 0 and 1: triangle 1 collinear */
+    flat[10] = 0.125;
+    flat[11] = 0.0;
+    GOOD_MESH();
+    md.vertices = flat;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero area", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  }
+#undef GOOD_MESH
+  CAPI_CONTEXT("embra_support_create");
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_MESH; /* its mesh comes through embra_mesh_support_create */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "embra_mesh_support_create", before, s.w,
+                embra_support_create(s.w, &sd, &out));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -2121,6 +2250,7 @@ int main(void) {
   RUN(test_polyline_supports);
   RUN(test_anchor_supports);
   RUN(test_polyline_support_points);
+  RUN(test_mesh_supports);
   RUN(test_step);
   return capi_test_finish();
 }

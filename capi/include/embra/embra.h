@@ -576,8 +576,14 @@ enum {
                                     a vertex it is held there until pulled along a segment. The
                                     closest point is searched over every segment at every
                                     projection (cost linear in the points) */
-  EMBRA_PIN_SUPPORT_AXES = 4      /* a per-axis anchor: the world coordinates whose `axis` component is
-                                     1 held at the target's, those whose component is 0 free */
+  EMBRA_PIN_SUPPORT_AXES = 4,     /* a per-axis anchor: the world coordinates whose `axis` component is
+                                    1 held at the target's, those whose component is 0 free */
+  EMBRA_PIN_SUPPORT_MESH = 5      /* on the closest point of a triangle mesh, made by
+                                     embra_mesh_support_create (below): inside a triangle it slides in
+                                     it and its reaction is normal to it; on an edge or at a vertex it is
+                                     held there until pulled into a triangle. The closest point is
+                                     searched over every triangle at every projection (cost linear in
+                                     the triangles) */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
@@ -599,7 +605,8 @@ EMBRA_API embra_support_def embra_default_support_def(void);
  * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
  * (or one too short to normalise), an axes support's axis with a component other than 0 or 1 or
  * with none 1, a negative or non-finite compliance, a stale group;
- * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create). */
+ * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create) and
+ * EMBRA_PIN_SUPPORT_MESH (its mesh comes through embra_mesh_support_create). */
 EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
 
 /* A support on a polyline curve (EMBRA_PIN_SUPPORT_POLYLINE): a pin that holds its particle on the
@@ -633,6 +640,31 @@ EMBRA_API embra_status embra_polyline_support_create(embra_world* world, const e
  * is not a polyline support. */
 EMBRA_API embra_status embra_polyline_support_get_points(const embra_world* world, embra_pin_id pin, double* out_points,
                                                          int32_t capacity, int32_t* out_count);
+/* A support on a triangle mesh (EMBRA_PIN_SUPPORT_MESH, Kangaroo's OnMesh): a pin that holds its
+ * particle on the closest point of the mesh, whose vertices are offsets from `target`, so
+ * embra_pin_set_target moves the mesh as a host moves a collider. Frictionless, hard or compliant,
+ * projected in its group like the other supports; its reaction (embra_world_get_reactions) is
+ * normal to the triangle it slides in. */
+#define EMBRA_MESH_SUPPORT_DEF_VERSION 1
+typedef struct embra_mesh_support_def {
+  int32_t version;          /* EMBRA_MESH_SUPPORT_DEF_VERSION */
+  int32_t particle;         /* world particle index */
+  double target[3];         /* m: the mesh's origin; default {0, 0, 0} (the vertices are world points) */
+  int32_t vertex_count;     /* [3, EMBRA_MAX_PARTICLES] */
+  int32_t triangle_count;   /* [1, EMBRA_MAX_CONSTRAINTS] */
+  const double* vertices;   /* double[3 * vertex_count], m, offsets from target (copied at creation) */
+  const int32_t* triangles; /* int32_t[3 * triangle_count], 0-based vertex indices (copied); each
+                               triangle of nonzero area. Open or closed, any orientation */
+  double compliance;        /* 0 (default) = hard; > 0: m/N */
+  embra_group_id group;     /* its group; {0,0} = default group */
+} embra_mesh_support_def;
+
+EMBRA_API embra_mesh_support_def embra_default_mesh_support_def(void);
+/* Creates a mesh support. Refused: a particle out of range, a vertex or triangle count out of range,
+ * NULL vertices or triangles, a non-finite target or vertex, a vertex index out of range, a
+ * degenerate (zero-area) triangle, a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_mesh_support_create(embra_world* world, const embra_mesh_support_def* def,
+                                                 embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The

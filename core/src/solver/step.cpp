@@ -222,6 +222,17 @@ void World::project_group(Group& g, double h, bool first) {
       x_[p.particle] += w * dl;
       continue;
     }
+    if (p.support == PinSupport::mesh) {
+      // Held on the closest point of the mesh: inside a triangle, the multiplier keeps only its part
+      // along the triangle's normal (it slides in the face freely); on an edge or at a vertex, all.
+      const Vec3 d = x_[p.particle] - p.target;
+      const SurfacePoint c = closest_point_on_mesh(p.curve, p.triangles, d);
+      const Vec3 lambda = c.inside_face ? Vec3(c.normal.dot(p.lambda) * c.normal) : p.lambda;
+      const Vec3 dl = (-(d - c.point) - alpha * lambda) / (w + alpha);
+      p.lambda = lambda + dl;
+      x_[p.particle] += w * dl;
+      continue;
+    }
     const Vec3 dl = (-p.held(x_[p.particle] - p.target) - alpha * p.lambda) / (w + alpha);
     p.lambda += dl;
     x_[p.particle] += w * dl;

@@ -750,6 +750,49 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A particle on a mesh support (two triangles of a square inclined at 30 degrees) slides
+        /// down it on the discrete path of g sin(theta) and the reaction is m g cos(theta) along the normal;
+        /// a degenerate triangle is refused.</summary>
+        [Test]
+        public void MeshSupportHoldsAParticleSlidingDownAnInclinedFace()
+        {
+            double th = Math.PI / 6;
+            var n = new[] { -Math.Sin(th), 0.0, Math.Cos(th) };
+            var down = new[] { -Math.Cos(th), 0.0, -Math.Sin(th) };
+            var ab = new[] { 1, 1, -1, 1, -1, -1, 1, -1 };
+            var verts = new double[12];
+            for (int v = 0; v < 4; ++v)
+                for (int k = 0; k < 3; ++k) verts[3 * v + k] = 10 * (ab[2 * v] * down[k] + (k == 1 ? ab[2 * v + 1] : 0));
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0.3, 0 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateMeshSupport(0, verts, new[] { 0, 3, 2, 0, 2, 1 });
+                w.Step(30);
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                double along = p[0] * down[0] + p[2] * down[2];
+                double exact = 9.81 * Math.Sin(th) * h * h * steps * (steps + 1) / 2;
+                // rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+                Assert.AreEqual(exact, along, steps * steps * 2.2e-16 * 10);
+                Assert.AreEqual(0.0, p[0] * n[0] + p[2] * n[2], 1e-12);
+                Reaction r0 = w.Reactions()[0];
+                Assert.AreEqual(pin, r0.Pin);
+                unsafe
+                {
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(2 * 9.81 * Math.Cos(th) * n[k], r0.Force[k], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateMeshSupport(0, new double[] { 0, 0, 0, 1, 0, 0, 2, 0, 0 }, new[] { 0, 1, 2 }));
+            }
+        }
+
         /// <summary>PolylineSupportPoints reads the points exactly as created; SetPinTarget moves the
         /// target (and so the curve) and leaves them as they are.</summary>
         [Test]

@@ -220,6 +220,31 @@ test('polylineSupportPoints reads the points as created; setPinTarget moves the 
   w.close();
 });
 
+test('a mesh support: a particle slides down an inclined face at g sin(theta)', () => {
+  const th = Math.PI / 6;
+  const n = [-Math.sin(th), 0, Math.cos(th)];
+  const down = [-Math.cos(th), 0, -Math.sin(th)];
+  const verts = [[1, 1], [-1, 1], [-1, -1], [1, -1]].map(([a, b]) => [0, 1, 2].map((k) => 10 * (a * down[k] + b * [0, 1, 0][k])));
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0, 0.3, 0]], { generate: 0, masses: [2] });
+  const pin = w.createMeshSupport(0, verts, [[0, 3, 2], [0, 2, 1]]);
+  w.step(30);
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  const along = p[0] * down[0] + p[2] * down[2];
+  const exact = 9.81 * Math.sin(th) * h * h * steps * (steps + 1) / 2;
+  // rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+  assert.ok(Math.abs(along - exact) < steps * steps * 2.2e-16 * 10);
+  assert.ok(Math.abs(p[0] * n[0] + p[2] * n[2]) < 1e-12);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  for (let k = 0; k < 3; k++) assert.ok(Math.abs(r[0].force[k] - 2 * 9.81 * Math.cos(th) * n[k]) < 1e-9 * 9.81);
+  assert.throws(() => w.createMeshSupport(0, [[0, 0, 0], [1, 0, 0], [2, 0, 0]], [[0, 1, 2]]), embra.EmbraError);
+  assert.throws(() => w.createMeshSupport(0, verts, [[0, 1, 4]]), embra.EmbraError);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];

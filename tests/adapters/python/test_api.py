@@ -210,6 +210,37 @@ def test_polyline_support_points_read_back_and_move_with_the_target():
             w.polyline_support_points(plane)
 
 
+def test_mesh_support_holds_a_particle_sliding_down_an_inclined_face():
+    """A particle on a mesh support (two triangles of a square inclined at 30 degrees) slides down it
+    on the discrete path of g sin(theta), stays in the face, and the reaction is m g cos(theta)
+    along its normal; a degenerate triangle is refused."""
+    th = math.pi / 6
+    n = (-math.sin(th), 0.0, math.cos(th))
+    down = (-math.cos(th), 0.0, -math.sin(th))
+    corners = [(1, 1), (-1, 1), (-1, -1), (1, -1)]
+    verts = [tuple(10 * (a * down[k] + b * (0.0, 1.0, 0.0)[k]) for k in range(3)) for a, b in corners]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.0, 0.3, 0.0)], generate=0, masses=[2.0])
+        pin = w.create_mesh_support(0, verts, [(0, 3, 2), (0, 2, 1)])
+        w.step(30)
+        steps, h = 300, (1.0 / 60.0) / 10
+        p = list(flat(w.positions()))
+        along = sum(p[k] * down[k] for k in range(3))
+        exact = 9.81 * math.sin(th) * h * h * steps * (steps + 1) / 2
+        # rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+        assert abs(along - exact) < steps * steps * 2.2e-16 * 10
+        assert abs(sum(p[k] * n[k] for k in range(3))) < 1e-12
+        r = w.reactions()
+        assert r[0]["pin"] == pin
+        for k in range(3):
+            assert abs(r[0]["force"][k] - 2.0 * 9.81 * math.cos(th) * n[k]) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_mesh_support(0, [(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 1, 2)])
+        with pytest.raises(embra.EmbraError):
+            w.create_mesh_support(0, verts, [(0, 1, 4)])
+        assert w.counts().pins == 1
+
+
 def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
     """A particle on a frictionless plane inclined at 30 degrees: s_n = g sin(theta) h^2 n (n + 1) / 2
     down the slope after n substeps (symplectic Euler, the plane projected exactly), and the
@@ -468,7 +499,8 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
                "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
                "embra_support_def": _capi.SupportDef, "embra_area_load": _capi.AreaLoad,
-               "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef}
+               "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef,
+               "embra_mesh_support_def": _capi.MeshSupportDef}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
     assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",
