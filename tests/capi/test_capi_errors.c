@@ -2221,6 +2221,45 @@ static void test_mesh_supports(void) {
   embra_world_destroy(s.w);
 }
 
+/* The panel builder's planarity refusal follows the tolerances in force: a quad with a corner 2e-5 m
+ * off the plane of a 1 m square (its diagonals 1e-5 of an edge apart, refused by the old fixed 1e-6
+ * bound) is refused under a document whose corner distance target is 1e-6 m, leaving the saved scene
+ * as it was, and built under the default tolerances (corner distance target 5e-5 m). */
+static void test_panel_planarity_tolerance(void) {
+  scene s;
+  char* before;
+  const double pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 2e-5, 0, 1, 0};
+  const int32_t quad[4] = {0, 1, 2, 3};
+  embra_panel_mesh_def pd;
+  embra_tolerances t = embra_default_tolerances();
+  embra_body_id body;
+  embra_panel_metrics m;
+  CHECK(scene_build(&s));
+  t.planarity_distance.target = 1e-6;
+  CHECK_OK(embra_world_set_tolerances(s.w, &t));
+  pd = embra_default_panel_mesh_def();
+  pd.vertex_count = 4;
+  pd.positions = pos;
+  pd.quads = quad;
+  pd.quad_count = 1;
+  before = saved_json(s.w);
+  CHECK(before != NULL);
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not planar within the tolerances", before, s.w,
+                embra_panel_mesh_create(s.w, &pd, &body, NULL));
+  t = embra_default_tolerances();
+  CHECK_OK(embra_world_set_tolerances(s.w, &t));
+  CHECK_OK(embra_panel_mesh_create(s.w, &pd, &body, NULL));
+  memset(&m, 0, sizeof m);
+  m.version = EMBRA_PANEL_METRICS_VERSION;
+  CHECK_OK(embra_panel_mesh_get_metrics(s.w, body, NULL, &m));
+  CHECK(m.planarity_top.max <= t.planarity.target);
+  CHECK(m.corner_distance_top.max <= t.planarity_distance.target && m.corner_distance_top.max > 1e-6);
+  CHECK(m.thickness.max <= t.thickness.target);
+  CHECK(m.miter.max <= t.miter.target);
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -2251,6 +2290,7 @@ int main(void) {
   RUN(test_anchor_supports);
   RUN(test_polyline_support_points);
   RUN(test_mesh_supports);
+  RUN(test_panel_planarity_tolerance);
   RUN(test_step);
   return capi_test_finish();
 }

@@ -1107,7 +1107,10 @@ typedef struct embra_panel_mesh_def {
   const double* positions; /* double[3 * vertex_count], model units (m) */
   const int32_t* quads;    /* int32_t[4 * quad_count], counter-clockwise seen from the top's normal
                               side (the bottom layer is offset to the other side); consistently
-                              oriented, every edge on at most two quads, each quad planar */
+                              oriented, every edge on at most two quads, each quad planar within
+                              the world's tolerances (embra_world_set_tolerances; the defaults
+                              when none were set): planarity (1 - n1.n2) at most
+                              planarity.target, corner distance at most planarity_distance.target */
   int32_t quad_count;
   int32_t grid_columns;    /* grid (vertex_count 0): panels along +x (>= 1); default 4 */
   int32_t grid_rows;       /* panels along +y (>= 1); default 4 */

@@ -1358,6 +1358,7 @@ class Builder {
     d.positions = positions;
     d.quads = quads;
     read_rows(kPanelMeshRows, p, d);
+    if (doc_.contains("tolerances")) d.tolerances = parse_tolerances(doc_["tolerances"].dump());
     if (p.contains("pins"))  // the schema has checked it is one of kPanelPinsNames
       for (int k = 0; k < static_cast<int>(std::size(kPanelPinsNames)); ++k)
         if (p["pins"] == kPanelPinsNames[k]) d.pins = static_cast<PanelPins>(k);
