@@ -45,7 +45,9 @@ static_assert(static_cast<int>(embra::PinSupport::point) == 0, "embra::PinSuppor
 static_assert(static_cast<int>(embra::PinSupport::plane) == 1, "embra::PinSupport::plane is EMBRA_PIN_SUPPORT_PLANE = 1");
 static_assert(static_cast<int>(embra::PinSupport::line) == 2, "embra::PinSupport::line is EMBRA_PIN_SUPPORT_LINE = 2");
 static_assert(static_cast<int>(embra::PinSupport::polyline) == 3, "embra::PinSupport::polyline is EMBRA_PIN_SUPPORT_POLYLINE = 3");
-static_assert(embra::kPinSupportCount == 4, "embra::PinSupport and the 4 EMBRA_PIN_SUPPORT_* values differ");
+static_assert(static_cast<int>(embra::PinSupport::axes) == 4, "embra::PinSupport::axes is EMBRA_PIN_SUPPORT_AXES = 4");
+static_assert(static_cast<int>(embra::PinSupport::mesh) == 5, "embra::PinSupport::mesh is EMBRA_PIN_SUPPORT_MESH = 5");
+static_assert(embra::kPinSupportCount == 6, "embra::PinSupport and the 6 EMBRA_PIN_SUPPORT_* values differ");
 
 static_assert(static_cast<int>(embra::AreaLoadMode::normal) == 0, "embra::AreaLoadMode::normal is EMBRA_AREA_LOAD_NORMAL = 0");
 static_assert(static_cast<int>(embra::AreaLoadMode::true_area) == 1, "embra::AreaLoadMode::true_area is EMBRA_AREA_LOAD_TRUE_AREA = 1");

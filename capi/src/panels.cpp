@@ -61,6 +61,7 @@ embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_
     to_core(kPanelMeshCopies, *def, d);
     d.pins = static_cast<embra::PanelPins>(def->pins);
     d.group = to_id(def->group);
+    d.tolerances = embra::io::parse_tolerances(world->meta.tolerances);  // the world's, in force
     const embra::Id id = embra::build_panel_mesh(world->world, d);
     *out_body = from_id<embra_body_id>(id);
     if (out_first_particle) *out_first_particle = world->world.body(id).first_particle;

@@ -42,7 +42,7 @@ namespace Embra
     public enum ConstraintKind { Distance = 0, EdgeAngle = 1, Dihedral = 2, TetVolume = 3, Weld = 4, Tether = 5, Planarity = 6, PlaneOffset = 7, EqualLength = 8, Conical = 9, LengthMin = 10, AngleMin = 11, AngleMax = 12, Colinear = 13, Direction = 14, Cocircular = 15, Cospherical = 16 }
 
     /// <summary>EMBRA_PIN_SUPPORT_*.</summary>
-    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3 }
+    public enum PinSupport { Point = 0, Plane = 1, Line = 2, Polyline = 3, Axes = 4, Mesh = 5 }
 
     /// <summary>EMBRA_COLLIDER_*.</summary>
     public enum ColliderShape { Plane = 0, Sphere = 1, Box = 2, Capsule = 3, Convex = 4, Mesh = 5 }
@@ -253,6 +253,22 @@ namespace Embra
         public int PointCount;
         public int Closed;
         public IntPtr Points;
+        public double Compliance;
+        public GroupId Group;
+    }
+
+    /// <summary>embra_mesh_support_def.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct MeshSupportDef
+    {
+        public const int CurrentVersion = 1;
+        public int Version;
+        public int Particle;
+        public fixed double Target[3];
+        public int VertexCount;
+        public int TriangleCount;
+        public IntPtr Vertices;
+        public IntPtr Triangles;
         public double Compliance;
         public GroupId Group;
     }
@@ -615,6 +631,9 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_support_create(IntPtr world, ref SupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern PolylineSupportDef embra_default_polyline_support_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_create(IntPtr world, ref PolylineSupportDef def, out PinId pin);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_polyline_support_get_points(IntPtr world, PinId pin, [Out] double[] points, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern MeshSupportDef embra_default_mesh_support_def();
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_mesh_support_create(IntPtr world, ref MeshSupportDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_destroy(IntPtr world, PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_set_target(IntPtr world, PinId pin, double[] target);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_get_target(IntPtr world, PinId pin, [Out] double[] target);

@@ -720,7 +720,9 @@ namespace Embra
         /// <summary>Holds a particle at target (m): compliance 0 = hard, > 0 (m/N) a soft pin in group.</summary>
         /// <summary>A frictionless sliding support (embra_support_create): `particle` held on the plane
         /// through `target` (m) normal to `axis` (PinSupport.Plane) or on the line through it along `axis`
-        /// (PinSupport.Line); axis null = {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
+        /// (PinSupport.Line); or a per-axis anchor (PinSupport.Axes, a roller): the world coordinates whose
+        /// `axis` component is 1 held at the target's, those with 0 free ({0, 0, 1}: z held); axis null =
+        /// {0, 0, 1}; compliance 0 hard, > 0 m/N; projected in `group`.</summary>
         public PinId CreateSupport(int particle, double[] target, PinSupport support = PinSupport.Plane, double[] axis = null,
                                    double compliance = 0.0, GroupId group = default(GroupId))
         {
@@ -766,6 +768,36 @@ namespace Embra
             return pin;
         }
 
+        /// <summary>A frictionless support on a triangle mesh (embra_mesh_support_create): the particle held
+        /// on the closest point of the mesh (`vertices` xyz per vertex, m, offsets from `target`, so
+        /// SetPinTarget moves the mesh; `triangles` three 0-based indices each). Compliance 0 = hard, else
+        /// m/N.</summary>
+        public PinId CreateMeshSupport(int particle, double[] vertices, int[] triangles, double[] target = null,
+                                       double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(vertices != null && vertices.Length % 3 == 0, "vertices: a whole number of xyz triples is required");
+            Need(triangles != null && triangles.Length % 3 == 0, "triangles: a whole number of index triples is required");
+            if (target != null) Three(target, "target");
+            var def = Native.embra_default_mesh_support_def();
+            def.Particle = particle;
+            if (target != null)
+                for (int i = 0; i < 3; ++i) def.Target[i] = target[i];
+            def.Compliance = compliance;
+            def.Group = group;
+            var pin = new PinId();
+            fixed (double* v = vertices)
+            fixed (int* t = triangles)
+            {
+                def.Vertices = (IntPtr)v;
+                def.VertexCount = vertices.Length / 3;
+                def.Triangles = (IntPtr)t;
+                def.TriangleCount = triangles.Length / 3;
+                var d = def;
+                Call(w => Native.embra_mesh_support_create(w, ref d, out pin));
+            }
+            return pin;
+        }
+
         public PinId CreatePin(int particle, double[] target, double compliance = 0.0, GroupId group = default(GroupId))
         {
             Three(target, "target");
@@ -781,6 +813,18 @@ namespace Embra
         }
 
         public void DestroyPin(PinId pin) { Call(w => Native.embra_pin_destroy(w, pin)); }
+
+        /// <summary>A polyline support's points as created (embra_polyline_support_get_points): xyz per
+        /// point, m, offsets from its target; SetPinTarget moves the target, not these, so the curve's
+        /// world points are PinTarget(pin) plus each. Refused for a pin that is not one.</summary>
+        public double[] PolylineSupportPoints(PinId pin)
+        {
+            int n = 0;
+            Call(w => Native.embra_polyline_support_get_points(w, pin, null, 0, out n));
+            var out_ = new double[3 * n];
+            Call(w => Native.embra_polyline_support_get_points(w, pin, out_, n, out n));
+            return out_;
+        }
 
         public void SetPinTarget(PinId pin, double[] target)
         {

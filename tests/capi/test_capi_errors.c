@@ -1431,7 +1431,7 @@ static void test_pins(void) {
     sd.particle = g_ref.n;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_support_create(W, &sd, &out));
     GOOD_SUPPORT();
-    sd.support = 4;
+    sd.support = EMBRA_PIN_SUPPORT_MESH + 1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
     sd.support = -1;
     REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "support", embra_support_create(W, &sd, &out));
@@ -2132,6 +2132,318 @@ static void test_polyline_supports(void) {
   embra_world_destroy(s.w);
 }
 
+/* Per-axis anchors (EMBRA_PIN_SUPPORT_AXES): the axis flags checked; a refused call leaves the saved
+ * scene as it was. */
+static void test_anchor_supports(void) {
+  scene s;
+  char* before;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0}, dead;
+  const double not_flags[] = {0.5, 2.0, -1.0, 1e-300, 1.0 + 1e-15};
+  int i, k;
+  CHECK(scene_build(&s));
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_AXES; /* the default axis {0, 0, 1}: z held */
+  CHECK_OK(embra_support_create(s.w, &sd, &dead));
+  CHECK_OK(embra_pin_destroy(s.w, dead));
+  sd.axis[0] = 1.0;
+  CHECK_OK(embra_support_create(s.w, &sd, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"axes\"") != NULL);
+#define GOOD_ANCHOR()                    \
+  do {                                   \
+    sd = embra_default_support_def();    \
+    sd.particle = s.point;               \
+    sd.support = EMBRA_PIN_SUPPORT_AXES; \
+  } while (0)
+  GOOD_ANCHOR();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_support_create(NULL, &sd, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_support_create(s.w, NULL, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_support_create(s.w, &sd, NULL));
+  sd.particle = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_support_create(s.w, &sd, &out));
+  sd.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_support_create(s.w, &sd, &out));
+  GOOD_ANCHOR();
+  sd.axis[2] = 0.0; /* nothing held */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "holds no coordinate", before, s.w, embra_support_create(s.w, &sd, &out));
+  for (k = 0; k < 3; ++k)
+    for (i = 0; i < (int)(sizeof not_flags / sizeof not_flags[0]); ++i) {
+      GOOD_ANCHOR();
+      sd.axis[k] = not_flags[i];
+      CAPI_CONTEXT("axis[%d] = %.17g", k, not_flags[i]);
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "1 (that coordinate held) or 0", before, s.w,
+                    embra_support_create(s.w, &sd, &out));
+    }
+  for (i = 0; i < 3; ++i) {
+    GOOD_ANCHOR();
+    sd.axis[i] = bad_value(i);
+    CAPI_CONTEXT("axis[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "axis", before, s.w, embra_support_create(s.w, &sd, &out));
+    GOOD_ANCHOR();
+    sd.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_support_create(s.w, &sd, &out));
+  }
+  CAPI_CONTEXT("compliance, group, stale pin");
+  GOOD_ANCHOR();
+  sd.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_support_create(s.w, &sd, &out));
+  sd.compliance = NAN;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_support_create(s.w, &sd, &out));
+  GOOD_ANCHOR();
+  sd.group = s.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_support_create(s.w, &sd, &out));
+  {
+    const double t[3] = {0.0, 0.0, 0.0};
+    REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w, embra_pin_set_target(s.w, dead, t));
+  }
+#undef GOOD_ANCHOR
+  free(before);
+  embra_world_destroy(s.w);
+}
+
+/* A polyline support's points read back (embra_polyline_support_get_points): exactly as created, and
+ * unchanged by embra_pin_set_target, which moves the curve with the target; every refusal leaves the
+ * saved scene as it was. */
+static void test_polyline_support_points(void) {
+  scene s;
+  char* before;
+  embra_polyline_support_def pd;
+  embra_support_def sd;
+  embra_pin_id poly, plane;
+  const double pts[3 * 4] = {0.1, -0.2, 0.3, 1.0 / 3.0, 0.25, -0.125, 0.7, 0.9, 0.05, -0.4, 0.6, 0.2};
+  const double moved[3] = {0.5, -1.25, 2.0};
+  double got[3 * 4], target[3], big[3 * 6];
+  int32_t n = -1;
+  CHECK(scene_build(&s));
+  pd = embra_default_polyline_support_def();
+  pd.particle = s.point;
+  pd.target[0] = 0.25;
+  pd.target[1] = 0.25;
+  pd.target[2] = 0.6;
+  pd.points = pts;
+  pd.point_count = 4;
+  pd.closed = 1;
+  CHECK_OK(embra_polyline_support_create(s.w, &pd, &poly));
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  CHECK_OK(embra_support_create(s.w, &sd, &plane));
+  /* Two calls: the count, then the points, bit for bit as created. */
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, NULL, 0, &n));
+  CHECK_INT(n, 4);
+  memset(got, 0, sizeof got);
+  n = -1;
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, got, 4, &n));
+  CHECK_INT(n, 4);
+  CHECK(memcmp(got, pts, sizeof pts) == 0);
+  n = -1;
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, big, 6, &n)); /* a larger buffer is fine */
+  CHECK_INT(n, 4);
+  CHECK(memcmp(big, pts, sizeof pts) == 0);
+  /* Moving the target moves the curve: the offsets read back unchanged, the target is the new one. */
+  CHECK_OK(embra_pin_set_target(s.w, poly, moved));
+  CHECK_OK(embra_world_step(s.w));
+  CHECK_OK(embra_polyline_support_get_points(s.w, poly, got, 4, &n));
+  CHECK(memcmp(got, pts, sizeof pts) == 0);
+  CHECK_OK(embra_pin_get_target(s.w, poly, target));
+  CHECK(memcmp(target, moved, sizeof moved) == 0);
+  before = saved_json(s.w);
+  CHECK(before != NULL);
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w,
+                embra_polyline_support_get_points(NULL, poly, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, 4, NULL));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, -1, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, NULL, 4, &n));
+  memset(got, 0, sizeof got);
+  REFUSED_SAVED(EMBRA_ERROR_BUFFER_TOO_SMALL, "4 needed", before, s.w,
+                embra_polyline_support_get_points(s.w, poly, got, 3, &n));
+  CHECK(got[0] == 0.0 && got[8] == 0.0); /* nothing written */
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_dead, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "pin", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_wrong_gen, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not a polyline support", before, s.w,
+                embra_polyline_support_get_points(s.w, plane, got, 4, &n));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not a polyline support", before, s.w,
+                embra_polyline_support_get_points(s.w, s.pin_soft, got, 4, &n));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
+/* Mesh supports: the mesh checked whole; a refused call leaves the saved scene as it was. */
+static void test_mesh_supports(void) {
+  scene s;
+  char* before;
+  embra_mesh_support_def md;
+  embra_support_def sd;
+  embra_pin_id out = {0, 0};
+  /* A tetrahedron round the target: 4 vertices, 4 triangles, counter-clockwise from outside. */
+  double verts[3 * 4] = {0.3, 0, 0, -0.1, 0.25, 0, -0.1, -0.25, 0, 0, 0, 0.4};
+  int32_t tris[3 * 4] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+  int i, k;
+  CHECK(scene_build(&s));
+  md = embra_default_mesh_support_def();
+  CHECK(md.version == EMBRA_MESH_SUPPORT_DEF_VERSION && md.vertex_count == 0 && md.triangle_count == 0);
+  CHECK(md.vertices == NULL && md.triangles == NULL && md.compliance == 0.0 && md.target[0] == 0.0);
+  md.particle = s.point;
+  md.target[0] = 0.25;
+  md.target[1] = 0.25;
+  md.target[2] = 0.5;
+  md.vertices = verts;
+  md.vertex_count = 4;
+  md.triangles = tris;
+  md.triangle_count = 4;
+  md.compliance = 1e-5;
+  CHECK_OK(embra_mesh_support_create(s.w, &md, &out));
+  CHECK_OK(embra_world_step(s.w));
+  before = saved_json(s.w);
+  CHECK(before != NULL && strstr(before, "\"mesh\"") != NULL);
+#define GOOD_MESH()                        \
+  do {                                     \
+    md = embra_default_mesh_support_def(); \
+    md.particle = s.point;                 \
+    md.vertices = verts;                   \
+    md.vertex_count = 4;                   \
+    md.triangles = tris;                   \
+    md.triangle_count = 4;                 \
+  } while (0)
+  GOOD_MESH();
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "world", before, s.w, embra_mesh_support_create(NULL, &md, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "def", before, s.w, embra_mesh_support_create(s.w, NULL, &out));
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "out_pin", before, s.w, embra_mesh_support_create(s.w, &md, NULL));
+  md.version = 2;
+  REFUSED_SAVED(EMBRA_ERROR_VERSION, "version", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.vertices = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertices", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.triangles = NULL;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangles", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.vertex_count = 2;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertices", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.vertex_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertex_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.vertex_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "vertex_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.triangle_count = 0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangles", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.triangle_count = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangle_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.triangle_count = INT32_MAX;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "triangle_count", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.particle = s.n;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  md.particle = -1;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.compliance = -1.0;
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  GOOD_MESH();
+  md.group = s.g_dead;
+  REFUSED_SAVED(EMBRA_ERROR_STALE_ID, "group", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  for (i = 0; i < 3; ++i) {
+    GOOD_MESH();
+    md.target[i] = bad_value(i);
+    CAPI_CONTEXT("target[%d] = %s", i, bad_name(i));
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "target", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    for (k = 0; k < 12; k += 5) {
+      double bad[3 * 4];
+      memcpy(bad, verts, sizeof bad);
+      bad[k] = bad_value(i);
+      CAPI_CONTEXT("vertices[%d] = %s", k, bad_name(i));
+      GOOD_MESH();
+      md.vertices = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "finite", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    }
+  }
+  CAPI_CONTEXT("indices out of range");
+  for (k = 0; k < 12; k += 7) {
+    int32_t bad[3 * 4];
+    const int32_t wrong[2] = {4, -1};
+    for (i = 0; i < 2; ++i) {
+      memcpy(bad, tris, sizeof bad);
+      bad[k] = wrong[i];
+      GOOD_MESH();
+      md.triangles = bad;
+      REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    }
+  }
+  CAPI_CONTEXT("degenerate triangles");
+  {
+    int32_t repeated[3 * 4];
+    double flat[3 * 4];
+    memcpy(repeated, tris, sizeof repeated);
+    repeated[5] = repeated[4]; /* triangle 1 = (0, 1, 1) */
+    GOOD_MESH();
+    md.triangles = repeated;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero area", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+    memcpy(flat, verts, sizeof flat);
+    flat[9] = 0.1; /* vertex 3 onto the line through vertices 0 and 1: triangle 1 collinear */
+    flat[10] = 0.125;
+    flat[11] = 0.0;
+    GOOD_MESH();
+    md.vertices = flat;
+    REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "zero area", before, s.w, embra_mesh_support_create(s.w, &md, &out));
+  }
+#undef GOOD_MESH
+  CAPI_CONTEXT("embra_support_create");
+  sd = embra_default_support_def();
+  sd.particle = s.point;
+  sd.support = EMBRA_PIN_SUPPORT_MESH; /* its mesh comes through embra_mesh_support_create */
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "embra_mesh_support_create", before, s.w,
+                embra_support_create(s.w, &sd, &out));
+  free(before);
+  embra_world_destroy(s.w);
+}
+
+/* The panel builder's planarity refusal follows the tolerances in force: a quad with a corner 2e-5 m
+ * off the plane of a 1 m square (its diagonals 1e-5 of an edge apart, refused by the old fixed 1e-6
+ * bound) is refused under a document whose corner distance target is 1e-6 m, leaving the saved scene
+ * as it was, and built under the default tolerances (corner distance target 5e-5 m). */
+static void test_panel_planarity_tolerance(void) {
+  scene s;
+  char* before;
+  const double pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 2e-5, 0, 1, 0};
+  const int32_t quad[4] = {0, 1, 2, 3};
+  embra_panel_mesh_def pd;
+  embra_tolerances t = embra_default_tolerances();
+  embra_body_id body;
+  embra_panel_metrics m;
+  CHECK(scene_build(&s));
+  t.planarity_distance.target = 1e-6;
+  CHECK_OK(embra_world_set_tolerances(s.w, &t));
+  pd = embra_default_panel_mesh_def();
+  pd.vertex_count = 4;
+  pd.positions = pos;
+  pd.quads = quad;
+  pd.quad_count = 1;
+  before = saved_json(s.w);
+  CHECK(before != NULL);
+  REFUSED_SAVED(EMBRA_ERROR_INVALID_ARGUMENT, "not planar within the tolerances", before, s.w,
+                embra_panel_mesh_create(s.w, &pd, &body, NULL));
+  t = embra_default_tolerances();
+  CHECK_OK(embra_world_set_tolerances(s.w, &t));
+  CHECK_OK(embra_panel_mesh_create(s.w, &pd, &body, NULL));
+  memset(&m, 0, sizeof m);
+  m.version = EMBRA_PANEL_METRICS_VERSION;
+  CHECK_OK(embra_panel_mesh_get_metrics(s.w, body, NULL, &m));
+  CHECK(m.planarity_top.max <= t.planarity.target);
+  CHECK(m.corner_distance_top.max <= t.planarity_distance.target && m.corner_distance_top.max > 1e-6);
+  CHECK(m.thickness.max <= t.thickness.target);
+  CHECK(m.miter.max <= t.miter.target);
+  free(before);
+  embra_world_destroy(s.w);
+}
+
 static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
@@ -2161,6 +2473,10 @@ int main(void) {
   RUN(test_statics);
   RUN(test_distributed_loads);
   RUN(test_polyline_supports);
+  RUN(test_anchor_supports);
+  RUN(test_polyline_support_points);
+  RUN(test_mesh_supports);
+  RUN(test_panel_planarity_tolerance);
   RUN(test_step);
   return capi_test_finish();
 }

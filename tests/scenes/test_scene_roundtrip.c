@@ -3,9 +3,9 @@
  * For every scene file given on the command line (CMake passes every JSON file of examples/ and of
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
- * orders and weights, hard and soft pins, plane, line and polyline supports, a plane and a sphere, non-default solver
- * settings, a rest scale, initial velocities, point, area and line loads, and a destroyed group, pin and collider whose
- * slots are reused):
+ * orders and weights, hard and soft pins, plane, line, polyline, axes and mesh supports, a plane and a sphere,
+ * non-default solver settings, a rest scale, initial velocities, point, area and line loads, and a destroyed group, pin
+ * and collider whose slots are reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -496,6 +496,32 @@ static embra_world* build_api_world(void) {
       su.compliance = 1e-4;
       CHECK_OK(embra_polyline_support_create(w, &su, &spin));
     }
+    /* A mesh support: a tetrahedron round a cloth particle (vertices with every bit), hard. */
+    {
+      double verts[3 * 4] = {0.3, 0.0, 0.0, -0.1, 0.25 / 3.0, 0.0, -0.1, -0.25, 0.01, 0.0, 0.0, 0.4};
+      int32_t tris[3 * 4] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+      embra_mesh_support_def me = embra_default_mesh_support_def();
+      embra_pin_id mpin;
+      me.particle = c0 + NX + 4;
+      memcpy(me.target, &cloth_xyz[3 * (NX + 4)], sizeof me.target);
+      me.vertices = verts;
+      me.vertex_count = 4;
+      me.triangles = tris;
+      me.triangle_count = 4;
+      CHECK_OK(embra_mesh_support_create(w, &me, &mpin));
+    }
+    /* A per-axis anchor holding x and z of a cloth particle (y free), compliant. */
+    {
+      embra_support_def ax = embra_default_support_def();
+      embra_pin_id apin;
+      ax.particle = c0 + NX + 3;
+      ax.support = EMBRA_PIN_SUPPORT_AXES;
+      memcpy(ax.target, &cloth_xyz[3 * (NX + 3)], sizeof ax.target);
+      ax.target[2] += 0.1 / 3.0;
+      ax.axis[0] = 1.0;
+      ax.compliance = 2e-5;
+      CHECK_OK(embra_support_create(w, &ax, &apin));
+    }
     CHECK_OK(embra_world_set_area_loads(w, area, 3));
     CHECK_OK(embra_world_set_line_loads(w, line, 2));
   }
@@ -514,7 +540,7 @@ static void api_world_round_trips(void) {
   if (w == NULL) return;
   CHECK_OK(embra_world_get_counts(w, &c));
   CHECK_INT(c.bodies, 2);
-  CHECK_INT(c.pins, 8); /* five pins and three supports */
+  CHECK_INT(c.pins, 10); /* five pins and five supports */
   CHECK_INT(c.colliders, 2);
   if (g_save_api_path != NULL) CHECK_OK(embra_world_save_file(w, g_save_api_path));
   check_round_trip("the C-ABI world", w, NULL);

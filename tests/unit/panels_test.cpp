@@ -223,5 +223,80 @@ TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
   RecordProperty("conical_after_60_frames_miter", test::sci(r1.miter.max));
 }
 
+// An optimised PQ mesh is planar to its optimiser's tolerance, not to rounding. This one is stated
+// exactly: the conical band above (a surface of revolution, 24 around, 4 rows, radius 3 m; every
+// quad an isosceles trapezoid, every inner vertex conical) with each vertex v moved by
+// 4e-6 m x (sin(12.9898 v + 1), sin(78.233 v + 2), sin(37.719 v + 3)): about 1e-5 of the 0.6-0.8 m
+// edges off planar. The builder's old rule (diagonals at most 1e-6 of the mean edge apart) refused
+// it; the tolerances in force accept it (planarity 1 - n1.n2 <= 1e-6, corner distance <= 5e-5 m),
+// and the panels it builds read thickness and miter within the tolerances at frame 0. A stricter
+// document (corner distance 1e-6 m) refuses it and changes nothing.
+TEST(PanelMesh, PerturbedConicalMeshPlanarWithinTheTolerancesIsBuiltWithinThem) {
+  constexpr int around = 24, rows = 4;
+  constexpr double radius = 3.0, amplitude = 4e-6;
+  std::vector<double> pos;
+  for (int i = 0; i <= rows; ++i) {
+    const double phi = -0.4 + 0.8 * i / rows;
+    for (int j = 0; j < around; ++j) {
+      const double theta = 2 * std::numbers::pi * j / around;
+      const double v = static_cast<double>(i * around + j);
+      pos.insert(pos.end(), {radius * std::cos(phi) * std::cos(theta) + amplitude * std::sin(12.9898 * v + 1.0),
+                             radius * std::cos(phi) * std::sin(theta) + amplitude * std::sin(78.233 * v + 2.0),
+                             radius * std::sin(phi) + amplitude * std::sin(37.719 * v + 3.0)});
+    }
+  }
+  std::vector<int32_t> quads;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < around; ++j) {
+      const int32_t a = i * around + j, b = i * around + (j + 1) % around;
+      quads.insert(quads.end(), {a, b, b + around, a + around});
+    }
+  auto P = [&](int32_t v) { return Vec3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]); };
+  double old_rule = 0.0, planarity = 0.0, corner = 0.0, corner_rel = 0.0;
+  for (size_t q = 0; q < quads.size(); q += 4) {
+    const Vec3 a = P(quads[q]), b = P(quads[q + 1]), c = P(quads[q + 2]), d = P(quads[q + 3]);
+    old_rule = std::max(old_rule, quad_diagonal_distance(a, b, c, d));
+    planarity = std::max(planarity, quad_planarity(a, b, c, d));
+    corner = std::max(corner, quad_corner_distance(a, b, c, d));
+    const double edge = ((b - a).norm() + (c - b).norm() + (d - c).norm() + (a - d).norm()) / 4.0;
+    corner_rel = std::max(corner_rel, quad_corner_distance(a, b, c, d) / edge);
+  }
+  RecordProperty("old_rule_diagonal_distance_over_edge", test::sci(old_rule));
+  RecordProperty("corner_distance_over_edge", test::sci(corner_rel));
+  EXPECT_GT(old_rule, 1e-6) << "the old rule (diagonals 1e-6 of an edge apart) refused this mesh";
+  EXPECT_GT(corner_rel, 5e-6);
+  EXPECT_LT(corner_rel, 5e-5) << "about 1e-5 of an edge off planar";
+  const Tolerances tol;
+  EXPECT_LE(planarity, tol.planarity.target);
+  EXPECT_LE(corner, tol.planarity_distance.target);
+
+  World w(test::settings(20, 1));
+  PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.thickness = 0.05;
+  // A stricter document refuses it, and nothing changes.
+  PanelMeshDesc strict = d;
+  strict.tolerances.planarity_distance.target = 1e-6;
+  EXPECT_THROW(build_panel_mesh(w, strict), Error);
+  EXPECT_EQ(w.particle_count(), 0);
+  const Id body = build_panel_mesh(w, d);
+  const PanelLayout& l = *w.panel_layout(body);
+  const PanelReport r0 = report_panels(measure_panels(l, w.positions()), tol);
+  RecordProperty("frame0_planarity_top", test::sci(r0.planarity_top.max));
+  RecordProperty("frame0_corner_distance_top", test::sci(r0.corner_distance_top.max));
+  RecordProperty("frame0_thickness", test::sci(r0.thickness.max));
+  RecordProperty("frame0_miter", test::sci(r0.miter.max));
+  RecordProperty("frame0_planarity_bottom", test::sci(r0.planarity_bottom.max));
+  RecordProperty("frame0_corner_distance_bottom", test::sci(r0.corner_distance_bottom.max));
+  EXPECT_LE(r0.planarity_top.max, tol.planarity.target);
+  EXPECT_LE(r0.planarity_bottom.max, tol.planarity.target);
+  EXPECT_LE(r0.corner_distance_top.max, tol.planarity_distance.target);
+  EXPECT_LE(r0.corner_distance_bottom.max, tol.planarity_distance.target);
+  EXPECT_LE(r0.thickness.max, tol.thickness.target);
+  EXPECT_LE(r0.miter.max, tol.miter.target);
+  EXPECT_TRUE(r0.within_tolerance);
+}
+
 }  // namespace
 }  // namespace embra

@@ -632,23 +632,32 @@ typedef struct embra_pin_def {
 EMBRA_API embra_pin_def embra_default_pin_def(void);
 /* A particle takes at most one hard pin. */
 EMBRA_API embra_status embra_pin_create(embra_world* world, const embra_pin_def* def, embra_pin_id* out_pin);
-/* Sliding supports: a pin that holds its particle on a plane or a line through the target, and
- * lets it slide along it, frictionless. A per-axis anchor (a roller) is one of them: one
- * coordinate held is a plane with that axis as its normal ({0, 0, 1}: z held, x and y free), two
- * held a line along the third. A support is a pin (an embra_pin_id: embra_pin_destroy,
- * embra_pin_set_target, embra_world_get_pins and the scene's "pins" take it), projected in its
- * group like a constraint, never kinematic; its reaction (embra_world_get_reactions) is normal to
- * the plane or across the line. */
+/* Sliding supports: a pin that holds its particle on a plane or a line through the target, or on a
+ * polyline, and lets it slide along it, frictionless; or a per-axis anchor (EMBRA_PIN_SUPPORT_AXES,
+ * Kangaroo's AnchorXYZ, a roller) that holds chosen world coordinates of its particle at the
+ * target's and leaves the others free ({0, 0, 1}: z held, x and y free). A support is a pin (an
+ * embra_pin_id: embra_pin_destroy, embra_pin_set_target, embra_world_get_pins and the scene's
+ * "pins" take it), projected in its group like a constraint, never kinematic; its reaction
+ * (embra_world_get_reactions) is normal to the plane or across the line, and for an axes support
+ * has only the held components (the free ones exactly 0). */
 enum {
-  EMBRA_PIN_SUPPORT_POINT = 0,   /* the particle held at the target: embra_pin_create's pin */
-  EMBRA_PIN_SUPPORT_PLANE = 1,   /* on the plane through the target, normal `axis` */
-  EMBRA_PIN_SUPPORT_LINE = 2,    /* on the line through the target, along `axis` */
-  EMBRA_PIN_SUPPORT_POLYLINE = 3 /* on the closest point of a polyline, made by
+  EMBRA_PIN_SUPPORT_POINT = 0,    /* the particle held at the target: embra_pin_create's pin */
+  EMBRA_PIN_SUPPORT_PLANE = 1,    /* on the plane through the target, normal `axis` */
+  EMBRA_PIN_SUPPORT_LINE = 2,     /* on the line through the target, along `axis` */
+  EMBRA_PIN_SUPPORT_POLYLINE = 3, /* on the closest point of a polyline, made by
                                     embra_polyline_support_create (below): inside a segment it
                                     slides along it and its reaction is normal to the segment; at
                                     a vertex it is held there until pulled along a segment. The
                                     closest point is searched over every segment at every
                                     projection (cost linear in the points) */
+  EMBRA_PIN_SUPPORT_AXES = 4,     /* a per-axis anchor: the world coordinates whose `axis` component is
+                                    1 held at the target's, those whose component is 0 free */
+  EMBRA_PIN_SUPPORT_MESH = 5      /* on the closest point of a triangle mesh, made by
+                                     embra_mesh_support_create (below): inside a triangle it slides in
+                                     it and its reaction is normal to it; on an edge or at a vertex it is
+                                     held there until pulled into a triangle. The closest point is
+                                     searched over every triangle at every projection (cost linear in
+                                     the triangles) */
 };
 
 #define EMBRA_SUPPORT_DEF_VERSION 1
@@ -657,9 +666,10 @@ typedef struct embra_support_def {
   int32_t particle; /* world particle index */
   int32_t support;  /* EMBRA_PIN_SUPPORT_*; default EMBRA_PIN_SUPPORT_PLANE */
   int32_t reserved0;
-  double target[3];     /* m: a point of the plane or line */
+  double target[3];     /* m: a point of the plane or line; where an axes support holds */
   double axis[3];       /* the plane's normal or the line's direction: finite, of any nonzero length
-                           (kept as a unit vector); default {0, 0, 1} */
+                           (kept as a unit vector); for EMBRA_PIN_SUPPORT_AXES the held coordinates:
+                           each component 1 (held) or 0 (free), not all 0; default {0, 0, 1} */
   double compliance;    /* 0 (default) = hard (projected with compliance 0); > 0: m/N */
   embra_group_id group; /* its group; {0,0} = default group */
 } embra_support_def;
@@ -667,8 +677,10 @@ typedef struct embra_support_def {
 EMBRA_API embra_support_def embra_default_support_def(void);
 /* Creates a support (EMBRA_PIN_SUPPORT_POINT: a pin, as embra_pin_create). Refused: an unknown
  * support, a particle out of range, a non-finite target or axis, a zero axis for a plane or line
- * (or one too short to normalise), a negative or non-finite compliance, a stale group;
- * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create). */
+ * (or one too short to normalise), an axes support's axis with a component other than 0 or 1 or
+ * with none 1, a negative or non-finite compliance, a stale group;
+ * EMBRA_PIN_SUPPORT_POLYLINE (its curve comes through embra_polyline_support_create) and
+ * EMBRA_PIN_SUPPORT_MESH (its mesh comes through embra_mesh_support_create). */
 EMBRA_API embra_status embra_support_create(embra_world* world, const embra_support_def* def, embra_pin_id* out_pin);
 
 /* A support on a polyline curve (EMBRA_PIN_SUPPORT_POLYLINE): a pin that holds its particle on the
@@ -694,6 +706,39 @@ EMBRA_API embra_polyline_support_def embra_default_polyline_support_def(void);
  * or 1, a negative or non-finite compliance, a stale group. */
 EMBRA_API embra_status embra_polyline_support_create(embra_world* world, const embra_polyline_support_def* def,
                                                      embra_pin_id* out_pin);
+/* A polyline support's points as created: m, offsets from its target, point k at out_points[3 k ..
+ * 3 k + 2]. embra_pin_set_target moves the target and so the whole curve, and leaves these offsets
+ * as they are: the curve's world points are the target (embra_pin_get_target) plus these. Two-call
+ * pattern: out_points NULL and capacity 0 only write *out_count; a smaller capacity is
+ * EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written. Capacity in points. Refused: a stale pin, a pin that
+ * is not a polyline support. */
+EMBRA_API embra_status embra_polyline_support_get_points(const embra_world* world, embra_pin_id pin, double* out_points,
+                                                         int32_t capacity, int32_t* out_count);
+/* A support on a triangle mesh (EMBRA_PIN_SUPPORT_MESH, Kangaroo's OnMesh): a pin that holds its
+ * particle on the closest point of the mesh, whose vertices are offsets from `target`, so
+ * embra_pin_set_target moves the mesh as a host moves a collider. Frictionless, hard or compliant,
+ * projected in its group like the other supports; its reaction (embra_world_get_reactions) is
+ * normal to the triangle it slides in. */
+#define EMBRA_MESH_SUPPORT_DEF_VERSION 1
+typedef struct embra_mesh_support_def {
+  int32_t version;          /* EMBRA_MESH_SUPPORT_DEF_VERSION */
+  int32_t particle;         /* world particle index */
+  double target[3];         /* m: the mesh's origin; default {0, 0, 0} (the vertices are world points) */
+  int32_t vertex_count;     /* [3, EMBRA_MAX_PARTICLES] */
+  int32_t triangle_count;   /* [1, EMBRA_MAX_CONSTRAINTS] */
+  const double* vertices;   /* double[3 * vertex_count], m, offsets from target (copied at creation) */
+  const int32_t* triangles; /* int32_t[3 * triangle_count], 0-based vertex indices (copied); each
+                               triangle of nonzero area. Open or closed, any orientation */
+  double compliance;        /* 0 (default) = hard; > 0: m/N */
+  embra_group_id group;     /* its group; {0,0} = default group */
+} embra_mesh_support_def;
+
+EMBRA_API embra_mesh_support_def embra_default_mesh_support_def(void);
+/* Creates a mesh support. Refused: a particle out of range, a vertex or triangle count out of range,
+ * NULL vertices or triangles, a non-finite target or vertex, a vertex index out of range, a
+ * degenerate (zero-area) triangle, a negative or non-finite compliance, a stale group. */
+EMBRA_API embra_status embra_mesh_support_create(embra_world* world, const embra_mesh_support_def* def,
+                                                 embra_pin_id* out_pin);
 /* Destroys a pin (and a scene action that moves it). */
 EMBRA_API embra_status embra_pin_destroy(embra_world* world, embra_pin_id pin);
 /* Moves the target (m); a hard-pinned particle travels there over the next step's substeps. The
@@ -1137,7 +1182,10 @@ typedef struct embra_panel_mesh_def {
   const double* positions; /* double[3 * vertex_count], model units (m) */
   const int32_t* quads;    /* int32_t[4 * quad_count], counter-clockwise seen from the top's normal
                               side (the bottom layer is offset to the other side); consistently
-                              oriented, every edge on at most two quads, each quad planar */
+                              oriented, every edge on at most two quads, each quad planar within
+                              the world's tolerances (embra_world_set_tolerances; the defaults
+                              when none were set): planarity (1 - n1.n2) at most
+                              planarity.target, corner distance at most planarity_distance.target */
   int32_t quad_count;
   int32_t grid_columns;    /* grid (vertex_count 0): panels along +x (>= 1); default 4 */
   int32_t grid_rows;       /* panels along +y (>= 1); default 4 */

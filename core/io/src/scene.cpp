@@ -659,7 +659,7 @@ constexpr std::tuple kPanelMeshRows{Row{"thickness", &PanelMeshDesc::thickness},
                                     Row{"slide_compliance", &PanelMeshDesc::slide_compliance}};
 
 /// The pin supports' names in the scene format, by PinSupport.
-constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline"};
+constexpr const char* kPinSupportNames[] = {"point", "plane", "line", "polyline", "axes", "mesh"};
 static_assert(std::size(kPinSupportNames) == kPinSupportCount);
 
 /// The area load modes' names in the scene format, by AreaLoadMode.
@@ -1359,6 +1359,7 @@ class Builder {
     d.positions = positions;
     d.quads = quads;
     read_rows(kPanelMeshRows, p, d);
+    if (doc_.contains("tolerances")) d.tolerances = parse_tolerances(doc_["tolerances"].dump());
     if (p.contains("pins"))  // the schema has checked it is one of kPanelPinsNames
       for (int k = 0; k < static_cast<int>(std::size(kPanelPinsNames)); ++k)
         if (p["pins"] == kPanelPinsNames[k]) d.pins = static_cast<PanelPins>(k);
@@ -1420,6 +1421,11 @@ class Builder {
       if (p.contains("points"))
         for (const json& c : p["points"]) d.curve.push_back(vec3(c));
       d.closed = p.contains("closed") && p["closed"].get<bool>();
+      if (p.contains("vertices"))
+        for (const json& c : p["vertices"]) d.curve.push_back(vec3(c));
+      if (p.contains("triangles"))
+        for (const json& t : p["triangles"])
+          d.triangles.push_back({t[0].get<int32_t>(), t[1].get<int32_t>(), t[2].get<int32_t>()});
       d.group = group(p, "group", at);
       const Id id = guard(at, [&] { return w.create_pin(d); });
       if (p.contains("name")) {
@@ -1687,6 +1693,13 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
       for (const Vec3& c : p.curve) points.push_back(vec_json(c));
       j["points"] = points;
       j["closed"] = p.closed;
+    } else if (p.support == PinSupport::mesh) {
+      j["support"] = kPinSupportNames[static_cast<int>(p.support)];
+      json vertices = json::array(), triangles = json::array();
+      for (const Vec3& c : p.curve) vertices.push_back(vec_json(c));
+      for (const auto& t : p.triangles) triangles.push_back({t[0], t[1], t[2]});
+      j["vertices"] = vertices;
+      j["triangles"] = triangles;
     } else if (p.support != PinSupport::point) {
       j["support"] = kPinSupportNames[static_cast<int>(p.support)];
       j["axis"] = vec_json(p.axis);

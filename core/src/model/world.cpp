@@ -1316,7 +1316,8 @@ Id World::create_pin(const PinDesc& desc) {
   check_non_negative(desc.compliance, "pin compliance");
   const int32_t support = static_cast<int32_t>(desc.support);
   if (support < 0 || support >= kPinSupportCount)
-    invalid("pin support " + std::to_string(support) + " is not point (0), plane (1), line (2) or polyline (3)");
+    invalid("pin support " + std::to_string(support) +
+            " is not point (0), plane (1), line (2), polyline (3), axes (4) or mesh (5)");
   for (int k = 0; k < 3; ++k) check_finite(desc.axis[k], "pin axis");
   const bool polyline = desc.support == PinSupport::polyline;
   if (polyline) {
@@ -1334,11 +1335,48 @@ Id World::create_pin(const PinDesc& desc) {
         invalid("polyline segment " + std::to_string(s) + " (points " + std::to_string(s) + " and " +
                 std::to_string((s + 1) % n) + ") has zero length (or one beyond range): it is degenerate");
     }
+  } else if (desc.support == PinSupport::mesh) {
+    const size_t n = desc.curve.size(), t = desc.triangles.size();
+    if (n < 3u || n > static_cast<size_t>(limits::kMaxParticles))
+      invalid("a mesh support needs 3 to 2097152 vertices; " + std::to_string(n) + " given");
+    if (t < 1u || t > static_cast<size_t>(limits::kMaxConstraints))
+      invalid("a mesh support needs 1 to 16777216 triangles; " + std::to_string(t) + " given");
+    for (const Vec3& c : desc.curve)
+      for (int k = 0; k < 3; ++k) check_finite(c[k], "mesh support vertex");
+    for (size_t f = 0; f < t; ++f) {
+      const auto& tri = desc.triangles[f];
+      for (int k = 0; k < 3; ++k)
+        if (tri[k] < 0 || static_cast<size_t>(tri[k]) >= n)
+          invalid("mesh support triangle " + std::to_string(f) + " vertex " + std::to_string(tri[k]) +
+                  " is outside [0, " + std::to_string(n) + ")");
+      // Zero area: its sides parallel to 1e-12 (a sliver whose closest points are rounding), or a
+      // squared area too small to divide by (as a polyline's segments) or beyond range.
+      const Vec3 a = desc.curve[static_cast<size_t>(tri[0])], b = desc.curve[static_cast<size_t>(tri[1])],
+                 c = desc.curve[static_cast<size_t>(tri[2])];
+      const double area2 = (b - a).cross(c - a).squaredNorm();
+      const double sides2 = (b - a).squaredNorm() * (c - a).squaredNorm();
+      if (!(area2 >= limits::kMinPositive) || !std::isfinite(area2) || !(area2 > 1e-24 * sides2))
+        invalid("mesh support triangle " + std::to_string(f) + " (vertices " + std::to_string(tri[0]) + ", " +
+                std::to_string(tri[1]) + ", " + std::to_string(tri[2]) +
+                ") has zero area (its sides parallel, or an area beyond range): it is degenerate");
+    }
   } else if (!desc.curve.empty()) {
     invalid("polyline points are given for a support that is not a polyline");
   }
+  if (desc.support != PinSupport::mesh && !desc.triangles.empty())
+    invalid("mesh triangles are given for a support that is not a mesh");
+  const bool axes = desc.support == PinSupport::axes;
+  if (axes) {
+    for (int k = 0; k < 3; ++k)
+      if (desc.axis[k] != 0.0 && desc.axis[k] != 1.0)
+        invalid("an axes support's axis[" + std::to_string(k) + "] is " + std::to_string(desc.axis[k]) +
+                ": each component is 1 (that coordinate held) or 0 (free)");
+    if (desc.axis == Vec3::Zero())
+      invalid("an axes support holds no coordinate (axis is {0, 0, 0}): hold at least one");
+  }
   const double axis_length = desc.axis.norm();
-  if (desc.support != PinSupport::point && !polyline &&
+  const bool on_mesh = desc.support == PinSupport::mesh;
+  if (desc.support != PinSupport::point && !polyline && !axes && !on_mesh &&
       !(axis_length > 0.0 && std::isfinite(axis_length) && (desc.axis / axis_length).allFinite()))
     invalid(std::string("pin axis is zero (or too short to normalise): a ") +
             (desc.support == PinSupport::plane ? "plane" : "line") + " support needs a direction (its " +
@@ -1357,9 +1395,11 @@ Id World::create_pin(const PinDesc& desc) {
   p.compliance = desc.compliance;
   p.group = gid;
   p.support = desc.support;
-  if (desc.support != PinSupport::point && !polyline) p.axis = desc.axis / axis_length;
+  if (desc.support != PinSupport::point && !polyline && !on_mesh)
+    p.axis = axes ? Vec3(desc.axis.cwiseAbs()) : Vec3(desc.axis / axis_length);  // -0 as 0
   p.curve = desc.curve;
   p.closed = polyline && desc.closed;
+  p.triangles = desc.triangles;
   const Id id = slots::create(pins_, p);
   const int32_t slot = static_cast<int32_t>(id.index);
   if (kinematic) {

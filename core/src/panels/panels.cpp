@@ -38,6 +38,13 @@ std::vector<std::vector<std::pair<int32_t, int32_t>>> corners_around(std::span<c
   return around;
 }
 
+/// v with 3 significant digits (for messages).
+std::string g3(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 /// Undirected edge key.
 std::pair<int32_t, int32_t> edge_key(int32_t a, int32_t b) {
   return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
@@ -433,10 +440,14 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     for (int k = 0; k < 4; ++k)
       if (!((P(v[(k + 1) % 4]) - P(v[k])).norm() > 1e-9 * mean_edge))
         invalid(name + " is degenerate: an edge has zero length");
-    const double apart = quad_diagonal_distance(q0, q1, q2, q3);
-    if (apart > 1e-6)
-      invalid(name + " is not planar (diagonals " + std::to_string(apart * mean_edge) +
-              " apart): a panel starts planar");
+    // Planar within the tolerances in force: the paper's planarity and the corner distance at most
+    // their targets (a real PQ mesh is planar to its optimiser's tolerance, not to rounding).
+    const double planarity = quad_planarity(q0, q1, q2, q3);
+    const double corner = quad_corner_distance(q0, q1, q2, q3);
+    if (!(planarity <= d.tolerances.planarity.target) || !(corner <= d.tolerances.planarity_distance.target))
+      invalid(name + " is not planar within the tolerances: planarity " + g3(planarity) + " (target " +
+              g3(d.tolerances.planarity.target) + "), corner distance " + g3(corner) + " (target " +
+              g3(d.tolerances.planarity_distance.target) + ")");
   }
 
   // --- bottom layer: each vertex offset to where its faces' offset planes meet ---

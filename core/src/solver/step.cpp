@@ -223,13 +223,25 @@ void World::project_group(Group& g, double h, bool first) {
     const double alpha = p.compliance * inv_h2;
     if (w + alpha <= 0.0) continue;
     // The held part only (all of it for a point): a support's multiplier stays along its normal
-    // (plane) or across its line, so the particle slides freely the other ways.
+    // (plane), across its line, or in its held coordinates (axes), so the particle slides freely the
+    // other ways.
     if (p.support == PinSupport::polyline) {
       // Held on the closest point of the curve: inside a segment, the multiplier keeps only its part
       // across the segment (it slides along it freely); at a vertex, all of it.
       const Vec3 d = x_[p.particle] - p.target;
       const CurvePoint c = closest_point_on_polyline(p.curve, p.closed, d);
       const Vec3 lambda = c.inside_segment ? Vec3(p.lambda - c.tangent.dot(p.lambda) * c.tangent) : p.lambda;
+      const Vec3 dl = (-(d - c.point) - alpha * lambda) / (w + alpha);
+      p.lambda = lambda + dl;
+      x_[p.particle] += w * dl;
+      continue;
+    }
+    if (p.support == PinSupport::mesh) {
+      // Held on the closest point of the mesh: inside a triangle, the multiplier keeps only its part
+      // along the triangle's normal (it slides in the face freely); on an edge or at a vertex, all.
+      const Vec3 d = x_[p.particle] - p.target;
+      const SurfacePoint c = closest_point_on_mesh(p.curve, p.triangles, d);
+      const Vec3 lambda = c.inside_face ? Vec3(c.normal.dot(p.lambda) * c.normal) : p.lambda;
       const Vec3 dl = (-(d - c.point) - alpha * lambda) / (w + alpha);
       p.lambda = lambda + dl;
       x_[p.particle] += w * dl;

@@ -23,6 +23,7 @@ const CONSTRAINT_BATCH_DEF_VERSION = 1;
 const PIN_DEF_VERSION = 1;
 const SUPPORT_DEF_VERSION = 1;
 const POLYLINE_SUPPORT_DEF_VERSION = 1;
+const MESH_SUPPORT_DEF_VERSION = 1;
 const COLLIDER_DEF_VERSION = 2;
 const SOLVE_RESIDUAL_TARGET_M = 1e-4;
 const SOLVE_RESIDUAL_TARGET_RAD = 1e-3;
@@ -80,6 +81,8 @@ const PIN_SUPPORT_POINT = 0;
 const PIN_SUPPORT_PLANE = 1;
 const PIN_SUPPORT_LINE = 2;
 const PIN_SUPPORT_POLYLINE = 3;
+const PIN_SUPPORT_AXES = 4;
+const PIN_SUPPORT_MESH = 5;
 
 // --- embra_collider_shape ---
 const COLLIDER_PLANE = 0;
@@ -127,7 +130,7 @@ const CUTS_CSV = 1;
 // Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 const GENERATE_NAMES = Object.freeze({ stretch: 1, shear: 2, bend: 4, volume: 8 });
 const CONSTRAINT_NAMES = Object.freeze({ distance: 0, edge_angle: 1, dihedral: 2, tet_volume: 3, weld: 4, tether: 5, planarity: 6, plane_offset: 7, equal_length: 8, conical: 9, length_min: 10, angle_min: 11, angle_max: 12, colinear: 13, direction: 14, cocircular: 15, cospherical: 16 });
-const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3 });
+const PIN_SUPPORT_NAMES = Object.freeze({ point: 0, plane: 1, line: 2, polyline: 3, axes: 4, mesh: 5 });
 const COLLIDER_NAMES = Object.freeze({ plane: 0, sphere: 1, box: 2, capsule: 3, convex: 4, mesh: 5 });
 const RESIDUAL_NAMES = Object.freeze({ pins: -1, contacts: -2 });
 const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
@@ -264,6 +267,17 @@ const PolylineSupportDef = koffi.struct('embra_polyline_support_def', {
   point_count: 'int32_t',
   closed: 'int32_t',
   points: 'const double *',
+  compliance: 'double',
+  group: GroupIdType,
+});
+const MeshSupportDef = koffi.struct('embra_mesh_support_def', {
+  version: 'int32_t',
+  particle: 'int32_t',
+  target: koffi.array('double', 3, 'Array'),
+  vertex_count: 'int32_t',
+  triangle_count: 'int32_t',
+  vertices: 'const double *',
+  triangles: 'const int32_t *',
   compliance: 'double',
   group: GroupIdType,
 });
@@ -481,6 +495,7 @@ const STRUCTS = {
   embra_pin_def: PinDef,
   embra_support_def: SupportDef,
   embra_polyline_support_def: PolylineSupportDef,
+  embra_mesh_support_def: MeshSupportDef,
   embra_collider_def: ColliderDef,
   embra_step_report: StepReport,
   embra_kind_residual: KindResidual,
@@ -563,6 +578,9 @@ const PROTOTYPES = {
   embra_support_create: 'embra_status embra_support_create(embra_world *world, const embra_support_def *def, _Out_ embra_pin_id *out_pin)',
   embra_default_polyline_support_def: 'embra_polyline_support_def embra_default_polyline_support_def(void)',
   embra_polyline_support_create: 'embra_status embra_polyline_support_create(embra_world *world, const embra_polyline_support_def *def, _Out_ embra_pin_id *out_pin)',
+  embra_polyline_support_get_points: 'embra_status embra_polyline_support_get_points(const embra_world *world, embra_pin_id pin, double *out_points, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_default_mesh_support_def: 'embra_mesh_support_def embra_default_mesh_support_def(void)',
+  embra_mesh_support_create: 'embra_status embra_mesh_support_create(embra_world *world, const embra_mesh_support_def *def, _Out_ embra_pin_id *out_pin)',
   embra_pin_destroy: 'embra_status embra_pin_destroy(embra_world *world, embra_pin_id pin)',
   embra_pin_set_target: 'embra_status embra_pin_set_target(embra_world *world, embra_pin_id pin, const double *target)',
   embra_pin_get_target: 'embra_status embra_pin_get_target(const embra_world *world, embra_pin_id pin, double *out_target)',
@@ -642,27 +660,27 @@ module.exports = {
   ABI_VERSION, MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS,
   MAX_PASSES_PER_STEP, MAX_OBJ_BYTES, MAX_THREADS, SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION,
   CONSTRAINT_DEF_VERSION, CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, SUPPORT_DEF_VERSION,
-  POLYLINE_SUPPORT_DEF_VERSION, COLLIDER_DEF_VERSION, SOLVE_RESIDUAL_TARGET_M, SOLVE_RESIDUAL_TARGET_RAD,
-  SOLVE_RESIDUAL_TARGET_M3, SOLVE_WORST_RESIDUAL, SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION,
-  TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION, WIND_DEF_VERSION, PRESSURE_DEF_VERSION,
-  SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT, ERROR_STALE_ID,
-  ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL, ERROR_INTERNAL,
-  ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME, CONSTRAINT_DISTANCE,
-  CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD, CONSTRAINT_TETHER,
-  CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH, CONSTRAINT_CONICAL,
-  CONSTRAINT_LENGTH_MIN, CONSTRAINT_ANGLE_MIN, CONSTRAINT_ANGLE_MAX, CONSTRAINT_COLINEAR,
+  POLYLINE_SUPPORT_DEF_VERSION, MESH_SUPPORT_DEF_VERSION, COLLIDER_DEF_VERSION, SOLVE_RESIDUAL_TARGET_M,
+  SOLVE_RESIDUAL_TARGET_RAD, SOLVE_RESIDUAL_TARGET_M3, SOLVE_WORST_RESIDUAL, SOLVE_DEF_VERSION,
+  PANEL_MESH_DEF_VERSION, TOLERANCES_VERSION, PANEL_METRICS_VERSION, LOAD_OPTIONS_VERSION, WIND_DEF_VERSION,
+  PRESSURE_DEF_VERSION, SURFACE_TENSION_DEF_VERSION, VORTEX_DEF_VERSION, OK, ERROR_INVALID_ARGUMENT,
+  ERROR_STALE_ID, ERROR_BUFFER_TOO_SMALL, ERROR_SCHEMA, ERROR_VERSION, ERROR_LOCKED, ERROR_NUMERICAL,
+  ERROR_INTERNAL, ERROR_CANCELLED, GENERATE_STRETCH, GENERATE_SHEAR, GENERATE_BEND, GENERATE_VOLUME,
+  CONSTRAINT_DISTANCE, CONSTRAINT_EDGE_ANGLE, CONSTRAINT_DIHEDRAL, CONSTRAINT_TET_VOLUME, CONSTRAINT_WELD,
+  CONSTRAINT_TETHER, CONSTRAINT_PLANARITY, CONSTRAINT_PLANE_OFFSET, CONSTRAINT_EQUAL_LENGTH,
+  CONSTRAINT_CONICAL, CONSTRAINT_LENGTH_MIN, CONSTRAINT_ANGLE_MIN, CONSTRAINT_ANGLE_MAX, CONSTRAINT_COLINEAR,
   CONSTRAINT_DIRECTION, CONSTRAINT_COCIRCULAR, CONSTRAINT_COSPHERICAL, PIN_SUPPORT_POINT, PIN_SUPPORT_PLANE,
-  PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, COLLIDER_PLANE, COLLIDER_SPHERE, COLLIDER_BOX, COLLIDER_CAPSULE,
-  COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS, RESIDUAL_CONTACTS, SOLVE_UNTIL_SETTLED,
-  SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE, SOLVE_OSCILLATING,
-  SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA, PANEL_PINS_NONE,
-  PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS,
-  PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES,
-  CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES,
-  AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType,
-  ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef,
-  PinDef, SupportDef, PolylineSupportDef, ColliderDef, StepReport, KindResidual, ConstraintResidual,
-  GroupConflict, Reaction, GroupReport, SolveDef, SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef,
-  Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef,
-  SurfaceTensionDef, VortexDef,
+  PIN_SUPPORT_LINE, PIN_SUPPORT_POLYLINE, PIN_SUPPORT_AXES, PIN_SUPPORT_MESH, COLLIDER_PLANE, COLLIDER_SPHERE,
+  COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS, RESIDUAL_CONTACTS,
+  SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE,
+  SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA,
+  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
+  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
+  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
+  SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
+  GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
+  ConstraintDef, ConstraintBatchDef, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef, ColliderDef,
+  StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef, SolveResult,
+  Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions,
+  FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

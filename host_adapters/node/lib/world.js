@@ -819,7 +819,9 @@ class World {
   /**
    * A frictionless sliding support (embra_support_create): `particle` held on the plane through
    * `target` (m) normal to `axis` (support 'plane', the default) or on the line through it along
-   * `axis` ('line'). Options: support, axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
+   * `axis` ('line'); or a per-axis anchor ('axes', a roller): the world coordinates whose `axis`
+   * component is 1 held at the target's, those with 0 free ([0, 0, 1]: z held). Options: support,
+   * axis (default [0, 0, 1]), compliance (0 hard, else m/N), group.
    * Returns its PinId.
    */
   createSupport(particle, target, opts) {
@@ -863,6 +865,50 @@ class World {
     const pin = {};
     this.#call('embra_polyline_support_create', d, pin);
     return new PinId(pin.index, pin.generation);
+  }
+
+  /**
+   * A frictionless support on a triangle mesh (embra_mesh_support_create): `particle` held on the
+   * closest point of the mesh (`vertices`: xyz per vertex, m, offsets from the target, so
+   * setPinTarget moves the mesh; `triangles`: three 0-based indices each). Options: target
+   * (default [0, 0, 0]), compliance (0 hard, else m/N), group. Returns its PinId.
+   */
+  createMeshSupport(particle, vertices, triangles, opts) {
+    const o = options(opts, 'createMeshSupport options');
+    const d = lib.embra_default_mesh_support_def();
+    d.particle = buf.int32(particle, 'particle');
+    const xyz = buf.doublesIn(vertices, 'vertices');
+    if (xyz === null) throw new TypeError('vertices: required');
+    d.vertices = xyz;
+    d.vertex_count = xyzCount(xyz, 'vertices');
+    const tri = buf.intsIn(triangles, 'triangles');
+    if (tri === null) throw new TypeError('triangles: required');
+    if (tri.length % 3) throw new TypeError(`triangles: ${tri.length} indices is not a whole number of triangles`);
+    d.triangles = tri;
+    d.triangle_count = tri.length / 3;
+    if (o.has('target')) d.target = buf.fixed(take(o, 'target'), 3, 'target');
+    if (o.has('compliance')) d.compliance = buf.number(take(o, 'compliance'), 'compliance');
+    if (o.has('group')) d.group = toId(take(o, 'group'), GroupId, 'group');
+    if (o.size) throw new TypeError(`createMeshSupport: unknown option '${o.keys().next().value}'`);
+    const pin = {};
+    this.#call('embra_mesh_support_create', d, pin);
+    return new PinId(pin.index, pin.generation);
+  }
+
+  /**
+   * A polyline support's points as created (embra_polyline_support_get_points): an array of
+   * [x, y, z] offsets from its target (m); setPinTarget moves the target, not these, so the curve's
+   * world points are pinTarget(pin) plus each. Refused for a pin that is not one.
+   */
+  polylineSupportPoints(pin) {
+    const p = toId(pin, PinId, 'pin');
+    const n = [0];
+    this.#call('embra_polyline_support_get_points', p, null, 0, n);
+    const out = new Float64Array(3 * n[0]);
+    this.#call('embra_polyline_support_get_points', p, out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) result.push([out[3 * k], out[3 * k + 1], out[3 * k + 2]]);
+    return result;
   }
 
   destroyPin(pin) {

@@ -25,6 +25,7 @@ CONSTRAINT_BATCH_DEF_VERSION = 1
 PIN_DEF_VERSION = 1
 SUPPORT_DEF_VERSION = 1
 POLYLINE_SUPPORT_DEF_VERSION = 1
+MESH_SUPPORT_DEF_VERSION = 1
 COLLIDER_DEF_VERSION = 2
 SOLVE_RESIDUAL_TARGET_M = 1e-4
 SOLVE_RESIDUAL_TARGET_RAD = 1e-3
@@ -82,6 +83,8 @@ PIN_SUPPORT_POINT = 0
 PIN_SUPPORT_PLANE = 1
 PIN_SUPPORT_LINE = 2
 PIN_SUPPORT_POLYLINE = 3
+PIN_SUPPORT_AXES = 4
+PIN_SUPPORT_MESH = 5
 
 # --- embra_collider_shape ---
 COLLIDER_PLANE = 0
@@ -129,7 +132,7 @@ CUTS_CSV = 1
 # Each enum's names (the enumerator's suffix, lowercased; the scene schema's names too).
 GENERATE_NAMES = {"stretch": 1, "shear": 2, "bend": 4, "volume": 8}
 CONSTRAINT_NAMES = {"distance": 0, "edge_angle": 1, "dihedral": 2, "tet_volume": 3, "weld": 4, "tether": 5, "planarity": 6, "plane_offset": 7, "equal_length": 8, "conical": 9, "length_min": 10, "angle_min": 11, "angle_max": 12, "colinear": 13, "direction": 14, "cocircular": 15, "cospherical": 16}
-PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3}
+PIN_SUPPORT_NAMES = {"point": 0, "plane": 1, "line": 2, "polyline": 3, "axes": 4, "mesh": 5}
 COLLIDER_NAMES = {"plane": 0, "sphere": 1, "box": 2, "capsule": 3, "convex": 4, "mesh": 5}
 RESIDUAL_NAMES = {"pins": -1, "contacts": -2}
 SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
@@ -327,6 +330,21 @@ class PolylineSupportDef(_Struct):
         ("point_count", c_int32),
         ("closed", c_int32),
         ("points", POINTER(c_double)),
+        ("compliance", c_double),
+        ("group", GroupId),
+    ]
+
+
+class MeshSupportDef(_Struct):
+    """embra_mesh_support_def."""
+    _fields_ = [
+        ("version", c_int32),
+        ("particle", c_int32),
+        ("target", c_double * 3),
+        ("vertex_count", c_int32),
+        ("triangle_count", c_int32),
+        ("vertices", POINTER(c_double)),
+        ("triangles", POINTER(c_int32)),
         ("compliance", c_double),
         ("group", GroupId),
     ]
@@ -674,6 +692,9 @@ PROTOTYPES = {
     "embra_support_create": (c_int32, [c_void_p, POINTER(SupportDef), POINTER(PinId)]),
     "embra_default_polyline_support_def": (PolylineSupportDef, []),
     "embra_polyline_support_create": (c_int32, [c_void_p, POINTER(PolylineSupportDef), POINTER(PinId)]),
+    "embra_polyline_support_get_points": (c_int32, [c_void_p, PinId, POINTER(c_double), c_int32, POINTER(c_int32)]),
+    "embra_default_mesh_support_def": (MeshSupportDef, []),
+    "embra_mesh_support_create": (c_int32, [c_void_p, POINTER(MeshSupportDef), POINTER(PinId)]),
     "embra_pin_destroy": (c_int32, [c_void_p, PinId]),
     "embra_pin_set_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),
     "embra_pin_get_target": (c_int32, [c_void_p, PinId, POINTER(c_double)]),

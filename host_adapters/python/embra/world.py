@@ -674,8 +674,10 @@ class World:
 
     def create_support(self, particle, target, support="plane", axis=(0.0, 0.0, 1.0), compliance=0.0, group=None):
         """A frictionless sliding support (embra_support_create): `particle` held on the plane through
-        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line");
-        compliance 0 = hard, > 0 m/N; projected in `group`. Returns its PinId."""
+        `target` (m) normal to `axis` ("plane"), or on the line through it along `axis` ("line"); or a
+        per-axis anchor ("axes", a roller): the world coordinates whose `axis` component is 1 held at
+        the target's, those with 0 free ((0, 0, 1): z held); compliance 0 = hard, > 0 m/N; projected
+        in `group`. Returns its PinId."""
         d = lib.embra_default_support_def()
         d.particle = buf.int32(particle, "particle")
         d.support = _enum(support, PIN_SUPPORTS, "support")
@@ -707,6 +709,43 @@ class World:
         pin = PinId()
         self._call("embra_polyline_support_create", byref(d), byref(pin))
         return pin
+
+    def create_mesh_support(self, particle, vertices, triangles, target=(0.0, 0.0, 0.0), compliance=0.0,
+                            group=None):
+        """A frictionless support on a triangle mesh (embra_mesh_support_create): `particle` held on the
+        closest point of the mesh (`vertices` (n, 3), m, offsets from `target`, so set_pin_target
+        moves the mesh; `triangles` (t, 3), 0-based); compliance 0 = hard, > 0 m/N; projected in
+        `group`. Returns its PinId."""
+        d = lib.embra_default_mesh_support_def()
+        d.particle = buf.int32(particle, "particle")
+        d.target = buf.d3(target, "target")
+        d.compliance = float(compliance)
+        d.group = _id(group, GroupId, "group")
+        buf.check_rows(vertices, 3, "vertices")
+        buf.check_rows(triangles, 3, "triangles")
+        v, nv, keep_v = buf.doubles_in(vertices, "vertices")
+        t, nt, keep_t = buf.ints_in(triangles, "triangles")
+        if nv % 3:
+            raise ValueError(f"vertices: {nv} numbers is not a whole number of xyz triples")
+        if nt % 3:
+            raise ValueError(f"triangles: {nt} indices is not a whole number of triangles")
+        d.vertices, d.vertex_count = v, buf.int32(nv // 3, "vertex count")
+        d.triangles, d.triangle_count = t, buf.int32(nt // 3, "triangle count")
+        pin = PinId()
+        self._call("embra_mesh_support_create", byref(d), byref(pin))
+        del keep_v, keep_t
+        return pin
+
+    def polyline_support_points(self, pin):
+        """A polyline support's points as created (embra_polyline_support_get_points): a list of
+        (x, y, z) offsets from its target (m); set_pin_target moves the target, not these, so the
+        curve's world points are pin_target(pin) plus each. Refused for a pin that is not one."""
+        p = _id(pin, PinId, "pin")
+        n = c_int32()
+        self._call("embra_polyline_support_get_points", p, None, 0, byref(n))
+        out = (c_double * max(3 * n.value, 1))()
+        self._call("embra_polyline_support_get_points", p, out, n.value, byref(n))
+        return [tuple(out[3 * i:3 * i + 3]) for i in range(n.value)]
 
     def destroy_pin(self, pin):
         self._call("embra_pin_destroy", _id(pin, PinId, "pin"))

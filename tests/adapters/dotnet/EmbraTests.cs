@@ -812,6 +812,117 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>A particle on a mesh support (two triangles of a square inclined at 30 degrees) slides
+        /// down it on the discrete path of g sin(theta) and the reaction is m g cos(theta) along the normal;
+        /// a degenerate triangle is refused.</summary>
+        [Test]
+        public void MeshSupportHoldsAParticleSlidingDownAnInclinedFace()
+        {
+            double th = Math.PI / 6;
+            var n = new[] { -Math.Sin(th), 0.0, Math.Cos(th) };
+            var down = new[] { -Math.Cos(th), 0.0, -Math.Sin(th) };
+            var ab = new[] { 1, 1, -1, 1, -1, -1, 1, -1 };
+            var verts = new double[12];
+            for (int v = 0; v < 4; ++v)
+                for (int k = 0; k < 3; ++k) verts[3 * v + k] = 10 * (ab[2 * v] * down[k] + (k == 1 ? ab[2 * v + 1] : 0));
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0.3, 0 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateMeshSupport(0, verts, new[] { 0, 3, 2, 0, 2, 1 });
+                w.Step(30);
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                double along = p[0] * down[0] + p[2] * down[2];
+                double exact = 9.81 * Math.Sin(th) * h * h * steps * (steps + 1) / 2;
+                // rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+                Assert.AreEqual(exact, along, steps * steps * 2.2e-16 * 10);
+                Assert.AreEqual(0.0, p[0] * n[0] + p[2] * n[2], 1e-12);
+                Reaction r0 = w.Reactions()[0];
+                Assert.AreEqual(pin, r0.Pin);
+                unsafe
+                {
+                    for (int k = 0; k < 3; ++k) Assert.AreEqual(2 * 9.81 * Math.Cos(th) * n[k], r0.Force[k], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateMeshSupport(0, new double[] { 0, 0, 0, 1, 0, 0, 2, 0, 0 }, new[] { 0, 1, 2 }));
+            }
+        }
+
+        /// <summary>PolylineSupportPoints reads the points exactly as created; SetPinTarget moves the
+        /// target (and so the curve) and leaves them as they are.</summary>
+        [Test]
+        public void PolylineSupportPointsReadBackAndMoveWithTheTarget()
+        {
+            var pts = new double[] { 0, 0, 0, 1.0 / 3.0, 0.1, -0.2, 0.7, -0.4, 0.05 };
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 2;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0 }, masses: new[] { 1.0, 1.0 }, def: def);
+                var pin = w.CreatePolylineSupport(0, pts);
+                var plane = w.CreateSupport(1, new double[] { 0, 0, 0 }, PinSupport.Plane, null, 1.0);
+                CollectionAssert.AreEqual(pts, w.PolylineSupportPoints(pin));
+                w.SetPinTarget(pin, new double[] { 0.25, -1.5, 2.0 });
+                w.Step();
+                CollectionAssert.AreEqual(pts, w.PolylineSupportPoints(pin));
+                CollectionAssert.AreEqual(new double[] { 0.25, -1.5, 2.0 }, w.PinTarget(pin));
+                Assert.Throws<EmbraArgumentException>(() => w.PolylineSupportPoints(plane));
+            }
+        }
+
+        /// <summary>A roller (an axes support holding z) under gravity and a horizontal point load: z stays at
+        /// the target's, x and y follow (F / m) h^2 n (n + 1) / 2, and the reaction holds the weight in z
+        /// with x and y exactly 0; an axis that is not 0/1 flags is refused.</summary>
+        [Test]
+        public void AxesSupportHoldsZAndLetsXAndYAccelerate()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 10;
+            solver.Iterations = 1;
+            solver.Tethers = 0;
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(new double[] { 0.3, -0.4, 1.2 }, masses: new[] { 2.0 }, def: def);
+                var pin = w.CreateSupport(0, new double[] { 0.3, -0.4, 1.2 }, PinSupport.Axes, new double[] { 0, 0, 1 });
+                w.SetLoads(new double[] { 1.5, 0.5, 0.0 });
+                for (int f = 0; f < 30; ++f)
+                {
+                    w.Step();
+                    Assert.AreEqual(1.2, w.GetPositions()[2], 1e-12);
+                }
+                int steps = 300;
+                double h = 1.0 / 60.0 / 10;
+                var p = w.GetPositions();
+                Assert.AreEqual(0.75 * h * h * steps * (steps + 1) / 2, p[0] - 0.3, 1e-12);
+                Assert.AreEqual(0.25 * h * h * steps * (steps + 1) / 2, p[1] + 0.4, 1e-12);
+                Reaction r0 = w.Reactions()[0];
+                Assert.AreEqual(pin, r0.Pin);
+                unsafe
+                {
+                    Assert.AreEqual(0.0, r0.Force[0]);
+                    Assert.AreEqual(0.0, r0.Force[1]);
+                    Assert.AreEqual(2 * 9.81, r0.Force[2], 1e-9 * 9.81);
+                }
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Axes, new double[] { 0, 0.5, 1 }));
+                Assert.Throws<EmbraArgumentException>(
+                    () => w.CreateSupport(0, new double[] { 0, 0, 0 }, PinSupport.Axes, new double[] { 0, 0, 0 }));
+            }
+        }
+
         /// <summary>A particle on a frictionless plane inclined at 30 degrees slides down it at g sin(theta)
         /// (the exact discrete path) and the support pushes with m g cos(theta) along its normal.</summary>
         [Test]

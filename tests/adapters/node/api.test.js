@@ -231,6 +231,58 @@ test('a polyline support holds a bead on a circle while it swings', () => {
   w.close();
 });
 
+test('polylineSupportPoints reads the points as created; setPinTarget moves the curve', () => {
+  const pts = [[0, 0, 0], [1 / 3, 0.1, -0.2], [0.7, -0.4, 0.05]];
+  const w = new embra.World({ gravity: [0, 0, 0], substeps: 4, iterations: 2, tethers: 0 });
+  w.createBody([[0, 0, 0], [1, 0, 0]], { generate: 0, masses: [1, 1] });
+  const pin = w.createPolylineSupport(0, pts);
+  const plane = w.createSupport(1, [0, 0, 0], { compliance: 1 });
+  assert.deepStrictEqual(w.polylineSupportPoints(pin), pts);
+  const shift = [0.25, -1.5, 2];
+  w.setPinTarget(pin, shift);
+  w.step(2);
+  assert.deepStrictEqual(w.polylineSupportPoints(pin), pts);
+  const q = Array.from(w.positions()).slice(0, 3);
+  // On the moved curve: the distance to its nearest segment.
+  let best = Infinity;
+  for (let s = 0; s + 1 < pts.length; s++) {
+    const a = pts[s].map((c, k) => c + shift[k]);
+    const b = pts[s + 1].map((c, k) => c + shift[k]);
+    const e = [0, 1, 2].map((k) => b[k] - a[k]);
+    const t = Math.min(1, Math.max(0, [0, 1, 2].reduce((acc, k) => acc + (q[k] - a[k]) * e[k], 0) /
+      e.reduce((acc, c) => acc + c * c, 0)));
+    best = Math.min(best, Math.hypot(...[0, 1, 2].map((k) => q[k] - a[k] - t * e[k])));
+  }
+  assert.ok(best < 1e-9);
+  assert.throws(() => w.polylineSupportPoints(plane), embra.EmbraError);
+  w.close();
+});
+
+test('a mesh support: a particle slides down an inclined face at g sin(theta)', () => {
+  const th = Math.PI / 6;
+  const n = [-Math.sin(th), 0, Math.cos(th)];
+  const down = [-Math.cos(th), 0, -Math.sin(th)];
+  const verts = [[1, 1], [-1, 1], [-1, -1], [1, -1]].map(([a, b]) => [0, 1, 2].map((k) => 10 * (a * down[k] + b * [0, 1, 0][k])));
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0, 0.3, 0]], { generate: 0, masses: [2] });
+  const pin = w.createMeshSupport(0, verts, [[0, 3, 2], [0, 2, 1]]);
+  w.step(30);
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  const along = p[0] * down[0] + p[2] * down[2];
+  const exact = 9.81 * Math.sin(th) * h * h * steps * (steps + 1) / 2;
+  // rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+  assert.ok(Math.abs(along - exact) < steps * steps * 2.2e-16 * 10);
+  assert.ok(Math.abs(p[0] * n[0] + p[2] * n[2]) < 1e-12);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  for (let k = 0; k < 3; k++) assert.ok(Math.abs(r[0].force[k] - 2 * 9.81 * Math.cos(th) * n[k]) < 1e-9 * 9.81);
+  assert.throws(() => w.createMeshSupport(0, [[0, 0, 0], [1, 0, 0], [2, 0, 0]], [[0, 1, 2]]), embra.EmbraError);
+  assert.throws(() => w.createMeshSupport(0, verts, [[0, 1, 4]]), embra.EmbraError);
+  w.close();
+});
+
 test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along its normal', () => {
   const th = Math.PI / 6;
   const n = [-Math.sin(th), 0, Math.cos(th)];
@@ -249,6 +301,30 @@ test('a plane support: slides at g sin(theta), pushes with m g cos(theta) along 
   for (let k = 0; k < 3; k++) assert.ok(Math.abs(r[0].force[k] - 2 * 9.81 * Math.cos(th) * n[k]) < 1e-9 * 9.81);
   assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'line', axis: [0, 0, 0] }), embra.EmbraError);
   assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'curve' }));
+  w.close();
+});
+
+test('an axes support (roller) holds z and lets x and y accelerate at F / m', () => {
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 10, iterations: 1, tethers: 0 });
+  w.createBody([[0.3, -0.4, 1.2]], { generate: 0, masses: [2] });
+  const pin = w.createSupport(0, [0.3, -0.4, 1.2], { support: 'axes', axis: [0, 0, 1] });
+  w.setLoads([[1.5, 0.5, 0]]);
+  for (let f = 0; f < 30; f++) {
+    w.step();
+    assert.ok(Math.abs(w.positions()[2] - 1.2) < 1e-12);
+  }
+  const steps = 300;
+  const h = 1 / 60 / 10;
+  const p = w.positions();
+  assert.ok(Math.abs(p[0] - 0.3 - 0.75 * h * h * steps * (steps + 1) / 2) < 1e-12);
+  assert.ok(Math.abs(p[1] + 0.4 - 0.25 * h * h * steps * (steps + 1) / 2) < 1e-12);
+  const r = w.reactions();
+  assert.ok(r[0].pin.equals(pin));
+  assert.strictEqual(r[0].force[0], 0);
+  assert.strictEqual(r[0].force[1], 0);
+  assert.ok(Math.abs(r[0].force[2] - 2 * 9.81) < 1e-9 * 9.81);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'axes', axis: [0, 0.5, 1] }), embra.EmbraError);
+  assert.throws(() => w.createSupport(0, [0, 0, 0], { support: 'axes', axis: [0, 0, 0] }), embra.EmbraError);
   w.close();
 });
 

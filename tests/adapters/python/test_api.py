@@ -233,6 +233,57 @@ def test_polyline_support_holds_a_bead_on_a_circle():
         assert w.counts().pins == 1
 
 
+def test_polyline_support_points_read_back_and_move_with_the_target():
+    """polyline_support_points returns the points exactly as created; set_pin_target moves the
+    target (and so the curve) and leaves them as they are: the particle follows the moved curve."""
+    pts = [(0.0, 0.0, 0.0), (1.0 / 3.0, 0.1, -0.2), (0.7, -0.4, 0.05)]
+    with embra.World(gravity=(0.0, 0.0, 0.0), substeps=4, iterations=2, tethers=0) as w:
+        w.create_body([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0)], generate=0, masses=[1.0, 1.0])
+        pin = w.create_polyline_support(0, pts, target=(0.0, 0.0, 0.0))
+        plane = w.create_support(1, (0.0, 0.0, 0.0), "plane", compliance=1.0)
+        assert w.polyline_support_points(pin) == pts
+        shift = (0.25, -1.5, 2.0)
+        w.set_pin_target(pin, shift)
+        w.step(2)
+        assert w.polyline_support_points(pin) == pts
+        q = list(flat(w.positions()))[:3]
+        curve = [[shift[k] + p[k] for k in range(3)] for p in pts]
+        assert _distance_to_polyline(curve, False, q) < 1e-9
+        with pytest.raises(embra.EmbraError):
+            w.polyline_support_points(plane)
+
+
+def test_mesh_support_holds_a_particle_sliding_down_an_inclined_face():
+    """A particle on a mesh support (two triangles of a square inclined at 30 degrees) slides down it
+    on the discrete path of g sin(theta), stays in the face, and the reaction is m g cos(theta)
+    along its normal; a degenerate triangle is refused."""
+    th = math.pi / 6
+    n = (-math.sin(th), 0.0, math.cos(th))
+    down = (-math.cos(th), 0.0, -math.sin(th))
+    corners = [(1, 1), (-1, 1), (-1, -1), (1, -1)]
+    verts = [tuple(10 * (a * down[k] + b * (0.0, 1.0, 0.0)[k]) for k in range(3)) for a, b in corners]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.0, 0.3, 0.0)], generate=0, masses=[2.0])
+        pin = w.create_mesh_support(0, verts, [(0, 3, 2), (0, 2, 1)])
+        w.step(30)
+        steps, h = 300, (1.0 / 60.0) / 10
+        p = list(flat(w.positions()))
+        along = sum(p[k] * down[k] for k in range(3))
+        exact = 9.81 * math.sin(th) * h * h * steps * (steps + 1) / 2
+        # rounding of the closest point (vertices of size 10) carried on by the velocity: steps^2 eps 10
+        assert abs(along - exact) < steps * steps * 2.2e-16 * 10
+        assert abs(sum(p[k] * n[k] for k in range(3))) < 1e-12
+        r = w.reactions()
+        assert r[0]["pin"] == pin
+        for k in range(3):
+            assert abs(r[0]["force"][k] - 2.0 * 9.81 * math.cos(th) * n[k]) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_mesh_support(0, [(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 1, 2)])
+        with pytest.raises(embra.EmbraError):
+            w.create_mesh_support(0, verts, [(0, 1, 4)])
+        assert w.counts().pins == 1
+
+
 def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
     """A particle on a frictionless plane inclined at 30 degrees: s_n = g sin(theta) h^2 n (n + 1) / 2
     down the slope after n substeps (symplectic Euler, the plane projected exactly), and the
@@ -256,6 +307,33 @@ def test_plane_support_slides_at_g_sin_theta_and_pushes_along_its_normal():
             w.create_support(0, (0.0, 0.0, 0.0), "line", axis=(0.0, 0.0, 0.0))
         with pytest.raises(ValueError):
             w.create_support(0, (0.0, 0.0, 0.0), "curve")
+
+
+def test_axes_support_holds_z_and_lets_x_and_y_accelerate_at_f_over_m():
+    """A roller (per-axis anchor holding z) under gravity and a horizontal point load: z stays at the
+    target's, x and y follow s_n = (F / m) h^2 n (n + 1) / 2 (symplectic Euler), and the reaction
+    holds the weight in z with x and y exactly 0; an axis that is not 0/1 flags is refused."""
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=10, iterations=1, tethers=0) as w:
+        w.create_body([(0.3, -0.4, 1.2)], generate=0, masses=[2.0])
+        pin = w.create_support(0, (0.3, -0.4, 1.2), "axes", axis=(0, 0, 1))
+        w.set_loads([(1.5, 0.5, 0.0)])
+        steps, h = 300, (1.0 / 60.0) / 10
+        for _ in range(30):
+            w.step()
+            assert abs(list(flat(w.positions()))[2] - 1.2) < 1e-12
+        p = list(flat(w.positions()))
+        for k, a in ((0, 0.75), (1, 0.25)):
+            exact = a * h * h * steps * (steps + 1) / 2
+            assert abs(p[k] - (0.3, -0.4)[k] - exact) < 1e-12
+        r = w.reactions()[0]
+        assert r["pin"] == pin
+        assert r["force"][0] == 0.0 and r["force"][1] == 0.0
+        assert abs(r["force"][2] - 2.0 * 9.81) < 1e-9 * 9.81
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "axes", axis=(0.0, 0.5, 1.0))
+        with pytest.raises(embra.EmbraError):
+            w.create_support(0, (0.0, 0.0, 0.0), "axes", axis=(0.0, 0.0, 0.0))
+        assert w.counts().pins == 1
 
 
 def test_groups_bulk_constraints_and_reports():
@@ -464,7 +542,8 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
                "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
                "embra_support_def": _capi.SupportDef, "embra_area_load": _capi.AreaLoad,
-               "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef}
+               "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef,
+               "embra_mesh_support_def": _capi.MeshSupportDef}
     with open(os.path.join(source_dir, "capi", "include", "embra", "embra.h")) as f:
         declared = set(re.findall(r"typedef struct (embra_\w+) \{", f.read()))
     assert declared - {"embra_group_id", "embra_body_id", "embra_pin_id", "embra_collider_id",

@@ -28,6 +28,23 @@ namespace embra {
 
 enum class PanelPins : int32_t { none = 0, top_corners = 1, top_and_bottom_corners = 2 };
 
+/// A metric's tolerance: its target and the end of its colour scale.
+struct Tolerance {
+  double target = 0.0;  // within it: fine (drawn grey)
+  double max = 0.0;     // the colour scale's end
+};
+
+/// The tolerance settings document (schemas/tolerances.schema.json). Defaults: the paper's thickness
+/// (0.00005, max 0.001) and miter (0.001) tolerances, planarity 1e-6 (the bar), corner
+/// distance as thickness; unit_scale converts model units to millimetres per metre of panel.
+struct Tolerances {
+  double unit_scale = 1000.0;
+  Tolerance planarity{1e-6, 1e-4};
+  Tolerance planarity_distance{5e-5, 1e-3};
+  Tolerance thickness{5e-5, 1e-3};
+  Tolerance miter{1e-3, 1e-2};
+};
+
 struct PanelMeshDesc {
   std::span<const double> positions;  // top mesh vertices, 3 each (model units)
   std::span<const int32_t> quads;     // 4 vertex indices per panel, counter-clockwise seen from the
@@ -40,12 +57,17 @@ struct PanelMeshDesc {
   double slide_compliance = 1e-3;    // m/N of the soft distance from each bottom corner to its top corner
   PanelPins pins = PanelPins::none;  // hard pins at the mesh's corners (vertices on one panel only)
   Id group;                          // group of every constraint; null = the default group
+  // The tolerances in force (the world's tolerance document; through the C ABI the one set with
+  // embra_world_set_tolerances, in a scene its "tolerances"): a top quad is accepted when its
+  // planarity (quad_planarity) and corner distance (quad_corner_distance) are within their targets.
+  Tolerances tolerances{};
 };
 
 /// Builds a panel mesh: one body (8 particles per panel, top and bottom triangles for drawing and
 /// face contact), its constraints, its pins and its layout. Every argument is checked first (a
 /// quad with a repeated or out-of-range vertex, a degenerate quad, a non-manifold edge, a
-/// non-positive thickness are refused) and nothing changes on a refusal. Returns the body.
+/// non-positive thickness, a quad whose planarity or corner distance is beyond the target of
+/// desc.tolerances are refused) and nothing changes on a refusal. Returns the body.
 Id build_panel_mesh(World& world, const PanelMeshDesc& desc);
 
 /// The vertices (3 each) and quads (4 each) of an n x m grid of square panels of side `size` in the
@@ -102,22 +124,6 @@ struct PanelErrors {
                                    // between two of its corner copies in one layer (the welds' error)
 };
 PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x);
-
-struct Tolerance {
-  double target = 0.0;  // within it: fine (drawn grey)
-  double max = 0.0;     // the colour scale's end
-};
-
-/// The tolerance settings document (schemas/tolerances.schema.json). Defaults: the paper's thickness
-/// (0.00005, max 0.001) and miter (0.001) tolerances, planarity 1e-6 (the bar), corner
-/// distance as thickness; unit_scale converts model units to millimetres per metre of panel.
-struct Tolerances {
-  double unit_scale = 1000.0;
-  Tolerance planarity{1e-6, 1e-4};
-  Tolerance planarity_distance{5e-5, 1e-3};
-  Tolerance thickness{5e-5, 1e-3};
-  Tolerance miter{1e-3, 1e-2};
-};
 
 /// Max, RMS and counts of one metric against its tolerance.
 struct MetricSummary {

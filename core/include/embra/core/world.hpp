@@ -116,12 +116,15 @@ struct ConstraintInfo {
 
 /// What a pin holds (the numbering is part of the C ABI: embra_pin_support). A plane or line
 /// support lets its particle slide, frictionless, on the plane through the target normal to `axis`
-/// or on the line through it along `axis`; a per-axis anchor (a roller) is a plane (one coordinate
-/// held: its axis the normal) or a line (two held: the third the line).
-/// A polyline support holds its particle on the closest point of a polyline (open, or closed back to
-/// its first point) whose points are offsets from the target: moving the target moves the curve.
-enum class PinSupport : int32_t { point = 0, plane = 1, line = 2, polyline = 3 };
-constexpr int kPinSupportCount = 4;
+/// or on the line through it along `axis`. A polyline support holds its particle on the closest
+/// point of a polyline (open, or closed back to its first point) whose points are offsets from the
+/// target: moving the target moves the curve. A per-axis anchor (`axes`, Kangaroo's AnchorXYZ, a
+/// roller) holds the world coordinates whose `axis` component is 1 at the target's and leaves those
+/// whose component is 0 free: {0, 0, 1} holds z and lets x and y slide. A mesh support (Kangaroo's
+/// OnMesh) holds its particle on the closest point of a triangle mesh whose vertices are offsets
+/// from the target: moving the target moves the mesh, as a host moves a collider.
+enum class PinSupport : int32_t { point = 0, plane = 1, line = 2, polyline = 3, axes = 4, mesh = 5 };
+constexpr int kPinSupportCount = 6;
 
 struct PinDesc {
   int32_t particle = 0;
@@ -129,11 +132,15 @@ struct PinDesc {
   double compliance = 0.0;  // 0 = hard (the particle follows the target exactly), else m/N
   Id group;                 // group of a soft pin or a support; null = the default group
   PinSupport support = PinSupport::point;
-  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // plane: its normal; line: its direction (any length > 0)
+  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // plane: its normal; line: its direction (any length > 0);
+                                    // axes: 1 per held world coordinate, 0 per free one (not all 0)
   // polyline: its points (m, offsets from the target), at least 2 (closed: 3), no two consecutive
   // ones equal (nor the last and the first, closed), at most limits::kMaxParticles
   std::vector<Vec3> curve{};
   bool closed = false;
+  // mesh: its vertices in `curve` (m, offsets from the target; 3 to limits::kMaxParticles) and its
+  // triangles here (1 to limits::kMaxConstraints; indices into `curve`, each of nonzero area)
+  std::vector<std::array<int32_t, 3>> triangles{};
 };
 
 /// The numbering is part of the C ABI (embra_collider_shape).
@@ -417,9 +424,10 @@ struct Pin {
   double compliance = 0.0;
   Id group;
   PinSupport support = PinSupport::point;
-  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // unit
-  std::vector<Vec3> curve;          // polyline: its points, offsets from the target
+  Vec3 axis = Vec3(0.0, 0.0, 1.0);  // unit (plane, line); axes: 1 held, 0 free, per coordinate
+  std::vector<Vec3> curve;          // polyline: its points; mesh: its vertices (offsets from the target)
   bool closed = false;
+  std::vector<std::array<int32_t, 3>> triangles;  // mesh: its triangles
   Vec3 lambda = Vec3::Zero();
   uint32_t generation = 0;
   bool alive = false;
@@ -428,15 +436,20 @@ struct Pin {
   bool kinematic() const { return compliance == 0.0 && support == PinSupport::point; }
   /// The part of d (the particle's offset from the target) the pin holds: all of it for a point,
   /// its part along the normal for a plane, its part across the line for a line.
-  /// For a polyline: d less the closest point of the curve (the offset from it).
+  /// For a polyline (a mesh): d less the closest point of the curve (the mesh), the offset from it. For axes: its held
+  /// coordinates (the free ones 0, exactly).
   Vec3 held(const Vec3& d) const {
     switch (support) {
+      case PinSupport::axes:
+        return Vec3(axis.x() != 0.0 ? d.x() : 0.0, axis.y() != 0.0 ? d.y() : 0.0, axis.z() != 0.0 ? d.z() : 0.0);
       case PinSupport::plane:
         return axis.dot(d) * axis;
       case PinSupport::line:
         return d - axis.dot(d) * axis;
       case PinSupport::polyline:
         return d - closest_point_on_polyline(curve, closed, d).point;
+      case PinSupport::mesh:
+        return d - closest_point_on_mesh(curve, triangles, d).point;
       case PinSupport::point:
         break;
     }
