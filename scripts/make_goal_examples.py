@@ -54,13 +54,16 @@ def cable_net_roof():
             x, y = i * a, j * a
             verts.append([r(x), r(y), r(height(x, y))])
     side = lambda i, j: {s for s, on in (("x0", i == 0), ("x1", i == n - 1), ("y0", j == 0), ("y1", j == n - 1)) if on}  # noqa: E731
-    edges, rests = [], []
+    edges, rests, beams = [], [], []  # beams: the edge beams, drawn (mesh edges), not constraints
     for j in range(n):
         for i in range(n):
             for (di, dj) in ((1, 0), (0, 1)):
                 i2, j2 = i + di, j + dj
-                if i2 >= n or j2 >= n or side(i, j) & side(i2, j2):
-                    continue  # off the grid, or along an edge beam
+                if i2 >= n or j2 >= n:
+                    continue
+                if side(i, j) & side(i2, j2):  # along an edge beam
+                    beams.append([idx(i, j), idx(i2, j2)])
+                    continue
                 p, q = verts[idx(i, j)], verts[idx(i2, j2)]
                 edges.append([idx(i, j), idx(i2, j2)])
                 rests.append(r(0.99 * math.dist(p, q)))
@@ -95,7 +98,7 @@ def cable_net_roof():
         "solver": {"substeps": 10, "iterations": 40, "damping": 5.0, "realign_passes": 4, "tethers": 0},
         "bodies": [{
             "name": "net",
-            "mesh": {"vertices": verts, "edges": edges, "masses": [20.0] * len(verts)},
+            "mesh": {"vertices": verts, "edges": edges + beams, "masses": [20.0] * len(verts)},
             "generate": [],
         }],
         "constraints": [{"kind": "distance", "particles": edges, "rest": rests, "compliance": 1e-6}],
@@ -186,8 +189,9 @@ def conical_dome():
         "version": 1,
         "name": "conical_dome",
         "description": conical_dome.__doc__.replace("\n    ", " ").strip(),
-        "frames": 600,
-        "solver": {"substeps": 1, "iterations": 50, "gravity": [0, 0, 0], "damping": 1000.0, "tethers": 0},
+        "frames": 300,
+        "solver": {"substeps": 1, "iterations": 50, "gravity": [0, 0, 0], "damping": 30.0, "settle_speed": 1e-9,
+                   "tethers": 0},
         "bodies": [{
             "name": "dome",
             "mesh": {"vertices": verts, "edges": edges, "masses": [1.0] * len(verts)},
