@@ -277,6 +277,8 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     a.compliance.push_back(desc.compliance.empty() ? desc.uniform_compliance : desc.compliance[i]);
     a.rest_now.push_back(rest[i]);
     for (int c = 0; c < multipliers(desc.kind); ++c) a.lambda.push_back(0.0);
+    a.yield.push_back(0.0);
+    a.rupture.push_back(0.0);
   }
   rest_dirty_ = true;
   solver_dirty_ = true;
@@ -340,6 +342,8 @@ ConstraintArray take(ConstraintArray& a, Kind kind, size_t i) {
   move(a.compliance, one.compliance, 1);
   move(a.rest_now, one.rest_now, 1);
   move(a.lambda, one.lambda, per);
+  move(a.yield, one.yield, 1);
+  move(a.rupture, one.rupture, 1);
   return one;
 }
 
@@ -379,6 +383,8 @@ ConstraintInfo World::constraint(Id group_id, Kind kind, int64_t index) const {
   c.rest = a.rest[i];
   c.compliance = a.compliance[i];
   c.body = i < a.generated ? a.body[i] : -1;
+  c.yield = a.yield[i];
+  c.rupture = a.rupture[i];
   return c;
 }
 
@@ -414,7 +420,9 @@ int64_t World::move_constraint(Id group_id, Kind kind, int64_t index, Id to) {
                       {&dest.rest_v, &one.rest_v},
                       {&dest.compliance, &one.compliance},
                       {&dest.rest_now, &one.rest_now},
-                      {&dest.lambda, &one.lambda}})
+                      {&dest.lambda, &one.lambda},
+                      {&dest.yield, &one.yield},
+                      {&dest.rupture, &one.rupture}})
     d->insert(d->end(), s->begin(), s->end());
   dest.body.insert(dest.body.end(), one.body.begin(), one.body.end());
   rest_dirty_ = true;
@@ -673,6 +681,8 @@ Id World::create_body(const BodyDesc& d) {
     a.compliance.push_back(compliance);
     a.rest_now.push_back(rest);
     a.lambda.push_back(0.0);
+    a.yield.push_back(0.0);
+    a.rupture.push_back(0.0);
   };
   const Material& m = d.material;
   if (d.generate & generate_stretch)
@@ -734,6 +744,8 @@ Id World::create_body(const BodyDesc& d) {
       move_block(a.compliance, 1);
       move_block(a.rest_now, 1);
       move_block(a.lambda, 1);
+      move_block(a.yield, 1);
+      move_block(a.rupture, 1);
     }
     a.generated += added;
   }
