@@ -5,6 +5,7 @@ their few parameters, so each JSON's hundreds of rows come from one place:
   examples/cable_net_roof.json       a hypar cable net on four edge rails under snow
   examples/gridshell_chebyshev.json  an equal-length grid pushed up into a dome
   examples/conical_dome.json         a quad grid on a dome form-found conical
+  examples/plastic_hinge.json        a hinge loaded past its yield angle keeps its fold
 
 usage: scripts/make_goal_examples.py [EXAMPLES_DIR]   (default: the repository's examples/)"""
 import json
@@ -205,11 +206,53 @@ def conical_dome():
     }
 
 
+def plastic_hinge():
+    """A plastic hinge that keeps its fold: a square plate 0.5 m wide, hinged along the y axis to
+    a fixed plate, its free edge's mid point a particle of 1 kg 0.5 m from the hinge (held there by
+    two hard distances to the hinge's ends). The hinge is a dihedral of rest 0 (flat), compliance
+    0.2 rad/(N m), yielding past 0.4905 rad. Gravity grows from 0 to 9.81 m/s^2 over 300 frames
+    (quasi-static), is held until frame 1200 and taken away by frame 1260: loaded, the flap folds
+    down until its weight's moment m g r cos(phi) falls to the plastic moment yield / compliance
+    (cos(phi) = 1/2: 60 degrees); unloaded, it springs back by the yield angle and keeps a fold of
+    60 degrees less 0.4905 rad."""
+    r, w = 0.5, 0.5
+    verts = [[0.0, -w / 2, 0.0], [0.0, w / 2, 0.0], [-r, 0.0, 0.0], [r, 0.0, 0.0]]
+    g = 9.81
+    alpha, m = 0.2, 1.0
+    yield_angle = r * m * g * alpha * 0.5  # the plastic moment m g r cos(60 deg), times the compliance
+    return {
+        "format": "embra-scene",
+        "version": 1,
+        "name": "plastic_hinge",
+        "description": plastic_hinge.__doc__.replace("\n    ", " ").strip(),
+        "frames": 1800,
+        "solver": {"substeps": 10, "iterations": 20, "gravity": [0, 0, 0], "damping": 10.0, "realign_passes": 4,
+                   "tethers": 0, "settle_speed": 1e-6},
+        "bodies": [{
+            "name": "plate",
+            "mesh": {"vertices": verts, "triangles": [[0, 1, 2], [1, 0, 3]], "masses": [0.0, 0.0, 0.0, m]},
+            "generate": [],
+        }],
+        "constraints": [
+            {"kind": "distance", "particles": [[3, 0], [3, 1]]},
+            {"kind": "dihedral", "particles": [[0, 1, 2, 3]], "rest": [0.0], "compliance": alpha,
+             "yield": r_(yield_angle)},
+        ],
+        "actions": [{"type": "gravity", "keys": [{"frame": 0, "value": [0, 0, 0]}, {"frame": 300, "value": [0, 0, -g]},
+                                                 {"frame": 1200, "value": [0, 0, -g]}, {"frame": 1260, "value": [0, 0, 0]}]}],
+    }
+
+
+def r_(v):
+    return round(v, 15)
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "examples")
     dump(os.path.join(out, "cable_net_roof.json"), cable_net_roof())
     dump(os.path.join(out, "gridshell_chebyshev.json"), gridshell_chebyshev())
     dump(os.path.join(out, "conical_dome.json"), conical_dome())
+    dump(os.path.join(out, "plastic_hinge.json"), plastic_hinge())
 
 
 if __name__ == "__main__":

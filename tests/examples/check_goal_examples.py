@@ -13,6 +13,9 @@ usage: check_goal_examples.py EXAMPLE RUN_DIR
                        curvature, positive; the crown's two midlines both arching); the angles
                        between the two families of laths changed (the net sheared) while no
                        lath stretched.
+  plastic_hinge        the fold after unloading equals the plastic set by hand (the loaded fold
+                       where the weight's moment falls to the plastic moment, less the yield
+                       angle) to 1e-6 rad; the hinge's rest is the fold; at rest.
 Prints the measured figures; exits 1 if a check fails."""
 import json
 import math
@@ -156,6 +159,39 @@ def gridshell_chebyshev(run):
           f"by up to {math.degrees(shear):.2f} degrees (flat: 0)")
 
 
+def plastic_hinge(run):
+    world, _ = load(run)
+    first, masses = particles(world)
+    x = world["state"]["positions"]
+    hinge = next(b for b in world["constraints"] if b["kind"] == "dihedral")
+    a, b, c, d = (index(p, first) for p in hinge["particles"][0])
+    alpha, yield_angle = hinge["compliance"][0], hinge["yield"][0]
+    # The fold: the angle between the fixed plate (a, b, c) and the flap (b, a, d) across a-b.
+    e = sub(x[b], x[a])
+    u = e if norm(e) == 0 else scale(1.0 / norm(e), e)
+    def across(p):  # the part of p - a normal to the hinge line
+        v = sub(x[p], x[a])
+        return sub(v, scale(dot(v, u), u))
+    pc, pd = across(c), across(d)
+    r = norm(pd)
+    fold = math.pi - math.acos(dot(pc, pd) / (norm(pc) * norm(pd)))
+    g = max(norm(k["value"]) for act in world["actions"] if act["type"] == "gravity" for k in act["keys"])
+    m = masses[d]
+    # By hand: loaded, the weight's moment m g r cos(phi) about the hinge falls to the plastic moment
+    # yield / compliance where the flow stops; unloaded, the hinge springs back by the yield angle.
+    loaded = math.acos(yield_angle / (alpha * m * g * r))
+    by_hand = loaded - yield_angle
+    print(f"flap {m} kg at r = {r:.12f} m, compliance {alpha} rad/(N m), yield {yield_angle} rad, g {g} m/s^2: "
+          f"loaded fold {math.degrees(loaded):.6f} deg, set by hand {by_hand:.9f} rad")
+    check(abs(fold - by_hand) < 1e-6, f"fold after unloading {fold:.9f} rad = the plastic set by hand to "
+          f"{abs(fold - by_hand):.3g} rad (bound 1e-6)")
+    check(abs(abs(hinge["rest"][0]) - fold) < 1e-9, f"the hinge's rest followed it: rest {hinge['rest'][0]:.9f} rad, "
+          f"fold {fold:.9f} rad ({abs(abs(hinge['rest'][0]) - fold):.3g} apart, bound 1e-9)")
+    speed = max(norm(w) for w in world["state"]["velocities"])
+    check(speed < world["solver"]["settle_speed"], f"at rest: max speed {speed:.3g} m/s")
+
+
 if __name__ == "__main__":
-    {"cable_net_roof": cable_net_roof, "gridshell_chebyshev": gridshell_chebyshev}[sys.argv[1]](sys.argv[2])
+    {"cable_net_roof": cable_net_roof, "gridshell_chebyshev": gridshell_chebyshev,
+     "plastic_hinge": plastic_hinge}[sys.argv[1]](sys.argv[2])
     sys.exit(1 if failures else 0)

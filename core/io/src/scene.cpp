@@ -1297,7 +1297,7 @@ class Builder {
     guard(at, [&] { return w.add_constraints(d); });
     for (size_t i = 0; i < list.size(); ++i)
       if (yield[i] != 0.0 || rupture[i] != 0.0)
-        guard(at + "/particles/" + std::to_string(i), [&] {
+        guard(at + (yield[i] != 0.0 ? "/yield" : "/rupture"), [&] {
           w.set_constraint_plasticity(d.group, k, before + static_cast<int64_t>(i), yield[i], rupture[i]);
           return 0;
         });

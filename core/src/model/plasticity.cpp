@@ -21,8 +21,8 @@ bool plastic_kind(Kind kind) {
 
 void World::set_constraint_plasticity(Id group_id, Kind kind, int64_t index, double yield, double rupture) {
   if (!plastic_kind(kind))
-    invalid("plasticity and rupture are for distance and dihedral constraints, not kind " +
-            std::to_string(static_cast<int>(kind)));
+    invalid(std::string("plasticity and rupture are for distance and dihedral constraints, not ") + kind_name(kind) +
+            " (kind " + std::to_string(static_cast<int>(kind)) + ")");
   ConstraintArray& a = edited_array(group_id, kind, index);
   check_non_negative(yield, "yield");
   check_non_negative(rupture, "rupture");
