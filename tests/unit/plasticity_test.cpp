@@ -9,8 +9,8 @@
 //     one carrying every weight below, whose strain first passes the rupture strain): one event
 //     names it (group, kind, index, particles, frame), nothing else breaks, and the rest of the chain
 //     falls and steps on with its links at their lengths;
-//   - refusals: generated constraints, kinds other than distance and dihedral, negative or
-//     non-finite values, a distance of rest 0.
+//   - refusals: kinds other than distance and dihedral, negative or non-finite values, an index
+//     out of range, a distance of rest 0 (and a plastic distance's rest set to 0).
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -159,9 +159,13 @@ TEST(Plasticity, RefusalsChangeNothing) {
   EXPECT_THROW(w.set_constraint_plasticity(Id{}, Kind::distance, 1, 0.1, 0.0), Error) << "rest 0";
   EXPECT_THROW(w.set_constraint_plasticity(Id{}, Kind::tether, 0, 0.1, 0.0), Error) << "kind";
   EXPECT_THROW(w.set_constraint_plasticity(Id{}, static_cast<Kind>(99), 0, 0.1, 0.0), Error);
+  // A plastic distance keeps a strain to measure: its rest cannot be set to 0 (a saved world
+  // always loads back).
+  EXPECT_THROW(w.set_constraint_rest(Id{}, Kind::distance, 0, 0.0), Error);
   const ConstraintInfo c = w.constraint(Id{}, Kind::distance, 0);
   EXPECT_EQ(c.yield, 0.1);
   EXPECT_EQ(c.rupture, 0.5);
+  EXPECT_EQ(c.rest, 1.0);
   EXPECT_EQ(w.constraint(Id{}, Kind::distance, 1).yield, 0.0);
 }
 

@@ -548,7 +548,8 @@ EMBRA_API embra_status embra_constraint_remove(embra_world* world, embra_group_i
  * the elastic part); past `rupture` (> 0) the constraint is removed (the ones after it in its group
  * move down by one) and reported by embra_world_get_broken. 0 turns either off; the defaults are 0
  * (elastic, unbreakable). Each finite and >= 0; refused for other kinds, generated constraints and
- * a distance of rest 0 (no strain). */
+ * a distance of rest 0 (no strain); while either is set, embra_constraint_set_rest refuses a rest of
+ * 0 for that distance. */
 EMBRA_API embra_status embra_constraint_set_plasticity(embra_world* world, embra_group_id group,
                                                        embra_constraint_kind kind, int32_t index, double yield,
                                                        double rupture);

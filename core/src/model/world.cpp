@@ -402,7 +402,11 @@ void World::set_constraint_compliance(Id group_id, Kind kind, int64_t index, dou
 void World::set_constraint_rest(Id group_id, Kind kind, int64_t index, double rest) {
   ConstraintArray& a = edited_array(group_id, kind, index);
   check_rest(kind, rest, index);
-  a.rest[static_cast<size_t>(index)] = rest;
+  const auto i = static_cast<size_t>(index);
+  if (kind == Kind::distance && rest == 0.0 && (a.yield[i] != 0.0 || a.rupture[i] != 0.0))
+    invalid("distance constraint " + std::to_string(index) +
+            " yields or breaks at a strain: its rest length cannot be 0 (set its plasticity to 0 first)");
+  a.rest[i] = rest;
   rest_dirty_ = true;  // refresh_rest copies it to the solver's array
 }
 
