@@ -256,4 +256,48 @@ embra_status embra_constraint_remove(embra_world* world, embra_group_id group, e
                [&] { world->world.remove_constraint(to_id(group), static_cast<embra::Kind>(kind), index); });
 }
 
+embra_status embra_constraint_set_plasticity(embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                             int32_t index, double yield, double rupture) {
+  return guard("embra_constraint_set_plasticity", world, [&] {
+    world->world.set_constraint_plasticity(to_id(group), static_cast<embra::Kind>(kind), index, yield, rupture);
+  });
+}
+
+embra_status embra_constraint_get_plasticity(const embra_world* world, embra_group_id group, embra_constraint_kind kind,
+                                             int32_t index, double* out_yield, double* out_rupture) {
+  return guard("embra_constraint_get_plasticity", world, [&] {
+    need(out_yield, "out_yield");
+    need(out_rupture, "out_rupture");
+    const embra::ConstraintInfo c = world->world.constraint(to_id(group), static_cast<embra::Kind>(kind), index);
+    *out_yield = c.yield;
+    *out_rupture = c.rupture;
+  });
+}
+
+embra_status embra_world_get_broken(embra_world* world, embra_broken_constraint* out, int32_t capacity,
+                                    int32_t* out_count) {
+  return guard("embra_world_get_broken", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::BrokenConstraint>& b = world->world.broken();
+    const int32_t n = static_cast<int32_t>(b.size());
+    if (!fits(out, capacity, n, "broken constraints")) {
+      *out_count = n;
+      return;
+    }
+    for (int32_t i = 0; i < n; ++i) {
+      embra_broken_constraint e{};
+      e.group = from_id<embra_group_id>(b[i].group);
+      e.kind = static_cast<int32_t>(b[i].kind);
+      e.index = static_cast<int32_t>(b[i].index);
+      for (int k = 0; k < 4; ++k) e.particles[k] = b[i].particles[k];
+      e.frame = b[i].frame;
+      e.strain = b[i].strain;
+      out[i] = e;
+    }
+    *out_count = n;
+    world->world.take_broken();
+  });
+}
+
 }  // extern "C"

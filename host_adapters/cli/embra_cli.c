@@ -946,6 +946,21 @@ static void print_residuals(const embra_world* world) {
 
 /* What fights, for a person: the worst constraints (by violation x force) and the groups pulling
  * against each other, after a run that did not come to rest. */
+/* Prints the constraints broken since the last read (embra_world_get_broken, which empties the
+ * list): one "broke" line each, with its frame and strain. Returns how many. */
+static int32_t print_broken(embra_world* world) {
+  int32_t n = 0;
+  if (embra_world_get_broken(world, NULL, 0, &n) != EMBRA_OK || n == 0) return 0;
+  embra_broken_constraint* b = malloc(sizeof *b * (size_t)n);
+  if (!b || embra_world_get_broken(world, b, n, &n) != EMBRA_OK) n = 0;
+  for (int32_t i = 0; i < n; ++i)
+    printf("%-18s %s %d of group %u (particles %d %d%s) in frame %lld at strain %.6g\n", "broke",
+           embra_residual_name(b[i].kind), b[i].index, b[i].group.index, b[i].particles[0], b[i].particles[1],
+           b[i].particles[2] >= 0 ? " ..." : "", (long long)b[i].frame, b[i].strain);
+  free(b);
+  return n;
+}
+
 static void print_fighting(const embra_world* world) {
   embra_constraint_residual worst[5];
   int32_t n = 0;
@@ -1121,6 +1136,7 @@ static int cmd_run(int argc, char** argv) {
       break;
     }
     embra_world_get_report(world, &r);
+    print_broken(world);
     if (until >= 0) {
       settled_at =
           solved.outcome <= EMBRA_SOLVE_SETTLED_OUT_OF_TOLERANCE ? (long)r.frame - solve_def.hold_frames + 1 : -1;

@@ -215,6 +215,18 @@ namespace Embra
         public double Compliance;
     }
 
+    /// <summary>embra_broken_constraint.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct BrokenConstraint
+    {
+        public GroupId Group;
+        public int Kind;
+        public int Index;
+        public fixed int Particles[4];
+        public long Frame;
+        public double Strain;
+    }
+
     /// <summary>embra_pin_def.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct PinDef
@@ -625,6 +637,9 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_set_rest(IntPtr world, GroupId group, int kind, int index, double rest);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_set_group(IntPtr world, GroupId group, int kind, int index, GroupId to, out int newIndex);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_remove(IntPtr world, GroupId group, int kind, int index);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_set_plasticity(IntPtr world, GroupId group, int kind, int index, double yield, double rupture);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_get_plasticity(IntPtr world, GroupId group, int kind, int index, out double yield, out double rupture);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_broken(IntPtr world, [Out] BrokenConstraint[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern PinDef embra_default_pin_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_pin_create(IntPtr world, ref PinDef def, out PinId pin);
         [DllImport(Library, CallingConvention = C)] public static extern SupportDef embra_default_support_def();

@@ -702,6 +702,27 @@ namespace Embra
             Call(w => Native.embra_constraint_set_rest(w, group, (int)kind, index, rest));
         }
 
+        /// <summary>Plasticity and rupture of an added distance or dihedral
+        /// (embra_constraint_set_plasticity): past `yieldStrain` its rest follows it, past `rupture` it
+        /// breaks (see Broken()); 0: never.</summary>
+        public void SetConstraintPlasticity(GroupId group, ConstraintKind kind, int index, double yieldStrain,
+                                            double rupture)
+        {
+            Call(w => Native.embra_constraint_set_plasticity(w, group, (int)kind, index, yieldStrain, rupture));
+        }
+
+        /// <summary>(yield, rupture) of a constraint (embra_constraint_get_plasticity); 0 is none.</summary>
+        public (double Yield, double Rupture) ConstraintPlasticity(GroupId group, ConstraintKind kind, int index)
+        {
+            double y = 0, r = 0;
+            Call(w => Native.embra_constraint_get_plasticity(w, group, (int)kind, index, out y, out r));
+            return (y, r);
+        }
+
+        /// <summary>The constraints broken since the last call (embra_world_get_broken), in the order
+        /// they broke; the world's list is emptied.</summary>
+        public BrokenConstraint[] Broken() { return Ids<BrokenConstraint>(Native.embra_world_get_broken); }
+
         /// <summary>Moves the constraint to the end of group `to`'s; returns its index there.</summary>
         public int SetConstraintGroup(GroupId group, ConstraintKind kind, int index, GroupId to)
         {

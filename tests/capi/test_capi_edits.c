@@ -414,6 +414,94 @@ static void test_refusals(void) {
   embra_world_destroy(w);
 }
 
+/* Plasticity and rupture through the C ABI: refusals change nothing; a weight hung on a link whose
+ * static strain (m g c / L = 0.0981) is past its rupture strain (0.05) breaks it, one event names
+ * it, read with the two-call pattern (a count leaves the list; a read empties it), and the freed
+ * weight falls on. */
+static void test_plasticity_and_broken(void) {
+  int32_t first = 0, count = -1, n = 0;
+  embra_world* w = hanging_world(5.0, 1.0, &first);
+  embra_group_id def = {0, 0}, stale, g;
+  embra_group_def gd = embra_default_group_def();
+  embra_constraint_def c = embra_default_constraint_def();
+  embra_broken_constraint out[4];
+  embra_step_report report;
+  double yield = -1.0, rupture = -1.0;
+  char *before, *after;
+  c.particles[0] = first;
+  c.particles[1] = first + 1;
+  c.compliance = 0.01;
+  CHECK_OK(embra_constraint_add(w, &c));
+  CHECK_OK(embra_group_create(w, &gd, &stale));
+  CHECK_OK(embra_group_destroy(w, stale));
+  CHECK_OK(embra_group_create(w, &gd, &g));
+  before = capi_test_save(w);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, NAN, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0, -0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, INFINITY, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 1, 0.0, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, -1, 0.0, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_TETHER, 0, 0.0, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "distance and dihedral");
+  CHECK_STATUS(embra_constraint_set_plasticity(w, def, 77, 0, 0.0, 0.05), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, g, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_set_plasticity(w, stale, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0, 0.05),
+               EMBRA_ERROR_STALE_ID);
+  CHECK_STATUS(embra_constraint_set_plasticity(NULL, def, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0, 0.05),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_get_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, NULL, &rupture),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_constraint_get_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, &yield, NULL),
+               EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_broken(w, out, 4, NULL), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_broken(w, out, -1, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_broken(w, NULL, 4, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(embra_world_get_broken(NULL, out, 4, &count), EMBRA_ERROR_INVALID_ARGUMENT);
+  after = capi_test_save(w);
+  CHECK(before && after && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+
+  CHECK_OK(embra_constraint_get_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, &yield, &rupture));
+  CHECK(yield == 0.0 && rupture == 0.0);
+  CHECK_OK(embra_constraint_set_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, 0.0, 0.05));
+  CHECK_OK(embra_constraint_get_plasticity(w, def, EMBRA_CONSTRAINT_DISTANCE, 0, &yield, &rupture));
+  CHECK(yield == 0.0 && rupture == 0.05);
+  for (int f = 0; f < 120 && n == 0; ++f) {
+    CHECK_OK(embra_world_step(w));
+    CHECK_OK(embra_world_get_broken(w, NULL, 0, &n));
+  }
+  CHECK_INT(n, 1);
+  CHECK_OK(embra_world_get_broken(w, NULL, 0, &count));
+  CHECK_INT(count, 1); /* a count alone keeps the list */
+  CHECK_STATUS(embra_world_get_broken(w, out, 0, &count), EMBRA_ERROR_BUFFER_TOO_SMALL);
+  CHECK_OK(embra_world_get_broken(w, out, 4, &count));
+  CHECK_INT(count, 1);
+  CHECK_OK(embra_world_get_report(w, &report));
+  CHECK_INT(out[0].kind, EMBRA_CONSTRAINT_DISTANCE);
+  CHECK_INT(out[0].index, 0);
+  CHECK_INT(out[0].particles[0], first);
+  CHECK_INT(out[0].particles[1], first + 1);
+  CHECK_INT(out[0].particles[2], -1);
+  CHECK(out[0].frame == report.frame);
+  CHECK(out[0].strain > 0.05);
+  CHECK_OK(embra_world_get_broken(w, NULL, 0, &count));
+  CHECK_INT(count, 0); /* read: emptied */
+  CHECK_OK(embra_group_get_constraint_count(w, def, EMBRA_CONSTRAINT_DISTANCE, &count, NULL));
+  CHECK_INT(count, 0);
+  /* The weight falls free (1 s more, at up to g / damping = 2 m/s): the world steps on. */
+  for (int f = 0; f < 60; ++f) CHECK_OK(embra_world_step(w));
+  CHECK(z_of(w, first + 1) < -2.0);
+  embra_world_destroy(w);
+}
+
 /* A net of n x n particles 0.1 m apart at z = 0, edges along the grid (compliance c), the rest
  * 0.01 kg each: its four corners immovable (mass 0), or with `flap` its first row (y = 0), so
  * it swings down from that edge. */
@@ -715,6 +803,7 @@ int main(void) {
   RUN(test_material);
   RUN(test_field);
   RUN(test_refusals);
+  RUN(test_plasticity_and_broken);
   RUN(test_masses_hang);
   RUN(test_masses_uniform_scale);
   RUN(test_masses_heavier_half);

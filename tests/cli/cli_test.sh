@@ -160,5 +160,21 @@ printf '%s\n' "embra: installing libfoo" "build: 1% (Building CXX object a.o)" "
 cmp -s "$tmp/progress" "$tmp/progress_expected" && ok || bad "build progress: $(cat "$tmp/progress")"
 cmp -s "$tmp/build_out" "$tmp/build_log" && ok || bad "the build log must keep every line"
 
+# A link that breaks: `run` prints it (embra_world_get_broken) once, with its frame and strain. Two
+# links of 1e-3 m/N under 1 kg each, the top one breaking past a strain of 0.12 (statically 0.098;
+# the drop from rest overshoots it), the lower one (0.049 statically) never.
+cat >"$tmp/tear.json" <<'JSON'
+{"format": "embra-scene", "version": 1, "frames": 120, "solver": {"damping": 5.0, "tethers": 0},
+ "bodies": [{"name": "chain", "mesh": {"vertices": [[0, 0, 0], [0, 0, -0.2], [0, 0, -0.4]],
+   "edges": [[0, 1], [1, 2]], "masses": [0, 1, 1]}, "generate": []}],
+ "constraints": [{"kind": "distance", "particles": [[0, 1], [1, 2]], "compliance": 1e-3, "rupture": 0.12}]}
+JSON
+"$embra" run "$tmp/tear.json" --out "$tmp/tear" >"$tmp/tear.log" 2>&1 && ok || bad "the tearing chain failed: $(cat "$tmp/tear.log")"
+[ "$(grep -c '^broke ' "$tmp/tear.log")" -eq 1 ] && ok || bad "one link must break: $(grep broke "$tmp/tear.log")"
+grep -Eq '^broke +distance 0 of group 0 \(particles 0 1\) in frame [0-9]+ at strain 0\.1[2-9]' "$tmp/tear.log" && ok ||
+  bad "the top link must be named with its strain: $(grep broke "$tmp/tear.log")"
+grep -q '"constraints": \[' "$tmp/tear/final.json" && [ "$(grep -c '"rupture"' "$tmp/tear/final.json")" -eq 1 ] && ok ||
+  bad "final.json must keep the unbroken link and its rupture strain"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1110,7 +1110,22 @@ void Session::op_edit() {
   const int32_t index = in_.chance(2) ? in_.u8() % 8 : in_.integer();
   const std::string at = "(group {" + std::to_string(g.index) + ", " + std::to_string(g.generation) + "}, kind " +
                          std::to_string(kind) + ", index " + std::to_string(index);
-  switch (in_.u8() % 17) {
+  switch (in_.u8() % 18) {
+    case 17: {  // plasticity and rupture, then the broken constraints, into a buffer sized or not
+      const double y = in_.value(), r = in_.value();
+      call("embra_constraint_set_plasticity" + at + ", " + fmt(y) + ", " + fmt(r) + ")", true,
+           [&] { return embra_constraint_set_plasticity(world_, g, kind, index, y, r); });
+      double got_yield = 0.0, got_rupture = 0.0;
+      call("embra_constraint_get_plasticity" + at + ")", false, [&] {
+        return embra_constraint_get_plasticity(world_, g, kind, index, in_.chance(16) ? nullptr : &got_yield,
+                                               &got_rupture);
+      });
+      std::vector<embra_broken_constraint> out(8);
+      int32_t n = 0;
+      call("embra_world_get_broken", false,
+           [&] { return embra_world_get_broken(world_, in_.chance(4) ? nullptr : out.data(), in_.u8() % 9, &n); });
+      break;
+    }
     case 10: {  // point loads
       const int32_t first = particle();
       const int32_t count = in_.chance(16) ? -1 : in_.u8() % 6;

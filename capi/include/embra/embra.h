@@ -614,6 +614,42 @@ EMBRA_API embra_status embra_constraint_set_group(embra_world* world, embra_grou
 EMBRA_API embra_status embra_constraint_remove(embra_world* world, embra_group_id group, embra_constraint_kind kind,
                                                int32_t index);
 
+/* Plasticity and rupture of an added EMBRA_CONSTRAINT_DISTANCE or EMBRA_CONSTRAINT_DIHEDRAL (a
+ * hinge), named as for the edits above, checked after every step at the step's end positions.
+ * Its strain: (length - rest) / rest for a distance (dimensionless), angle - rest for a dihedral
+ * (rad, wrapped to (-pi, pi]). Past `yield` (> 0) the rest follows the constraint so that the strain
+ * is `yield` again (perfect plasticity: unloaded, it keeps the permanent set, its loaded value less
+ * the elastic part); past `rupture` (> 0) the constraint is removed (the ones after it in its group
+ * move down by one) and reported by embra_world_get_broken. 0 turns either off; the defaults are 0
+ * (elastic, unbreakable). Each finite and >= 0; refused for other kinds, generated constraints and
+ * a distance of rest 0 (no strain); while either is set, embra_constraint_set_rest refuses a rest of
+ * 0 for that distance. */
+EMBRA_API embra_status embra_constraint_set_plasticity(embra_world* world, embra_group_id group,
+                                                       embra_constraint_kind kind, int32_t index, double yield,
+                                                       double rupture);
+/* The constraint's yield and rupture strains (0: none). Both outputs required. */
+EMBRA_API embra_status embra_constraint_get_plasticity(const embra_world* world, embra_group_id group,
+                                                       embra_constraint_kind kind, int32_t index, double* out_yield,
+                                                       double* out_rupture);
+
+/* A constraint that broke past its rupture strain, named as it was when it broke. */
+typedef struct embra_broken_constraint {
+  embra_group_id group; /* its group (the default group by its own id, not {0,0}) */
+  int32_t kind;         /* EMBRA_CONSTRAINT_DISTANCE or EMBRA_CONSTRAINT_DIHEDRAL */
+  int32_t index;        /* its index among the group's constraints of that kind when it broke */
+  int32_t particles[4]; /* its particles, -1 past its arity */
+  int64_t frame;        /* the frame whose step broke it (embra_step_report.frame after that step) */
+  double strain;        /* the strain it broke at (dimensionless, or rad for a dihedral) */
+} embra_broken_constraint;
+
+/* The constraints broken since the last read, in the order they broke. Two-call pattern: out NULL
+ * and capacity 0 only write *out_count (required), and the list is kept; a buffer of at least that
+ * capacity receives them and the list is emptied (the next read returns only later breaks); a
+ * smaller one is EMBRA_ERROR_BUFFER_TOO_SMALL, nothing written, the list kept. Not saved with a
+ * scene. */
+EMBRA_API embra_status embra_world_get_broken(embra_world* world, embra_broken_constraint* out, int32_t capacity,
+                                              int32_t* out_count);
+
 /* ---------------------------------------------------------------------------------------------
  * Pins: a particle held at a target the host moves between steps (dragging, raising a tent)
  * ------------------------------------------------------------------------------------------- */

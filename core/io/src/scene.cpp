@@ -1282,7 +1282,26 @@ class Builder {
     } else {
       d.uniform_compliance = value_or(c, "compliance", d.uniform_compliance);
     }
+    // Plasticity and rupture: one value for all, or one per constraint; 0 (none) when left out.
+    const auto per_constraint = [&](const char* key) {
+      std::vector<double> v(list.size(), 0.0);
+      if (!c.contains(key)) return v;
+      if (!c[key].is_array()) return std::vector<double>(list.size(), c[key].get<double>());
+      if (c[key].size() != list.size())
+        fail(at + "/" + key,
+             "has " + std::to_string(c[key].size()) + " values for " + std::to_string(list.size()) + " constraints");
+      for (size_t i = 0; i < list.size(); ++i) v[i] = c[key][i].get<double>();
+      return v;
+    };
+    const std::vector<double> yield = per_constraint("yield"), rupture = per_constraint("rupture");
+    const int64_t before = w.constraint_count(d.group, k).first;
     guard(at, [&] { return w.add_constraints(d); });
+    for (size_t i = 0; i < list.size(); ++i)
+      if (yield[i] != 0.0 || rupture[i] != 0.0)
+        guard(at + (yield[i] != 0.0 ? "/yield" : "/rupture"), [&] {
+          w.set_constraint_plasticity(d.group, k, before + static_cast<int64_t>(i), yield[i], rupture[i]);
+          return 0;
+        });
   }
 
   void state(World& w, const json& s) {
@@ -1654,19 +1673,29 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
       const ConstraintArray& a = g.arrays[k];
       if (a.size() == a.generated) continue;
       const int n = arity(static_cast<Kind>(k));
-      json particles = json::array(), rest = json::array(), compliance = json::array();
+      json particles = json::array(), rest = json::array(), compliance = json::array(), yield = json::array(),
+           rupture = json::array();
+      bool plastic = false;
       for (size_t i = a.generated; i < a.size(); ++i) {
         json ops = json::array();
         for (int c = 0; c < n; ++c) ops.push_back(a.ids[i * n + c]);
         particles.push_back(ops);
         rest.push_back(a.rest[i]);
         compliance.push_back(a.compliance[i]);
+        yield.push_back(a.yield[i]);
+        rupture.push_back(a.rupture[i]);
+        plastic = plastic || a.yield[i] != 0.0 || a.rupture[i] != 0.0;
       }
-      constraints.push_back({{"kind", kind_name(static_cast<Kind>(k))},
-                             {"group", gname[slot]},
-                             {"particles", particles},
-                             {"rest", rest},
-                             {"compliance", compliance}});
+      json batch = {{"kind", kind_name(static_cast<Kind>(k))},
+                    {"group", gname[slot]},
+                    {"particles", particles},
+                    {"rest", rest},
+                    {"compliance", compliance}};
+      if (plastic) {  // written only when used, so a scene without them saves as before
+        batch["yield"] = yield;
+        batch["rupture"] = rupture;
+      }
+      constraints.push_back(batch);
     }
   }
   doc["constraints"] = constraints;

@@ -279,6 +279,8 @@ int64_t World::add_constraints(const ConstraintDesc& desc) {
     a.compliance.push_back(desc.compliance.empty() ? desc.uniform_compliance : desc.compliance[i]);
     a.rest_now.push_back(rest[i]);
     for (int c = 0; c < multipliers(desc.kind); ++c) a.lambda.push_back(0.0);
+    a.yield.push_back(0.0);
+    a.rupture.push_back(0.0);
   }
   rest_dirty_ = true;
   solver_dirty_ = true;
@@ -342,6 +344,8 @@ ConstraintArray take(ConstraintArray& a, Kind kind, size_t i) {
   move(a.compliance, one.compliance, 1);
   move(a.rest_now, one.rest_now, 1);
   move(a.lambda, one.lambda, per);
+  move(a.yield, one.yield, 1);
+  move(a.rupture, one.rupture, 1);
   return one;
 }
 
@@ -381,6 +385,8 @@ ConstraintInfo World::constraint(Id group_id, Kind kind, int64_t index) const {
   c.rest = a.rest[i];
   c.compliance = a.compliance[i];
   c.body = i < a.generated ? a.body[i] : -1;
+  c.yield = a.yield[i];
+  c.rupture = a.rupture[i];
   return c;
 }
 
@@ -398,7 +404,11 @@ void World::set_constraint_compliance(Id group_id, Kind kind, int64_t index, dou
 void World::set_constraint_rest(Id group_id, Kind kind, int64_t index, double rest) {
   ConstraintArray& a = edited_array(group_id, kind, index);
   check_rest(kind, rest, index);
-  a.rest[static_cast<size_t>(index)] = rest;
+  const auto i = static_cast<size_t>(index);
+  if (kind == Kind::distance && rest == 0.0 && (a.yield[i] != 0.0 || a.rupture[i] != 0.0))
+    invalid("distance constraint " + std::to_string(index) +
+            " yields or breaks at a strain: its rest length cannot be 0 (set its plasticity to 0 first)");
+  a.rest[i] = rest;
   rest_dirty_ = true;  // refresh_rest copies it to the solver's array
 }
 
@@ -416,7 +426,9 @@ int64_t World::move_constraint(Id group_id, Kind kind, int64_t index, Id to) {
                       {&dest.rest_v, &one.rest_v},
                       {&dest.compliance, &one.compliance},
                       {&dest.rest_now, &one.rest_now},
-                      {&dest.lambda, &one.lambda}})
+                      {&dest.lambda, &one.lambda},
+                      {&dest.yield, &one.yield},
+                      {&dest.rupture, &one.rupture}})
     d->insert(d->end(), s->begin(), s->end());
   dest.body.insert(dest.body.end(), one.body.begin(), one.body.end());
   rest_dirty_ = true;
@@ -675,6 +687,8 @@ Id World::create_body(const BodyDesc& d) {
     a.compliance.push_back(compliance);
     a.rest_now.push_back(rest);
     a.lambda.push_back(0.0);
+    a.yield.push_back(0.0);
+    a.rupture.push_back(0.0);
   };
   const Material& m = d.material;
   if (d.generate & generate_stretch)
@@ -736,6 +750,8 @@ Id World::create_body(const BodyDesc& d) {
       move_block(a.compliance, 1);
       move_block(a.rest_now, 1);
       move_block(a.lambda, 1);
+      move_block(a.yield, 1);
+      move_block(a.rupture, 1);
     }
     a.generated += added;
   }

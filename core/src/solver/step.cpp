@@ -544,6 +544,7 @@ void World::step(const StepControl& control) {
   }
   end_frame();
   measure();
+  apply_plasticity();
 }
 
 void World::begin_frame(const StepControl& control) {

@@ -243,6 +243,14 @@ const ConstraintBatchDef = koffi.struct('embra_constraint_batch_def', {
   compliances: 'const double *',
   compliance: 'double',
 });
+const BrokenConstraint = koffi.struct('embra_broken_constraint', {
+  group: GroupIdType,
+  kind: 'int32_t',
+  index: 'int32_t',
+  particles: koffi.array('int32_t', 4, 'Array'),
+  frame: 'int64_t',
+  strain: 'double',
+});
 const PinDef = koffi.struct('embra_pin_def', {
   version: 'int32_t',
   particle: 'int32_t',
@@ -492,6 +500,7 @@ const STRUCTS = {
   embra_body_def: BodyDef,
   embra_constraint_def: ConstraintDef,
   embra_constraint_batch_def: ConstraintBatchDef,
+  embra_broken_constraint: BrokenConstraint,
   embra_pin_def: PinDef,
   embra_support_def: SupportDef,
   embra_polyline_support_def: PolylineSupportDef,
@@ -572,6 +581,9 @@ const PROTOTYPES = {
   embra_constraint_set_rest: 'embra_status embra_constraint_set_rest(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, double rest)',
   embra_constraint_set_group: 'embra_status embra_constraint_set_group(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, embra_group_id to, _Out_ int32_t *out_new_index)',
   embra_constraint_remove: 'embra_status embra_constraint_remove(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index)',
+  embra_constraint_set_plasticity: 'embra_status embra_constraint_set_plasticity(embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, double yield, double rupture)',
+  embra_constraint_get_plasticity: 'embra_status embra_constraint_get_plasticity(const embra_world *world, embra_group_id group, embra_constraint_kind kind, int32_t index, _Out_ double *out_yield, _Out_ double *out_rupture)',
+  embra_world_get_broken: 'embra_status embra_world_get_broken(embra_world *world, embra_broken_constraint *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_default_pin_def: 'embra_pin_def embra_default_pin_def(void)',
   embra_pin_create: 'embra_status embra_pin_create(embra_world *world, const embra_pin_def *def, _Out_ embra_pin_id *out_pin)',
   embra_default_support_def: 'embra_support_def embra_default_support_def(void)',
@@ -679,8 +691,8 @@ module.exports = {
   CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
   SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
   GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
-  ConstraintDef, ConstraintBatchDef, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef, ColliderDef,
-  StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef, SolveResult,
-  Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions,
-  FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  ConstraintDef, ConstraintBatchDef, BrokenConstraint, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef,
+  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
+  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
+  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -786,6 +786,48 @@ class World {
       buf.int32(index, 'index'), buf.number(rest, 'rest'));
   }
 
+  /**
+   * Plasticity and rupture of an added distance or dihedral (embra_constraint_set_plasticity): past
+   * `yieldStrain` its rest follows it, past `rupture` it breaks (see broken()); 0: never.
+   */
+  setConstraintPlasticity(group, kind, index, yieldStrain, rupture) {
+    this.#call('embra_constraint_set_plasticity', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), buf.number(yieldStrain, 'yield'), buf.number(rupture, 'rupture'));
+  }
+
+  /** {yield, rupture} of a constraint (embra_constraint_get_plasticity); 0 is none. */
+  constraintPlasticity(group, kind, index) {
+    const y = [0];
+    const r = [0];
+    this.#call('embra_constraint_get_plasticity', toId(group, GroupId, 'group'), enumValue(kind, KINDS, 'kind'),
+      buf.int32(index, 'index'), y, r);
+    return { yield: y[0], rupture: r[0] };
+  }
+
+  /**
+   * The constraints broken since the last call (embra_world_get_broken), in the order they broke:
+   * [{group (GroupId), kind (name), index, particles, frame, strain}]; the world's list is emptied.
+   */
+  broken() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_broken', null, 0, n);
+    const size = koffi.sizeof(capi.BrokenConstraint);
+    const capacity = Math.max(n[0], 1);
+    const out = Buffer.alloc(capacity * size);
+    this.#call('embra_world_get_broken', out, capacity, n);
+    const names = Object.fromEntries(Object.entries(KINDS).map(([k, v]) => [v, k]));
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const b = koffi.decode(out, k * size, capi.BrokenConstraint);
+      result.push({
+        group: new GroupId(b.group.index, b.group.generation), kind: names[b.kind] ?? b.kind, index: b.index,
+        particles: Array.from(b.particles).filter((p) => p >= 0), frame: Number(b.frame), strain: b.strain,
+      });
+    }
+    return result;
+  }
+
   /** Moves the constraint to the end of group `to`'s; returns its index there. */
   setConstraintGroup(group, kind, index, to) {
     const at = [0];

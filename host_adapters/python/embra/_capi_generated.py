@@ -296,6 +296,18 @@ class ConstraintBatchDef(_Struct):
     ]
 
 
+class BrokenConstraint(_Struct):
+    """embra_broken_constraint."""
+    _fields_ = [
+        ("group", GroupId),
+        ("kind", c_int32),
+        ("index", c_int32),
+        ("particles", c_int32 * 4),
+        ("frame", c_int64),
+        ("strain", c_double),
+    ]
+
+
 class PinDef(_Struct):
     """embra_pin_def."""
     _fields_ = [
@@ -686,6 +698,9 @@ PROTOTYPES = {
     "embra_constraint_set_rest": (c_int32, [c_void_p, GroupId, c_int32, c_int32, c_double]),
     "embra_constraint_set_group": (c_int32, [c_void_p, GroupId, c_int32, c_int32, GroupId, POINTER(c_int32)]),
     "embra_constraint_remove": (c_int32, [c_void_p, GroupId, c_int32, c_int32]),
+    "embra_constraint_set_plasticity": (c_int32, [c_void_p, GroupId, c_int32, c_int32, c_double, c_double]),
+    "embra_constraint_get_plasticity": (c_int32, [c_void_p, GroupId, c_int32, c_int32, POINTER(c_double), POINTER(c_double)]),
+    "embra_world_get_broken": (c_int32, [c_void_p, POINTER(BrokenConstraint), c_int32, POINTER(c_int32)]),
     "embra_default_pin_def": (PinDef, []),
     "embra_pin_create": (c_int32, [c_void_p, POINTER(PinDef), POINTER(PinId)]),
     "embra_default_support_def": (SupportDef, []),

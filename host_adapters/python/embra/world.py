@@ -648,6 +648,32 @@ class World:
         self._call("embra_constraint_set_rest", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
                    buf.int32(index, "index"), float(rest))
 
+    def set_constraint_plasticity(self, group, kind, index, yield_strain, rupture):
+        """Plasticity and rupture of an added distance or dihedral (embra_constraint_set_plasticity):
+        past `yield_strain` its rest follows it, past `rupture` it breaks (see broken()); 0: never."""
+        self._call("embra_constraint_set_plasticity", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"), float(yield_strain), float(rupture))
+
+    def constraint_plasticity(self, group, kind, index):
+        """(yield, rupture) of a constraint (embra_constraint_get_plasticity); 0 is none."""
+        y, r = c_double(), c_double()
+        self._call("embra_constraint_get_plasticity", _id(group, GroupId, "group"), _enum(kind, KINDS, "kind"),
+                   buf.int32(index, "index"), byref(y), byref(r))
+        return y.value, r.value
+
+    def broken(self):
+        """The constraints broken since the last call (embra_world_get_broken), in the order they
+        broke: a list of dicts {group (GroupId), kind (name), index, particles, frame, strain}; the
+        world's list is emptied."""
+        n = c_int32()
+        self._call("embra_world_get_broken", None, 0, byref(n))
+        out = (_capi.BrokenConstraint * max(n.value, 1))()
+        self._call("embra_world_get_broken", out, max(n.value, 1), byref(n))
+        names = {v: k for k, v in KINDS.items()}
+        return [{"group": GroupId(b.group.index, b.group.generation), "kind": names.get(b.kind, b.kind),
+                 "index": b.index, "particles": [p for p in b.particles if p >= 0], "frame": b.frame,
+                 "strain": b.strain} for b in out[:n.value]]
+
     def set_constraint_group(self, group, kind, index, to):
         """Moves the constraint to the end of group `to`'s; returns its index there."""
         at = c_int32()

@@ -2365,6 +2365,46 @@ namespace Embra.Tests
         }
 
         [Test]
+        public void PlasticityKeepsASetAndRuptureBreaksWithAnEvent()
+        {
+            // Elastic strain under the weight m g c / L = 0.0196, past a yield of 0.01: the rest grows
+            // to m g c / 0.01 (approached from below, by 1 / (1 + yield) a frame), the elastic part m g c.
+            Body b;
+            var none = default(GroupId);
+            using (var w = Hanging(out b))
+            {
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 }, 1.0, 1e-3);
+                Assert.AreEqual((0.0, 0.0), w.ConstraintPlasticity(none, ConstraintKind.Distance, 0));
+                w.SetConstraintPlasticity(none, ConstraintKind.Distance, 0, 0.01, 0.0);
+                Assert.AreEqual((0.01, 0.0), w.ConstraintPlasticity(none, ConstraintKind.Distance, 0));
+                double d = Drop(w, b);
+                double rest = w.Constraint(none, ConstraintKind.Distance, 0).Rest;
+                Assert.AreEqual(2.0 * G * 1e-3 / 0.01, rest, 1e-5 * rest);
+                Assert.AreEqual(2.0 * G * 1e-3, 1.0 + d - rest, 1e-6);
+                Assert.AreEqual(0, w.Broken().Length);
+                Assert.Throws<EmbraArgumentException>(() => w.SetConstraintPlasticity(none, ConstraintKind.Tether, 0, 0.01, 0.0));
+            }
+            using (var w = Hanging(out b))
+            {
+                w.AddConstraint(ConstraintKind.Distance, new[] { b.First, b.First + 1 }, 1.0, 1e-3);
+                w.SetConstraintPlasticity(none, ConstraintKind.Distance, 0, 0.0, 0.015);
+                w.Step(60);
+                var events = w.Broken();
+                Assert.AreEqual(1, events.Length);
+                Assert.AreEqual((int)ConstraintKind.Distance, events[0].Kind);
+                Assert.AreEqual(0, events[0].Index);
+                unsafe
+                {
+                    BrokenConstraint e = events[0];
+                    Assert.AreEqual(b.First, e.Particles[0]);
+                    Assert.AreEqual(b.First + 1, e.Particles[1]);
+                }
+                Assert.Greater(events[0].Strain, 0.015);
+                Assert.AreEqual(0, w.Broken().Length);
+            }
+        }
+
+        [Test]
         public void ADisabledGroupStepsLikeNoConstraint()
         {
             Body b, fb;

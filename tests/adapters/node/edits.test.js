@@ -175,3 +175,30 @@ test('a uniform mass scale changes no motion (a pendulum and a free particle, ma
   near(Math.hypot(p[3], p[5]), 1.0, 1e-6, 'the link held');
   for (const [w] of worlds) w.close();
 });
+
+test('plasticity keeps a set, and rupture breaks with an event', () => {
+  // Elastic strain under the weight: m g c / L = 0.0196, past a yield of 0.01: the rest grows to
+  // m g c / 0.01 (approached from below, by 1 / (1 + yield) a frame), the elastic part at rest m g c.
+  let [w, b] = hanging({ damping: 6.0 });
+  w.addConstraint('distance', [b.first, b.first + 1], { rest: 1.0, compliance: 1e-3 });
+  assert.deepEqual(w.constraintPlasticity(null, 'distance', 0), { yield: 0, rupture: 0 });
+  w.setConstraintPlasticity(null, 'distance', 0, 0.01, 0.0);
+  assert.deepEqual(w.constraintPlasticity(null, 'distance', 0), { yield: 0.01, rupture: 0 });
+  const d = drop(w, b);
+  const rest = w.constraint(null, 'distance', 0).rest;
+  near(rest, (2.0 * G * 1e-3) / 0.01, 1e-5 * rest, 'rest m g c / yield');
+  near(1.0 + d - rest, 2.0 * G * 1e-3, 1e-6, 'elastic part m g c');
+  assert.deepEqual(w.broken(), []);
+  assert.throws(() => w.setConstraintPlasticity(null, 'tether', 0, 0.01, 0.0), /distance and dihedral/);
+  [w, b] = hanging({ damping: 6.0 });
+  w.addConstraint('distance', [b.first, b.first + 1], { rest: 1.0, compliance: 1e-3 });
+  w.setConstraintPlasticity(null, 'distance', 0, 0.0, 0.015);
+  w.step(60);
+  const events = w.broken();
+  assert.equal(events.length, 1);
+  assert.equal(events[0].kind, 'distance');
+  assert.equal(events[0].index, 0);
+  assert.deepEqual(events[0].particles, [b.first, b.first + 1]);
+  assert.ok(events[0].strain > 0.015 && events[0].frame > 0 && events[0].frame <= 60);
+  assert.deepEqual(w.broken(), []);
+});

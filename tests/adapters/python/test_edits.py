@@ -185,3 +185,33 @@ def test_a_uniform_mass_scale_changes_no_motion():
         worst = max(worst, max(abs(x - y) for x, y in zip(a, c)))
     assert worst < 1e-9
     assert math.hypot(c[3], c[5]) == pytest.approx(1.0, abs=1e-6)
+
+
+def test_plasticity_keeps_a_set_and_rupture_breaks_with_an_event():
+    # Elastic strain under the weight: m g c / L = 0.0196, past a yield of 0.01: at rest the rest has
+    # grown to m g c / 0.01 (approached from below, by 1 / (1 + yield) a frame), the elastic part m g c.
+    w, b = hanging(damping=6.0)
+    w.add_constraint("distance", [b.first, b.first + 1], rest=1.0, compliance=1e-3)
+    assert w.constraint_plasticity(None, "distance", 0) == (0.0, 0.0)
+    w.set_constraint_plasticity(None, "distance", 0, 0.01, 0.0)
+    assert w.constraint_plasticity(None, "distance", 0) == (0.01, 0.0)
+    assert drop(w, b) > 0.9
+    rest = w.constraint(None, "distance", 0)["rest"]
+    assert rest == pytest.approx(2.0 * G * 1e-3 / 0.01, rel=1e-5)
+    assert 1.0 + drop(w, b) - rest == pytest.approx(2.0 * G * 1e-3, abs=1e-6)
+    assert w.broken() == []
+    with pytest.raises(embra.InvalidArgumentError, match="distance and dihedral"):
+        w.set_constraint_plasticity(None, "tether", 0, 0.01, 0.0)
+    with pytest.raises(embra.InvalidArgumentError):
+        w.set_constraint_plasticity(None, "distance", 0, -1.0, 0.0)
+    # Past a rupture of 0.015 the link breaks: one event names it, then the list is empty.
+    w, b = hanging(damping=6.0)
+    w.add_constraint("distance", [b.first, b.first + 1], rest=1.0, compliance=1e-3)
+    w.set_constraint_plasticity(None, "distance", 0, 0.0, 0.015)
+    w.step(60)
+    events = w.broken()
+    assert len(events) == 1
+    e = events[0]
+    assert (e["kind"], e["index"], e["particles"]) == ("distance", 0, [b.first, b.first + 1])
+    assert e["strain"] > 0.015 and 0 < e["frame"] <= 60
+    assert w.broken() == [] and w.constraint_count(None, "distance") == (0, 0)

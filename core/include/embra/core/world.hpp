@@ -111,7 +111,20 @@ struct ConstraintInfo {
   ParticleSlots particles = no_particles();  // -1 past the kind's arity
   double rest = 0.0;                         // in the kind's unit, before any body's rest scale
   double compliance = 0.0;
-  int32_t body = -1;  // the body that generated it (it follows the body's material), or -1: added
+  int32_t body = -1;     // the body that generated it (it follows the body's material), or -1: added
+  double yield = 0.0;    // World::set_constraint_plasticity; 0 = elastic
+  double rupture = 0.0;  // 0 = unbreakable
+};
+
+/// A constraint that broke (World::set_constraint_plasticity): named as it was named when it
+/// broke, in the frame `frame` (the step that produced it), with the strain it broke at.
+struct BrokenConstraint {
+  Id group;
+  Kind kind = Kind::distance;
+  int64_t index = 0;
+  ParticleSlots particles = no_particles();
+  int64_t frame = 0;
+  double strain = 0.0;
 };
 
 /// What a pin holds (the numbering is part of the C ABI: embra_pin_support). A plane or line
@@ -315,8 +328,11 @@ struct ConstraintArray {
   std::vector<double> compliance;
   std::vector<double> rest_now;  // rest after scaling, refreshed when scales change
   std::vector<double> lambda;    // for welds: 3 per constraint
-  size_t generated = 0;          // the first `generated` entries come from bodies, in body order; added
-                                 // constraints follow in the order added (so a saved world loads the same)
+  // Plasticity and rupture of an added distance or dihedral (World::set_constraint_plasticity):
+  // the strain past which its rest follows it, and past which it breaks; 0 = never.
+  std::vector<double> yield, rupture;
+  size_t generated = 0;  // the first `generated` entries come from bodies, in body order; added
+                         // constraints follow in the order added (so a saved world loads the same)
   size_t size() const { return rest.size(); }
 };
 
@@ -580,6 +596,16 @@ class World {
   int64_t move_constraint(Id group, Kind kind, int64_t index, Id to);
   /// Removes the constraint; the constraints after it in `group` move down by one.
   void remove_constraint(Id group, Kind kind, int64_t index);
+  /// Plasticity and rupture of an added distance or dihedral, checked after every step at the
+  /// step's end positions. Its strain is (length - rest) / rest for a distance (dimensionless) and
+  /// angle - rest (rad, wrapped) for a dihedral. Past `yield` (> 0) the rest follows the constraint
+  /// so that the strain is `yield` again (perfect plasticity: a permanent set); past `rupture`
+  /// (> 0) the constraint is removed (later ones move down by one) and reported by take_broken.
+  /// 0 turns either off; each finite, >= 0 (a distance of rest 0 has no strain: refused).
+  void set_constraint_plasticity(Id group, Kind kind, int64_t index, double yield, double rupture);
+  /// The constraints broken since the last call, in the order they broke; the list is emptied.
+  std::vector<BrokenConstraint> take_broken();
+  const std::vector<BrokenConstraint>& broken() const { return broken_; }
   /// A disabled group keeps its constraints and soft pins but is not projected, measured or
   /// diagnosed until enabled again. The contact group is always enabled.
   void set_group_enabled(Id group, bool enabled);
@@ -744,6 +770,7 @@ class World {
   void check_state_in_range();
   void end_frame();
   void measure();
+  void apply_plasticity();  // model/plasticity.cpp
   /// What a frame that does not complete restores (step): the state, and the pin targets,
   /// collider poses, gravity and rest scales that StepControl::before_frame may change.
   struct FrameStart {
@@ -793,6 +820,7 @@ class World {
   std::vector<TetherCache> tether_cache_;  // one per body
   bool rest_dirty_ = true;
   bool solver_dirty_ = true;
+  std::vector<BrokenConstraint> broken_;
   std::vector<SelfContact> self_contacts_;  // this substep's (Settings::self_collision)
   std::vector<FaceContact> face_contacts_;  // this substep's panel faces against spheres
   SelfCollisionCache self_cache_;
