@@ -105,6 +105,8 @@ static_assert(EMBRA_MAX_CONSTRAINTS == embra::limits::kMaxConstraints);
 static_assert(EMBRA_MAX_PASSES_PER_STEP == embra::limits::kMaxPassesPerStep);
 static_assert(EMBRA_MAX_OBJ_BYTES == embra::limits::kMaxObjBytes);
 static_assert(EMBRA_MAX_THREADS == embra::limits::kMaxThreads);
+static_assert(EMBRA_GLOBAL_SOLVE_AUTO == embra::kGlobalSolveAuto);
+static_assert(EMBRA_GLOBAL_SOLVE_AUTO_LIMIT == embra::kGlobalSolveAutoLimit);
 
 extern "C" {
 

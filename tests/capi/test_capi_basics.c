@@ -163,12 +163,16 @@ static void test_defaults(void) {
   CHECK_INT(s.tethers, 2);
   CHECK_INT(s.threads, 1);
   {
-    /* The form-finding preset: the defaults but for dt 1/15 s, 1 substep, 1 iteration and damping 6/s. */
+    /* The form-finding preset: the defaults but for dt 1/15 s, 1 substep, 1 iteration, damping 6/s and
+       the global solve on while its system is small. */
     embra_solver_def f = embra_form_finding_solver_def(), d = s;
     CHECK_NEAR(f.dt, 1.0 / 15.0, 0.0);
     CHECK_INT(f.substeps, 1);
     CHECK_INT(f.iterations, 1);
     CHECK_NEAR(f.damping, 6.0, 0.0);
+    CHECK_INT(f.global_solve, EMBRA_GLOBAL_SOLVE_AUTO);
+    CHECK_INT(s.global_solve, 0);
+    d.global_solve = f.global_solve;
     d.dt = f.dt;
     d.substeps = f.substeps;
     d.iterations = f.iterations;

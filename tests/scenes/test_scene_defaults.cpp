@@ -163,7 +163,8 @@ std::map<std::string, std::vector<json>> code_defaults() {
                                               {"tethers", s.tethers},
                                               {"self_collision", s.self_collision},
                                               {"chain_solve", s.chain_solve},
-                                              {"threads", s.threads}};
+                                              {"threads", s.threads},
+                                              {"global_solve", s.global_solve}};
   for (const auto& [key, value] : solver) c[d + "solver/properties/" + key] = {value, saved["solver"][key]};
 
   const embra_group_def g = embra_default_group_def();
@@ -353,7 +354,8 @@ void ranges(const std::string& dir) {
       {"tethers", &embra_solver_def::tethers},
       {"self_collision", &embra_solver_def::self_collision},
       {"chain_solve", &embra_solver_def::chain_solve},
-      {"threads", &embra_solver_def::threads}};
+      {"threads", &embra_solver_def::threads},
+      {"global_solve", &embra_solver_def::global_solve}};
   for (const auto& [key, member] : solver)
     same_range(scene, sp + key, [&, member = member](int64_t v) {
       return v >= INT32_MIN && v <= INT32_MAX && solver_accepts([&](embra_solver_def& s) {

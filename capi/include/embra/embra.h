@@ -118,6 +118,10 @@ enum {
 #define EMBRA_MAX_PASSES_PER_STEP 100000
 #define EMBRA_MAX_OBJ_BYTES 268435456
 #define EMBRA_MAX_THREADS 256
+/* embra_solver_def.global_solve: 2 turns the global solve on while its system has at most
+   EMBRA_GLOBAL_SOLVE_AUTO_LIMIT unknowns (3 per movable particle plus one per constraint row). */
+#define EMBRA_GLOBAL_SOLVE_AUTO 2
+#define EMBRA_GLOBAL_SOLVE_AUTO_LIMIT 20000
 
 /* The message of the last failed call on this thread ("" if none). Never NULL; valid until the
  * next embra call on this thread. */
@@ -237,39 +241,42 @@ typedef struct embra_solver_def {
                                   same bits at any count, so this changes only the time a step takes
                                   (128 x 128 cloth: 27.5 ms/frame on 1 thread, 17.1 on 2). The threads
                                   wait for work between steps without using the CPU */
-  int32_t global_solve;        /* 0 (default) or 1. 1: each substep is first solved as one system (the
-                                  global solve): the substep's implicit step over every constraint and
-                                  soft pin of the enabled groups, found by Newton's method on its energy
-                                  (1/2 |x - x~|^2_M + sum C^2 / (2 alpha~), hard constraints as a penalty
-                                  of 1e8 times their effective mass), with the geometric stiffness of
-                                  lengths in tension, a sparse LDL^T factorisation and a line search that
-                                  accepts only steps lowering the energy (it cannot blow up); the
-                                  multipliers are set from it and the `iterations` run on from there,
-                                  groups in their order and weight (hard constraints end exact; contacts,
-                                  pressure volumes and fields act in the iterations). A load carried
-                                  across a large or stiff structure needs no iterations to travel: the
-                                  statics are exact whatever the size. Costs a factorisation per Newton
-                                  iteration (up to 8 a substep, fewer near rest), one thread. The
-                                  form-finding preset uses it. This field was reserved0 (always 0) before
-                                  ABI 1.x added it: hosts that zero it keep the iterations alone. */
+  int32_t global_solve;        /* 0 (default), 1 or EMBRA_GLOBAL_SOLVE_AUTO (2). 1: each substep is first
+                                  solved as one system (the global solve): XPBD's implicit step over
+                                  every constraint and soft pin of the enabled groups, found by Newton's
+                                  method on its equations, one sparse LDL^T factorisation per Newton
+                                  iteration (up to 24 a substep; 2-10 at rest), with the geometric
+                                  stiffness of lengths in tension. Only steps that lower the residual
+                                  are taken, so it cannot blow up. The multipliers are set from it and
+                                  the `iterations` run on from there, groups in their order and weight
+                                  (they have the final word: contacts, pressure volumes, fields and the
+                                  automatic tethers act in them). A load carried across a net, a cable or
+                                  a stiff structure needs no iterations to travel: a settled form is its
+                                  exact statics whatever its size (a 64-link chain on the discrete
+                                  catenary to 4.9e-7 of its span, a 32 x 32 net's nodes in equilibrium
+                                  to 4.3e-13 of their weight, at the form-finding preset). A distance
+                                  compressed by more than 0.1 % is slack in it (the iterations push it
+                                  back). One thread; its cost grows faster than the system's size:
+                                  2 turns it on only while the system has at most
+                                  EMBRA_GLOBAL_SOLVE_AUTO_LIMIT unknowns, as the form-finding preset
+                                  does. This field was reserved0 (always 0) before: hosts that zero it
+                                  keep the iterations alone. */
 } embra_solver_def;
 
 EMBRA_API embra_solver_def embra_default_solver_def(void);
-/* The form-finding preset: the defaults with dt 1/15 s, 1 substep, 1 iteration and damping 6/s, for
- * the shape a structure comes to rest in rather than the motion on the way: every scene built with
- * it comes to rest (embra_world_solve says whether within tolerance). Large steps: the chain solve and
- * the tethers keep a cloth near inextensible. The 128 x 128 cloth hanging from two corners is at rest
- * (max speed under 1 mm/s, strain under 1 %, held 30 frames) after 44 frames, 0.19 s on 2 threads,
- * against 185 frames and 5.3 s on 1 thread at the defaults (BM_ClothToRest).
- * What it does not do: settle a structure on its exact equilibrium where a substep's fall g h^2
- * (4.4 cm at 1/15 s) is not small against its links, and tension makes the projections' dropped
- * geometric stiffness large (h^2 T / (m l) >> 1): a chain of 16 links of 7.5 cm built by hand comes
- * to rest stretched (its middle far below where 1.2 m of chain can reach) and embra_world_solve
- * reports it settled but out of tolerance, the distance residual named; a 32 x 32 net of links hung
- * from its corners rests with links stretched 145 %. For the exact shape of a chain, the defaults with
- * realign_passes 2 (and damping): 64 links settle on the discrete catenary to 7e-9 of the span. A
- * 32 x 32 net there still rests with links 2 % long (one pass a substep does not converge a net's
- * long-wavelength modes) and embra_world_solve says so (tests/unit/form_finding_test.cpp). */
+/* The form-finding preset: the defaults with dt 1/15 s, 1 substep, 1 iteration, damping 6/s and
+ * global_solve EMBRA_GLOBAL_SOLVE_AUTO, for the shape a structure comes to rest in rather than the
+ * motion on the way: every scene built with it comes to rest (embra_world_solve says whether within
+ * tolerance). Measured with no tuning (tests/unit/form_finding_test.cpp, FormFinding.ThePreset*):
+ * a chain of 64 links built by hand on an arc is at rest on the discrete catenary to 4.9e-7 of its
+ * span after 16 frames, its links at their length to 3e-17; a 32 x 32 net of links hung from its
+ * corners drawn in to 70 % is at rest after 30 frames, its links at length to 1.3e-16 m and every node
+ * in equilibrium (weight against link tensions) to 4.3e-13 of its weight. Both go through the global
+ * solve (their systems are small); a large cloth goes through the iterations alone, where large steps,
+ * the chain solve and the tethers keep it near inextensible: the 128 x 128 cloth hanging from two
+ * corners is at rest (max speed under 1 mm/s, strain under 1 %, held 30 frames) after 44 frames,
+ * against 185 frames at the defaults (BM_ClothToRest). Without the global solve (global_solve 0) the
+ * same chain comes to rest stretched and embra_world_solve reports it settled out of tolerance. */
 EMBRA_API embra_solver_def embra_form_finding_solver_def(void);
 
 /* Creates an empty world with a default group (order 0, weight 1) and a contact group

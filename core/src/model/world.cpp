@@ -101,7 +101,7 @@ void World::set_settings(const Settings& s) {
     invalid("settings.chebyshev_rho_milli must be in [0, 990]");
   if (s.self_collision != 0 && s.self_collision != 1) invalid("settings.self_collision must be 0 or 1");
   if (s.chain_solve != 0 && s.chain_solve != 1) invalid("settings.chain_solve must be 0 or 1");
-  if (s.global_solve != 0 && s.global_solve != 1) invalid("settings.global_solve must be 0 or 1");
+  if (s.global_solve < 0 || s.global_solve > kGlobalSolveAuto) invalid("settings.global_solve must be 0, 1 or 2");
   if (s.threads < 0 || s.threads > limits::kMaxThreads) invalid("settings.threads must be in [0, 256]");
   for (int k = 0; k < 3; ++k) check_finite(s.gravity[k], "settings.gravity");
   check_non_negative(s.damping, "settings.damping");

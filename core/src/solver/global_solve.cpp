@@ -184,8 +184,8 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
       }
     }
     // Soft pins and supports: held(x - target) = 0, a row per axis; held is the projection P (the
-    // polyline's across its segment at the closest point, or whole at a vertex), its rows the
-    // gradients.
+    // polyline's across its segment at the closest point, the mesh's along the face normal there,
+    // either whole at a vertex or edge), its rows the gradients.
     for (int32_t pi : g.soft_pins) {
       Pin& pin = pins_[pi];
       const Vec3 d = x[pin.particle] - pin.target;
@@ -201,6 +201,14 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
         case PinSupport::polyline: {
           const CurvePoint cp = closest_point_on_polyline(pin.curve, pin.closed, d);
           if (cp.inside_segment) proj -= cp.tangent * cp.tangent.transpose();
+          break;
+        }
+        case PinSupport::axes:
+          proj = pin.axis.cwiseAbs().asDiagonal();  // the held coordinates' flags, 1 or 0
+          break;
+        case PinSupport::mesh: {
+          const SurfacePoint cp = closest_point_on_mesh(pin.curve, pin.triangles, d);
+          if (cp.inside_face) proj = cp.normal * cp.normal.transpose();
           break;
         }
         case PinSupport::point:
@@ -237,6 +245,7 @@ void World::global_step(double h) {
   if (static_cast<int64_t>(gs.warm.size()) != gs.rows) gs.warm.assign(static_cast<size_t>(gs.rows), 0.0);
   global_terms(x_, inv_h2, static_cast<int>(Pass::warm), 0.0, false, false);
   const int64_t size = 3 * blocks + gs.rows;
+  if (settings_.global_solve == kGlobalSolveAuto && size > kGlobalSolveAutoLimit) return;
   gs.step.setZero(size);
   // F at x and lambda + t dl into gs.residual; returns |W F1|^2 + |F2|^2.
   const auto evaluate = [&](const std::vector<Vec3>& x, double t, bool matrix) {

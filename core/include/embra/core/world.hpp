@@ -214,10 +214,17 @@ struct Settings {
   // the result is the same bits at any count.
   int32_t threads = 1;
   // 1: each substep's implicit problem over every constraint and soft pin of the enabled groups is
-  // first solved as one system, by Newton's method on its energy with a sparse factorisation
-  // (solver/global_solve.cpp), then the iterations run on from it; 0 (default): the iterations alone.
+  // first solved as one system, by Newton's method with a sparse factorisation
+  // (solver/global_solve.cpp), then the iterations run on from it; 0 (default): the iterations alone;
+  // kGlobalSolveAuto (2): as 1 while the system has at most kGlobalSolveAutoLimit unknowns.
   int32_t global_solve = 0;
 };
+
+/// Settings::global_solve's automatic mode, and its limit: 3 unknowns per movable particle plus one
+/// per constraint row (a weld and a soft pin have 3). A direct factorisation's cost grows faster than
+/// the size (embra_solver_def.global_solve has the figures), the iterations' with it.
+constexpr int32_t kGlobalSolveAuto = 2;
+constexpr int64_t kGlobalSolveAutoLimit = 20000;
 
 struct GroupReport {
   int64_t count = 0;
@@ -533,7 +540,7 @@ inline Settings form_finding_settings() {
   s.substeps = 1;
   s.iterations = 1;
   s.damping = 6.0;
-  s.global_solve = 1;
+  s.global_solve = kGlobalSolveAuto;
   return s;
 }
 
