@@ -561,7 +561,7 @@ static void test_solver_and_gravity(void) {
   d.version = 3;
   REFUSED(EMBRA_ERROR_VERSION, "version", embra_world_set_solver(W, &d));
   d = embra_default_solver_def();
-  d.global_solve = 2;
+  d.global_solve = EMBRA_GLOBAL_SOLVE_AUTO + 1;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "global_solve", embra_world_set_solver(W, &d));
   d.global_solve = -1;
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "global_solve", embra_world_set_solver(W, &d));
