@@ -118,8 +118,9 @@ enum {
 #define EMBRA_MAX_PASSES_PER_STEP 100000
 #define EMBRA_MAX_OBJ_BYTES 268435456
 #define EMBRA_MAX_THREADS 256
-/* embra_solver_def.global_solve: 2 turns the global solve on while its system has at most
-   EMBRA_GLOBAL_SOLVE_AUTO_LIMIT unknowns (3 per movable particle plus one per constraint row). */
+/* embra_solver_def.global_solve: 2 turns the global solve on in a world without colliders or
+   self-collision while its system has at most EMBRA_GLOBAL_SOLVE_AUTO_LIMIT unknowns (3 per movable
+   particle plus one per constraint row). */
 #define EMBRA_GLOBAL_SOLVE_AUTO 2
 #define EMBRA_GLOBAL_SOLVE_AUTO_LIMIT 20000
 
@@ -256,8 +257,11 @@ typedef struct embra_solver_def {
                                   catenary to 4.9e-7 of its span, a 32 x 32 net's nodes in equilibrium
                                   to 4.3e-13 of their weight, at the form-finding preset). A distance
                                   compressed by more than 0.1 % is slack in it (the iterations push it
-                                  back). One thread; its cost grows faster than the system's size:
-                                  2 turns it on only while the system has at most
+                                  back). Contacts are not rows of it: with colliders it pulls into them
+                                  what the contacts push out (the 4 x 4 POQ drape at the preset with it
+                                  never came to rest). One thread; its cost grows faster than the
+                                  system's size. 2 turns it on only in a world without colliders or
+                                  self-collision and while the system has at most
                                   EMBRA_GLOBAL_SOLVE_AUTO_LIMIT unknowns, as the form-finding preset
                                   does. This field was reserved0 (always 0) before: hosts that zero it
                                   keep the iterations alone. */

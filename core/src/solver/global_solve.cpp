@@ -245,7 +245,14 @@ void World::global_step(double h) {
   if (static_cast<int64_t>(gs.warm.size()) != gs.rows) gs.warm.assign(static_cast<size_t>(gs.rows), 0.0);
   global_terms(x_, inv_h2, static_cast<int>(Pass::warm), 0.0, false, false);
   const int64_t size = 3 * blocks + gs.rows;
-  if (settings_.global_solve == kGlobalSolveAuto && size > kGlobalSolveAutoLimit) return;
+  if (settings_.global_solve == kGlobalSolveAuto) {
+    // Contacts are not rows of the solve: where they act it would pull into a collider what the
+    // contact projections push out, substep after substep (the POQ drape at the preset never came to
+    // rest). So the automatic mode leaves worlds with colliders or self-collision to the iterations.
+    const bool collides = settings_.self_collision != 0 ||
+                          std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; });
+    if (collides || size > kGlobalSolveAutoLimit) return;
+  }
   gs.step.setZero(size);
   // F at x and lambda + t dl into gs.residual; returns |W F1|^2 + |F2|^2.
   const auto evaluate = [&](const std::vector<Vec3>& x, double t, bool matrix) {

@@ -216,7 +216,8 @@ struct Settings {
   // 1: each substep's implicit problem over every constraint and soft pin of the enabled groups is
   // first solved as one system, by Newton's method with a sparse factorisation
   // (solver/global_solve.cpp), then the iterations run on from it; 0 (default): the iterations alone;
-  // kGlobalSolveAuto (2): as 1 while the system has at most kGlobalSolveAutoLimit unknowns.
+  // kGlobalSolveAuto (2): as 1 in a world without colliders or self-collision while the system has at
+  // most kGlobalSolveAutoLimit unknowns.
   int32_t global_solve = 0;
 };
 
