@@ -569,6 +569,7 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
                "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
+               "embra_collider_reaction": _capi.ColliderReaction, "embra_broken_constraint": _capi.BrokenConstraint,
                "embra_support_def": _capi.SupportDef, "embra_area_load": _capi.AreaLoad,
                "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef,
                "embra_mesh_support_def": _capi.MeshSupportDef}
