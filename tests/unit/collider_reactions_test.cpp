@@ -133,6 +133,35 @@ TEST(ColliderReactions, NetOnSphereAndPinsSumToTheLoad) {
   EXPECT_LT(imbalance, 1e-9);
 }
 
+/// The same net on the sphere, run twice on one thread and once on three: the same bits.
+TEST(ColliderReactions, SameBitsRunAfterRunAndOnThreeThreads) {
+  std::vector<std::vector<double>> runs;
+  for (const int threads : {1, 1, 3}) {
+    Settings s = resting_settings();
+    s.threads = threads;
+    World w(s);
+    ColliderDesc ball;
+    ball.shape = ColliderShape::sphere;
+    ball.radius = 0.6;
+    ball.position = Vec3(1.0, 1.1, -0.3);
+    w.create_collider(ball);
+    w.create_collider(ColliderDesc{});  // and the ground plane z = 0 the net's free corners reach
+    std::vector<Vec3> x;
+    const int32_t first = add_net(w, 9, 0.25, 0.5, 0.2, 1e-3, x);
+    test::hard_pin(w, first, x[0]);
+    for (int f = 0; f < 60; ++f) w.step();
+    std::vector<double> out;
+    for (const ColliderReaction& r : w.collider_reactions())
+      out.insert(out.end(), {r.force.x(), r.force.y(), r.force.z(), r.moment.x(), r.moment.y(), r.moment.z(),
+                             static_cast<double>(r.contacts)});
+    runs.push_back(out);
+  }
+  ASSERT_EQ(runs[0].size(), 14u);
+  EXPECT_GT(runs[0][6], 0.0);
+  EXPECT_EQ(runs[0], runs[1]);
+  EXPECT_EQ(runs[0], runs[2]);
+}
+
 /// A destroyed collider is not listed; one without contacts reads zero.
 TEST(ColliderReactions, ListsLiveCollidersInSlotOrder) {
   World w(resting_settings());
