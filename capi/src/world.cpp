@@ -354,6 +354,26 @@ embra_status embra_world_get_reactions(const embra_world* world, embra_reaction*
   });
 }
 
+embra_status embra_world_get_collider_reactions(const embra_world* world, embra_collider_reaction* out,
+                                                int32_t capacity, int32_t* out_count) {
+  return guard("embra_world_get_collider_reactions", world, [&] {
+    need(out_count, "out_count");
+    need_count(capacity, "capacity");
+    const std::vector<embra::ColliderReaction> r = world->world.collider_reactions();
+    const int32_t n = static_cast<int32_t>(r.size());
+    if (!fits(out, capacity, n, "collider reactions")) {
+      *out_count = n;
+      return;
+    }
+    for (int32_t i = 0; i < n; ++i)
+      out[i] = embra_collider_reaction{from_id<embra_collider_id>(r[i].collider),
+                                       r[i].contacts,
+                                       {r[i].force.x(), r[i].force.y(), r[i].force.z()},
+                                       {r[i].moment.x(), r[i].moment.y(), r[i].moment.z()}};
+    *out_count = n;
+  });
+}
+
 embra_status embra_world_get_warning(const embra_world* world, embra_warning* out_warning) {
   return guard("embra_world_get_warning", world, [&] {
     need(out_warning, "out_warning");

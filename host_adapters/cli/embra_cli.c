@@ -10,11 +10,11 @@
  *
  * `run` loads a scene (schemas/scene.schema.json), steps it N frames (default: the scene's own
  * "frames"; 0 loads and saves without stepping) and writes DIR/final.json (a complete scene to run
- * on), DIR/forces.json (reactions at the pins and member forces, N: write_forces), DIR/metrics.jsonl (one JSON object
- * per frame) and DIR/frame_NNNNN.obj every K frames; with panel meshes also their cut lists and, beside each OBJ, the
- * per-vertex error fields (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the mesh by; and
- * DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses. A DIR that holds anything
- * is refused (exit 1) unless --force, which writes into it.
+ * on), DIR/forces.json (reactions at the pins and colliders, member forces, N: write_forces), DIR/metrics.jsonl (one
+ * JSON object per frame) and DIR/frame_NNNNN.obj every K frames; with panel meshes also their cut lists and, beside
+ * each OBJ, the per-vertex error fields (frame_NNNNN.errors.json, final.errors.json) that the page's replay colours the
+ * mesh by; and DIR/index.json: the files written and, per OBJ frame, its files and the colliders' poses. A DIR that
+ * holds anything is refused (exit 1) unless --force, which writes into it.
  * --threads T steps on T threads (0: one per core; default: the scene's solver.threads): the same
  * bits at any T, and final.json keeps the scene's own setting. --until settled|tolerance steps with
  * embra_world_solve (N frames at most, 1000 by default) and prints why it stopped; it writes the
@@ -317,7 +317,7 @@ static int help(void) {
       "\n"
       "validate  loads SCENE.json (schemas/scene.schema.json) and builds its world; exit 0 if valid.\n"
       "run       steps the scene N frames (default: its own \"frames\"; 0: load and save only) and writes\n"
-      "          DIR/final.json, DIR/forces.json (pin reactions and member forces, N), DIR/metrics.jsonl,\n"
+      "          DIR/final.json, DIR/forces.json (pin and collider reactions, member forces, N), DIR/metrics.jsonl,\n"
       "          DIR/index.json and DIR/frame_NNNNN.obj every K frames.\n"
       "          --threads T steps on T threads (0: one per core; default: the scene's solver.threads);\n"
       "          the results are the same bits at any T, and final.json keeps the scene's own setting.\n"
@@ -820,14 +820,20 @@ static void run_index_frame(run_index* x, embra_world* world, long frame, const 
   text_printf(&x->frames, "]}");
 }
 
-/* Writes DIR/forces.json: the last step's statics (embra_world_get_reactions, embra_group_get_forces):
+/* Writes DIR/forces.json: the last step's statics (embra_world_get_reactions,
+ * embra_world_get_collider_reactions, embra_group_get_forces):
  * {"format": "embra-forces", "version": 1, "units": {"force": "N"},
  *  "reactions": [{"pin": [index, generation], "particle": p, "force": [x, y, z]}, ...],
  *  "reaction_sum": [x, y, z],
+ *  "colliders": [{"collider": [index, generation], "contacts": c, "force": [x, y, z],
+ *                 "moment": [x, y, z]}, ...],
+ *  "collider_sum": [x, y, z], "total": [x, y, z],
  *  "groups": [{"group": [index, generation], "distance": [tension, ...], "tether": [...],
  *              "equal_length": [...]}, ...]}
- * a group's kinds listed when it holds any, each constraint's tension (N, positive pulling its ends
- * together) in the order the constraints were added. */
+ * the colliders' forces on the world (N) and moments about their positions (N m); "total" is the
+ * pins' and colliders' sum, minus the total applied load at a static rest; a group's kinds listed
+ * when it holds any, each constraint's tension (N, positive pulling its ends together) in the order
+ * the constraints were added. */
 static int write_forces(const char* path, const embra_world* world) {
   FILE* f = open_write(path);
   if (!f) {
@@ -835,7 +841,7 @@ static int write_forces(const char* path, const embra_world* world) {
     return -1;
   }
   int rc = 0;
-  fputs("{\"format\":\"embra-forces\",\"version\":1,\"units\":{\"force\":\"N\"},\"reactions\":[", f);
+  fputs("{\"format\":\"embra-forces\",\"version\":1,\"units\":{\"force\":\"N\",\"moment\":\"N m\"},\"reactions\":[", f);
   int32_t n = 0;
   double sum[3] = {0.0, 0.0, 0.0};
   if (embra_world_get_reactions(world, NULL, 0, &n) != EMBRA_OK) rc = -1;
@@ -849,7 +855,24 @@ static int write_forces(const char* path, const embra_world* world) {
     }
     free(r);
   }
-  fprintf(f, "],\"reaction_sum\":[%.17g,%.17g,%.17g],\"groups\":[", sum[0], sum[1], sum[2]);
+  fprintf(f, "],\"reaction_sum\":[%.17g,%.17g,%.17g],\"colliders\":[", sum[0], sum[1], sum[2]);
+  double csum[3] = {0.0, 0.0, 0.0};
+  int32_t nc = 0;
+  if (rc == 0 && embra_world_get_collider_reactions(world, NULL, 0, &nc) != EMBRA_OK) rc = -1;
+  if (rc == 0 && nc > 0) {
+    embra_collider_reaction* c = malloc(sizeof *c * (size_t)nc);
+    if (!c || embra_world_get_collider_reactions(world, c, nc, &nc) != EMBRA_OK) rc = -1;
+    for (int32_t i = 0; rc == 0 && i < nc; ++i) {
+      fprintf(f,
+              "%s{\"collider\":[%u,%u],\"contacts\":%lld,\"force\":[%.17g,%.17g,%.17g],\"moment\":[%.17g,%.17g,%.17g]}",
+              i ? "," : "", c[i].collider.index, c[i].collider.generation, (long long)c[i].contacts, c[i].force[0],
+              c[i].force[1], c[i].force[2], c[i].moment[0], c[i].moment[1], c[i].moment[2]);
+      for (int k = 0; k < 3; ++k) csum[k] += c[i].force[k];
+    }
+    free(c);
+  }
+  fprintf(f, "],\"collider_sum\":[%.17g,%.17g,%.17g],\"total\":[%.17g,%.17g,%.17g],\"groups\":[", csum[0], csum[1],
+          csum[2], sum[0] + csum[0], sum[1] + csum[1], sum[2] + csum[2]);
   int32_t groups = 0;
   if (rc == 0 && embra_world_get_groups(world, NULL, 0, &groups) != EMBRA_OK) rc = -1;
   embra_group_id* ids = groups > 0 ? malloc(sizeof *ids * (size_t)groups) : NULL;

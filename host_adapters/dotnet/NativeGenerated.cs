@@ -367,6 +367,16 @@ namespace Embra
         public fixed double Force[3];
     }
 
+    /// <summary>embra_collider_reaction.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct ColliderReaction
+    {
+        public ColliderId Collider;
+        public long Contacts;
+        public fixed double Force[3];
+        public fixed double Moment[3];
+    }
+
     /// <summary>embra_group_report.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GroupReport
@@ -669,6 +679,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_residuals(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_forces(IntPtr world, GroupId group, int kind, [Out] double[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_reactions(IntPtr world, [Out] Reaction[] buffer, int capacity, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_collider_reactions(IntPtr world, [Out] ColliderReaction[] buffer, int capacity, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_report(IntPtr world, GroupId group, out GroupReport report);
         [DllImport(Library, CallingConvention = C)] public static extern SolveDef embra_default_solve_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_solve(IntPtr world, ref SolveDef def, out SolveResult result);

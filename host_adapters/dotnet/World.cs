@@ -1067,6 +1067,12 @@ namespace Embra
         /// the weights and point loads.</summary>
         public Reaction[] Reactions() { return Ids<Reaction>(Native.embra_world_get_reactions); }
 
+        /// <summary>The force (N) every live collider exerts on the world after the last step, from its
+        /// contacts of the last substep, normal push and friction (embra_world_get_collider_reactions),
+        /// colliders in creation-slot order: Force in N, Moment in N m about the collider's position. At a
+        /// static rest they and the pins' reactions sum to minus the weights and loads.</summary>
+        public ColliderReaction[] ColliderReactions() { return Ids<ColliderReaction>(Native.embra_world_get_collider_reactions); }
+
         public StepReport Report
         {
             get { var r = new StepReport(); Call(w => Native.embra_world_get_report(w, out r)); return r; }

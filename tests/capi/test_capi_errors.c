@@ -1830,6 +1830,7 @@ static void test_statics(void) {
   const double xyz[6] = {1, 2, 3, 4, 5, 6};
   double buf[64];
   embra_reaction r[8];
+  embra_collider_reaction cr[8];
   int32_t n32 = -7;
   int64_t n64 = -7;
   int i, k;
@@ -1858,6 +1859,18 @@ static void test_statics(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", embra_world_get_reactions(W, r, -1, &n32));
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out", embra_world_get_reactions(W, NULL, 8, &n32));
   REFUSED(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer", embra_world_get_reactions(W, r, 1, &n32));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", embra_world_get_collider_reactions(W, cr, 8, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "capacity", embra_world_get_collider_reactions(W, cr, -1, &n32));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out", embra_world_get_collider_reactions(W, NULL, 8, &n32));
+  /* Too small: nothing written (the sentinel survives), the count needed reported. */
+  n32 = -7;
+  memset(cr, 0xab, sizeof cr);
+  REFUSED(EMBRA_ERROR_BUFFER_TOO_SMALL, "buffer", embra_world_get_collider_reactions(W, cr, 1, &n32));
+  {
+    unsigned char sentinel[sizeof cr];
+    memset(sentinel, 0xab, sizeof sentinel);
+    CHECK(memcmp(cr, sentinel, sizeof cr) == 0);
+  }
 
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count",
           embra_group_get_forces(W, S->g_default, EMBRA_CONSTRAINT_DISTANCE, buf, 64, NULL));
@@ -1886,6 +1899,20 @@ static void test_statics(void) {
     for (i = 0; i < count; ++i) {
       CHECK(r[i].pin.index == pins[i].index && r[i].pin.generation == pins[i].generation);
       CHECK(isfinite(r[i].force[0]) && isfinite(r[i].force[1]) && isfinite(r[i].force[2]));
+    }
+    /* The colliders (the plane and the sphere; the destroyed one is not listed), in slot order. */
+    {
+      embra_collider_id cols[8];
+      int32_t nc = 0;
+      CHECK_OK(embra_world_get_colliders(s.w, cols, 8, &nc));
+      CHECK_OK(embra_world_get_collider_reactions(s.w, NULL, 0, &count));
+      CHECK(count == nc && count == 2);
+      CHECK_OK(embra_world_get_collider_reactions(s.w, cr, 8, &count));
+      for (i = 0; i < count; ++i) {
+        CHECK(cr[i].collider.index == cols[i].index && cr[i].collider.generation == cols[i].generation);
+        CHECK(cr[i].contacts >= 0);
+        for (k = 0; k < 3; ++k) CHECK(isfinite(cr[i].force[k]) && isfinite(cr[i].moment[k]));
+      }
     }
     CHECK_OK(embra_group_get_forces(s.w, s.g_custom, EMBRA_CONSTRAINT_DISTANCE, NULL, 0, &nf));
     CHECK(nf > 0 && nf <= 64);

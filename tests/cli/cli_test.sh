@@ -176,5 +176,30 @@ grep -Eq '^broke +distance 0 of group 0 \(particles 0 1\) in frame [0-9]+ at str
 grep -q '"constraints": \[' "$tmp/tear/final.json" && [ "$(grep -c '"rupture"' "$tmp/tear/final.json")" -eq 1 ] && ok ||
   bad "final.json must keep the unbroken link and its rupture strain"
 
+# forces.json carries the colliders' reactions: three loose particles (1, 1.5, 2 kg) at rest on a
+# ground plane, one under a point load whose horizontal part friction holds; the plane's force is
+# minus every weight and load (N, to 1e-9 relative), and "total" (pins + colliders) the same.
+cat >"$tmp/floor.json" <<'JSON'
+{"format": "embra-scene", "version": 1, "frames": 60,
+ "solver": {"substeps": 4, "iterations": 20, "damping": 5.0, "tethers": 0, "realign_passes": 2},
+ "bodies": [{"name": "p", "mesh": {"vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "masses": [1, 1.5, 2]},
+             "generate": []}],
+ "colliders": [{"name": "floor", "shape": "plane", "position": [0, 0, 0]}],
+ "loads": [{"particle": 2, "force": [0.5, 0, -2]}]}
+JSON
+"$embra" run "$tmp/floor.json" --out "$tmp/floor" >"$tmp/log" 2>&1 && ok || bad "the floor scene must run: $(cat "$tmp/log")"
+python3 - "$tmp/floor/forces.json" <<'PY' && ok || bad "forces.json: the floor's reaction is not minus the load"
+import json, math, sys
+f = json.load(open(sys.argv[1]))
+load = [0.5, 0.0, -9.81 * 4.5 - 2.0]
+c = f["colliders"]
+assert len(c) == 1 and c[0]["collider"][0] == 0 and c[0]["contacts"] == 3, c
+for key, v in (("force", c[0]["force"]), ("collider_sum", f["collider_sum"]), ("total", f["total"])):
+    err = math.dist(v, [-x for x in load]) / math.hypot(*load)
+    print(f"floor {key} + load: {err:.3g} of the load")
+    assert err < 1e-9, (key, v)
+assert f["units"]["moment"] == "N m" and f["reactions"] == []
+PY
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1155,7 +1155,7 @@ void Session::op_edit() {
         pins_.push_back(pin);
       break;
     }
-    case 12: {  // forces out: member forces and reactions, sized or not
+    case 12: {  // forces out: member forces, pin and collider reactions, sized or not
       int64_t n = 0;
       std::vector<double> forces(64);
       const bool ask = in_.chance(2);
@@ -1166,6 +1166,11 @@ void Session::op_edit() {
       int32_t m = 0;
       call("embra_world_get_reactions", false, [&] {
         return embra_world_get_reactions(world_, in_.chance(4) ? nullptr : reactions.data(), in_.u8() % 33, &m);
+      });
+      std::vector<embra_collider_reaction> colliders(32);
+      call("embra_world_get_collider_reactions", false, [&] {
+        return embra_world_get_collider_reactions(world_, in_.chance(4) ? nullptr : colliders.data(), in_.u8() % 33,
+                                                  &m);
       });
       break;
     }

@@ -1001,6 +1001,29 @@ typedef struct embra_reaction {
 EMBRA_API embra_status embra_world_get_reactions(const embra_world* world, embra_reaction* out, int32_t capacity,
                                                  int32_t* out_count);
 
+typedef struct embra_collider_reaction {
+  embra_collider_id collider;
+  int64_t contacts; /* its contacts that exerted a force in the last substep */
+  double force[3];  /* N: the force the collider exerts on the particles, summed over its contacts
+                       of the last substep: a particle contact's multiplier (a length) times the
+                       particle's mass over h^2, a panel face contact's (against a sphere) over h^2,
+                       along the contact normal where the solve left the particles; plus friction
+                       and the push back onto the surface after the solve (the displacement each
+                       gave, times the mass over h^2) */
+  double moment[3]; /* N m: the moment of those forces about the collider's position, each acting
+                       at its particle's position after the step (a face contact: at the point of
+                       its triangle nearest the sphere's centre) */
+} embra_collider_reaction;
+
+/* The force every live collider exerts on the world after the last step, colliders in
+ * creation-slot order (as embra_world_get_colliders); a collider without contacts reads 0. At a
+ * static rest the pins' reactions (embra_world_get_reactions) and the colliders' sum to minus the
+ * total applied load. A contact on a hard-pinned particle is not counted (its pin's reaction holds
+ * what the contact does not). Two-call pattern (out NULL, capacity 0: *out_count only; a smaller
+ * capacity is EMBRA_ERROR_BUFFER_TOO_SMALL and writes nothing). */
+EMBRA_API embra_status embra_world_get_collider_reactions(const embra_world* world, embra_collider_reaction* out,
+                                                          int32_t capacity, int32_t* out_count);
+
 typedef struct embra_group_report {
   int64_t count;       /* constraints in the group (soft pins and contacts included) */
   double residual_max; /* as in embra_step_report, over this group */

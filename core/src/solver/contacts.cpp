@@ -305,7 +305,10 @@ void World::settle_contacts_on_surface() {
     const double gap = contact_gap(c, closest, x_[i], x_prev_[i], radius_[i] + c.desc.thickness, n);
     // A swept contact never out through the far side (a thin plate): only when the closest point's
     // normal faces the way the particle came in.
-    if (gap < 0.0 && (!ct.swept || n.dot(c.rotation * ct.normal) > 0.0)) x_[i] -= gap * n;
+    if (gap < 0.0 && (!ct.swept || n.dot(c.rotation * ct.normal) > 0.0)) {
+      x_[i] -= gap * n;
+      ct.force_h2 -= (gap / w_[i]) * n;
+    }
   }
 }
 
@@ -313,27 +316,32 @@ void World::apply_friction() {
   // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
   // it is below mu_s times the normal push, else reduced by mu_k times it.
   Group& g = groups_[settings_.contact_group.index];
-  for (const Contact& ct : g.contacts) {
+  for (Contact& ct : g.contacts) {
     if (ct.lambda <= 0.0) continue;
     const Collider& c = colliders_[ct.collider];
     const int32_t i = ct.particle;
     Vec3 n;
     contact_gap(c, ct, x_[i], x_prev_[i], 0.0, n);
+    // The push as the solve left it, along the normal where it left the particle (the reactions).
+    ct.force_h2 = (ct.lambda / w_[i]) * n;
     const Vec3 slip = (x_[i] - x_prev_[i]) - (x_[i] - collider_point_before(c, x_[i]));
     const Vec3 tangential = slip - slip.dot(n) * n;
     const double len = tangential.norm();
     const double mu_s = std::sqrt(mu_s_[i] * c.desc.friction_static);
     const double mu_k = std::sqrt(mu_k_[i] * c.desc.friction_dynamic);
+    Vec3 moved = Vec3::Zero();
     if (len < mu_s * ct.lambda)
-      x_[i] -= tangential;
+      moved = -tangential;
     else if (len > 0.0)
-      x_[i] -= tangential * std::min(mu_k * ct.lambda / len, 1.0);
+      moved = -tangential * std::min(mu_k * ct.lambda / len, 1.0);
+    x_[i] += moved;
+    ct.force_h2 += moved / w_[i];
   }
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
   // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
   // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the
   // inverse of their joint mass).
-  for (const FaceContact& fc : face_contacts_) {
+  for (FaceContact& fc : face_contacts_) {
     if (fc.lambda <= 0.0) continue;
     const Collider& c = colliders_[fc.collider];
     const Vec3 bary = closest_barycentric(c.position, x_[fc.ids[0]], x_[fc.ids[1]], x_[fc.ids[2]]);
@@ -361,11 +369,15 @@ void World::apply_friction() {
       remove = tangential;
     else if (len > 0.0)
       remove = tangential * std::min(mu_k * push / len, 1.0);
+    double share = 0.0;  // of the movable corner pairs: pair k moves as a force b_k / denom remove / h^2
     for (int k = 0; k < 3; ++k) {
-      const Vec3 step = (slab_weight(fc.ids[k], fc.partner[k]) * bary[k] / denom) * remove;
+      const double ws = slab_weight(fc.ids[k], fc.partner[k]);
+      const Vec3 step = (ws * bary[k] / denom) * remove;
       x_[fc.ids[k]] -= step;
       x_[fc.partner[k]] -= step;
+      if (ws > 0.0) share += bary[k];
     }
+    fc.force_h2 = share * fc.lambda * n - (share / denom) * remove;
   }
 }
 

@@ -348,6 +348,12 @@ const Reaction = koffi.struct('embra_reaction', {
   reserved0: 'int32_t',
   force: koffi.array('double', 3, 'Array'),
 });
+const ColliderReaction = koffi.struct('embra_collider_reaction', {
+  collider: ColliderIdType,
+  contacts: 'int64_t',
+  force: koffi.array('double', 3, 'Array'),
+  moment: koffi.array('double', 3, 'Array'),
+});
 const GroupReport = koffi.struct('embra_group_report', {
   count: 'int64_t',
   residual_max: 'double',
@@ -513,6 +519,7 @@ const STRUCTS = {
   embra_constraint_residual: ConstraintResidual,
   embra_group_conflict: GroupConflict,
   embra_reaction: Reaction,
+  embra_collider_reaction: ColliderReaction,
   embra_group_report: GroupReport,
   embra_solve_def: SolveDef,
   embra_solve_result: SolveResult,
@@ -615,6 +622,7 @@ const PROTOTYPES = {
   embra_group_get_residuals: 'embra_status embra_group_get_residuals(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_group_get_forces: 'embra_status embra_group_get_forces(const embra_world *world, embra_group_id group, int32_t kind, double *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_world_get_reactions: 'embra_status embra_world_get_reactions(const embra_world *world, embra_reaction *out, int32_t capacity, _Out_ int32_t *out_count)',
+  embra_world_get_collider_reactions: 'embra_status embra_world_get_collider_reactions(const embra_world *world, embra_collider_reaction *out, int32_t capacity, _Out_ int32_t *out_count)',
   embra_group_get_report: 'embra_status embra_group_get_report(const embra_world *world, embra_group_id group, _Out_ embra_group_report *out_report)',
   embra_default_solve_def: 'embra_solve_def embra_default_solve_def(void)',
   embra_world_solve: 'embra_status embra_world_solve(embra_world *world, const embra_solve_def *def, _Out_ embra_solve_result *out_result)',
@@ -695,7 +703,7 @@ module.exports = {
   SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
   GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
   ConstraintDef, ConstraintBatchDef, BrokenConstraint, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef,
-  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, GroupReport, SolveDef,
-  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
-  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, ColliderReaction,
+  GroupReport, SolveDef, SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances,
+  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -1348,6 +1348,33 @@ class World {
     return result;
   }
 
+  /**
+   * The force (N) every live collider exerts on the world after the last step, from its contacts of
+   * the last substep, normal push and friction (embra_world_get_collider_reactions):
+   * [{collider (ColliderId), contacts, force ([x, y, z], N), moment ([x, y, z], N m about the
+   * collider's position)}], colliders in creation-slot order. At a static rest they and the pins'
+   * reactions sum to minus the weights and loads.
+   */
+  colliderReactions() {
+    const { koffi } = capi;
+    const n = [0];
+    this.#call('embra_world_get_collider_reactions', null, 0, n);
+    const size = koffi.sizeof(capi.ColliderReaction);
+    const out = Buffer.alloc(Math.max(n[0], 1) * size);
+    this.#call('embra_world_get_collider_reactions', out, n[0], n);
+    const result = [];
+    for (let k = 0; k < n[0]; k++) {
+      const r = koffi.decode(out, k * size, capi.ColliderReaction);
+      result.push({
+        collider: new ColliderId(r.collider.index, r.collider.generation),
+        contacts: Number(r.contacts),
+        force: Array.from(r.force),
+        moment: Array.from(r.moment),
+      });
+    }
+    return result;
+  }
+
   report() {
     const r = {};
     this.#call('embra_world_get_report', r);

@@ -445,6 +445,16 @@ class Reaction(_Struct):
     ]
 
 
+class ColliderReaction(_Struct):
+    """embra_collider_reaction."""
+    _fields_ = [
+        ("collider", ColliderId),
+        ("contacts", c_int64),
+        ("force", c_double * 3),
+        ("moment", c_double * 3),
+    ]
+
+
 class GroupReport(_Struct):
     """embra_group_report."""
     _fields_ = [
@@ -732,6 +742,7 @@ PROTOTYPES = {
     "embra_group_get_residuals": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
     "embra_group_get_forces": (c_int32, [c_void_p, GroupId, c_int32, POINTER(c_double), c_int64, POINTER(c_int64)]),
     "embra_world_get_reactions": (c_int32, [c_void_p, POINTER(Reaction), c_int32, POINTER(c_int32)]),
+    "embra_world_get_collider_reactions": (c_int32, [c_void_p, POINTER(ColliderReaction), c_int32, POINTER(c_int32)]),
     "embra_group_get_report": (c_int32, [c_void_p, GroupId, POINTER(GroupReport)]),
     "embra_default_solve_def": (SolveDef, []),
     "embra_world_solve": (c_int32, [c_void_p, POINTER(SolveDef), POINTER(SolveResult)]),

@@ -17,7 +17,7 @@ from ctypes import byref, c_char, c_double, c_int32, c_int64, c_void_p
 from . import _buffers as buf
 from . import _capi
 from ._capi import (AreaLoad, BodyDef, BodyId, ColliderDef, ColliderId, ConstraintBatchDef, ConstraintDef, FieldId, GroupDef,
-                    ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, Reaction, SolveResult, SolverDef,
+                    ConstraintResidual, GroupConflict, GroupId, GroupReport, KindResidual, Material, MetricSummary, PanelMetrics, PinDef, PinId, Reaction, ColliderReaction, SolveResult, SolverDef,
                     StepReport, PressureDef, SurfaceTensionDef, VortexDef, WindDef,
                     Tolerances, Warning, WorldCounts, LineLoad, lib)
 from .errors import EmbraError, check, error_for
@@ -1005,6 +1005,19 @@ class World:
         self._call("embra_world_get_reactions", out, n.value, byref(n))
         return [{"pin": PinId(r.pin.index, r.pin.generation), "particle": r.particle, "force": list(r.force)}
                 for r in out[:n.value]]
+
+    def collider_reactions(self):
+        """The force (N) every live collider exerts on the world after the last step, from its contacts
+        of the last substep, normal push and friction (embra_world_get_collider_reactions): a list of
+        dicts {collider (ColliderId), contacts, force ([x, y, z], N), moment ([x, y, z], N m about the
+        collider's position)}, colliders in creation-slot order. At a static rest they and the pins'
+        reactions sum to minus the weights and the point, area and line loads."""
+        n = c_int32()
+        self._call("embra_world_get_collider_reactions", None, 0, byref(n))
+        out = (ColliderReaction * max(n.value, 1))()
+        self._call("embra_world_get_collider_reactions", out, n.value, byref(n))
+        return [{"collider": ColliderId(r.collider.index, r.collider.generation), "contacts": r.contacts,
+                 "force": list(r.force), "moment": list(r.moment)} for r in out[:n.value]]
 
     def report(self):
         r = StepReport()

@@ -724,6 +724,61 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>Three loose particles (1, 1.5, 2 kg) resting on the ground plane z = 0, one with a point
+        /// load whose horizontal part friction holds: the plane's force is minus every weight and load,
+        /// its moment about its origin minus the loads' moment (N, N m, to 1e-9 relative).</summary>
+        [Test]
+        public void GroundPlaneReactionCarriesTheWeightsAndLoads()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 20;
+            solver.Damping = 5.0;
+            solver.Tethers = 0;
+            solver.RealignPasses = 2;
+            using (var w = new World(solver))
+            {
+                var floorDef = Library.DefaultColliderDef();
+                floorDef.Shape = (int)ColliderShape.Plane;
+                var floor = w.CreateCollider(floorDef);
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                double[] masses = { 1.0, 1.5, 2.0 };
+                w.CreateBody(new double[] { 0, 0, 0, 1, 0, 0, 0, 1, 0 }, masses: masses, def: def);
+                w.SetLoads(new double[] { 0.5, 0, -2 }, 2);
+                w.Step(50);
+                var loads = new double[3, 3];
+                for (int i = 0; i < 3; ++i) loads[i, 2] = -9.81 * masses[i];
+                loads[2, 0] = 0.5;
+                loads[2, 2] -= 2.0;
+                double[] p = w.GetPositions();
+                double[] total = new double[3], moment = new double[3];
+                for (int i = 0; i < 3; ++i)
+                {
+                    for (int k = 0; k < 3; ++k) total[k] += loads[i, k];
+                    moment[0] += p[3 * i + 1] * loads[i, 2] - p[3 * i + 2] * loads[i, 1];
+                    moment[1] += p[3 * i + 2] * loads[i, 0] - p[3 * i] * loads[i, 2];
+                    moment[2] += p[3 * i] * loads[i, 1] - p[3 * i + 1] * loads[i, 0];
+                }
+                var r = w.ColliderReactions();
+                Assert.AreEqual(1, r.Length);
+                Assert.AreEqual(floor, r[0].Collider);
+                Assert.AreEqual(3, r[0].Contacts);
+                double scale = Math.Sqrt(total[0] * total[0] + total[1] * total[1] + total[2] * total[2]);
+                double mscale = Math.Sqrt(moment[0] * moment[0] + moment[1] * moment[1] + moment[2] * moment[2]);
+                unsafe
+                {
+                    ColliderReaction c = r[0];
+                    for (int k = 0; k < 3; ++k)
+                    {
+                        Assert.AreEqual(-total[k], c.Force[k], 1e-9 * scale);
+                        Assert.AreEqual(-moment[k], c.Moment[k], 1e-9 * mscale);
+                    }
+                }
+                Assert.AreEqual(0, w.Reactions().Length);
+            }
+        }
+
         /// <summary>A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along
         /// (0, 3, -4): 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on
         /// each end (symplectic Euler: a h^2 n (n + 1) / 2 after n substeps). Refusals change nothing.</summary>

@@ -166,6 +166,42 @@ test('statics: two hard bars at 45 degrees carry a load, the pins react with eve
   w.close();
 });
 
+test('collider reactions: a ground plane carries the weights and loads resting on it', () => {
+  // Three loose particles (1, 1.5, 2 kg) on the plane z = 0, one with a point load whose horizontal
+  // part friction holds: the plane's force is minus every weight and load, its moment about its
+  // origin minus the loads' moment (N, N m, to 1e-9 relative).
+  const xyz = [[0, 0, 0], [1, 0, 0], [0, 1, 0]];
+  const masses = [1, 1.5, 2];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 20, damping: 5, tethers: 0,
+    realign_passes: 2 });
+  const floor = w.createCollider('plane', { position: [0, 0, 0] });
+  w.createBody(xyz, { generate: 0, masses });
+  w.setLoads([0.5, 0, -2], 2);
+  w.step(50);
+  const loads = masses.map((m) => [0, 0, -9.81 * m]);
+  loads[2] = [0.5, 0, -9.81 * 2 - 2];
+  const total = [0, 1, 2].map((k) => loads.reduce((a, f) => a + f[k], 0));
+  const p = Array.from(w.positions());
+  const moment = [0, 0, 0];
+  loads.forEach((f, i) => {
+    const x = p.slice(3 * i, 3 * i + 3);
+    moment[0] += x[1] * f[2] - x[2] * f[1];
+    moment[1] += x[2] * f[0] - x[0] * f[2];
+    moment[2] += x[0] * f[1] - x[1] * f[0];
+  });
+  const r = w.colliderReactions();
+  assert.equal(r.length, 1);
+  assert.ok(r[0].collider.equals(floor));
+  assert.equal(r[0].contacts, 3);
+  const scale = Math.hypot(...total);
+  for (let k = 0; k < 3; k++) {
+    assert.ok(Math.abs(r[0].force[k] + total[k]) < 1e-9 * scale, `force ${k}`);
+    assert.ok(Math.abs(r[0].moment[k] + moment[k]) < 1e-9 * Math.hypot(...moment), `moment ${k}`);
+  }
+  assert.equal(w.reactions().length, 0);
+  w.close();
+});
+
 test('area and line loads push free particles by p A / 3 and q L / 2, and read back', () => {
   // A free triangle of three 0.5 kg particles (0.5 m^2) under 12 Pa per true area along (0, 3, -4):
   // 2 N, 4 m/s^2 on each corner; a free edge of length 2 under (1, 0, 0) N/m: 1 N on each end.

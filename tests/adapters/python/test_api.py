@@ -161,6 +161,34 @@ def test_statics_two_bar_truss_forces_and_reactions():
         assert list(flat(w.loads()))[:3] == [0.0, 0.0, 0.0]
 
 
+def test_collider_reactions_carry_what_rests_on_a_ground_plane():
+    """Three loose particles (1, 1.5, 2 kg) resting on the ground plane z = 0, one with a point load
+    whose horizontal part friction holds: the plane's force is minus every weight and load, and its
+    moment about its origin minus the loads' moment (N, N m, to 1e-9 relative)."""
+    xyz = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)]
+    masses = [1.0, 1.5, 2.0]
+    with embra.World(gravity=(0.0, 0.0, -9.81), substeps=4, iterations=20, damping=5.0, tethers=0,
+                     realign_passes=2) as w:
+        floor = w.create_collider("plane", position=(0.0, 0.0, 0.0))
+        w.create_body(xyz, generate=0, masses=masses)
+        w.set_loads([(0.5, 0.0, -2.0)], first=2)
+        w.step(50)
+        loads = [(0.0, 0.0, -9.81 * m) for m in masses]
+        loads[2] = (0.5, 0.0, -9.81 * masses[2] - 2.0)
+        total = [sum(f[k] for f in loads) for k in range(3)]
+        q = list(flat(w.positions()))
+        moment = [0.0, 0.0, 0.0]
+        for x, f in zip([q[3 * i:3 * i + 3] for i in range(3)], loads):
+            moment = [moment[0] + x[1] * f[2] - x[2] * f[1], moment[1] + x[2] * f[0] - x[0] * f[2],
+                      moment[2] + x[0] * f[1] - x[1] * f[0]]
+        r = w.collider_reactions()
+        assert len(r) == 1 and r[0]["collider"] == floor and r[0]["contacts"] == 3
+        scale = math.hypot(*total)
+        assert max(abs(r[0]["force"][k] + total[k]) for k in range(3)) < 1e-9 * scale
+        assert max(abs(r[0]["moment"][k] + moment[k]) for k in range(3)) < 1e-9 * math.hypot(*moment)
+        assert w.reactions() == []
+
+
 def test_area_and_line_loads_accelerate_free_particles_and_read_back():
     """A free triangle of three 0.5 kg particles (area 0.5 m^2) under a true-area load of 12 Pa along
     (0, 3, -4): each corner is pushed by 12 x 0.5 / 3 = 2 N along (0, 0.6, -0.8), 4 m/s^2, so after n
@@ -541,6 +569,7 @@ def test_struct_layouts_match_the_header(tmp_path, source_dir):
                "embra_wind_def": _capi.WindDef, "embra_pressure_def": _capi.PressureDef,
                "embra_surface_tension_def": _capi.SurfaceTensionDef, "embra_vortex_def": _capi.VortexDef,
                "embra_load_options": _capi.LoadOptions, "embra_reaction": _capi.Reaction,
+               "embra_collider_reaction": _capi.ColliderReaction, "embra_broken_constraint": _capi.BrokenConstraint,
                "embra_support_def": _capi.SupportDef, "embra_area_load": _capi.AreaLoad,
                "embra_line_load": _capi.LineLoad, "embra_polyline_support_def": _capi.PolylineSupportDef,
                "embra_mesh_support_def": _capi.MeshSupportDef}

@@ -273,6 +273,15 @@ struct Reaction {
   Vec3 force = Vec3::Zero();  // N
 };
 
+/// The force a collider exerts on the world after the last step (World::collider_reactions): the
+/// sum over its contacts of the last substep, normal push and friction.
+struct ColliderReaction {
+  Id collider;
+  Vec3 force = Vec3::Zero();   // N, on the particles
+  Vec3 moment = Vec3::Zero();  // N m, of those forces about the collider's position
+  int64_t contacts = 0;        // contacts that pushed (lambda > 0) in the last substep
+};
+
 struct StepReport {
   int64_t frame = 0;            // frames stepped since creation
   double time = 0.0;            // simulated seconds
@@ -412,6 +421,10 @@ struct Contact {
   bool swept = false;
   Vec3 normal = Vec3::Zero();
   double offset = 0.0;
+  // kg m: the contact's force on the particle in the last substep times h^2 (World::collider_reactions):
+  // its push lambda / w along the normal where the solve left the particle (recorded as friction
+  // starts), friction's and the push back onto the surface (settle_contacts_on_surface).
+  Vec3 force_h2 = Vec3::Zero();
 };
 
 /// A face contact (panel meshes against sphere colliders): the point of triangle `ids` (of either
@@ -426,6 +439,9 @@ struct FaceContact {
   int32_t partner[3];
   int32_t collider;
   double lambda;
+  // kg m: the contact's force on the movable corner pairs times h^2, normal push (as the solve left
+  // them) and friction (apply_friction; World::collider_reactions).
+  Vec3 force_h2 = Vec3::Zero();
 };
 
 struct Group {
@@ -719,6 +735,14 @@ class World {
   /// sliding support: its multiplier over h^2. A hard point pin: minus the sum of the particle's weight, its point load
   /// and the forces of every constraint, automatic tether and soft pin on it (the pin holds the rest).
   std::vector<Reaction> reactions() const;
+  /// The force every live collider exerts on the world (N), colliders in slot order, from the last
+  /// substep's contacts: a particle contact pushes m lambda / h^2 along its normal (its lambda is a
+  /// length), a panel face contact b_k lambda / h^2 along its normal on each movable corner pair k,
+  /// each normal taken where the solve left the particles; friction and the push back onto the
+  /// surface add the force whose displacement they gave (Contact::force_h2 / h^2). The moment is
+  /// about the collider's position, each force acting at its particle (a face contact: its contact
+  /// point).
+  std::vector<ColliderReaction> collider_reactions() const;
   const Warning& warning() const { return warning_; }
 
  private:
