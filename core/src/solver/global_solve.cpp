@@ -83,7 +83,8 @@ void add_block(std::vector<Eigen::Triplet<double>>& out, int32_t ua, int32_t ub,
 /// into F1 (GlobalSolve::residual's particle part), writes F2 and, with `matrix`, emits K's
 /// constraint blocks, -J and -D into GlobalSolve::triplets (every row emits the same entries whether
 /// or not it is active, so the pattern never changes). Pass::evaluate with t and no matrix after an
-/// accepted step also stores lambda + t dl when `store`.
+/// accepted step also stores lambda + t dl when `store`. Pass::warm sets each row's multiplier from
+/// GlobalSolve::warm, Pass::keep copies them there after a kept solve, Pass::clear sets them to 0.
 void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_number, double t, bool matrix,
                          bool store) {
   GlobalSolve& gs = *global_;
