@@ -2434,8 +2434,9 @@ static void test_mesh_supports(void) {
 
 /* The panel builder's planarity refusal follows the tolerances in force: a quad with a corner 2e-5 m
  * off the plane of a 1 m square (its diagonals 1e-5 of an edge apart, refused by the old fixed 1e-6
- * bound) is refused under a document whose corner distance target is 1e-6 m, leaving the saved scene
- * as it was, and built under the default tolerances (corner distance target 5e-5 m). */
+ * bound; planarity 1 - 1/sqrt(1 + 2 (2e-5)^2) = 4e-10) is refused under a document whose planarity
+ * target is 1e-10, leaving the saved scene as it was, and built under the default tolerances
+ * (planarity target 1e-6). */
 static void test_panel_planarity_tolerance(void) {
   scene s;
   char* before;
@@ -2446,7 +2447,7 @@ static void test_panel_planarity_tolerance(void) {
   embra_body_id body;
   embra_panel_metrics m;
   CHECK(scene_build(&s));
-  t.planarity_distance.target = 1e-6;
+  t.planarity.target = 1e-10;
   CHECK_OK(embra_world_set_tolerances(s.w, &t));
   pd = embra_default_panel_mesh_def();
   pd.vertex_count = 4;

@@ -1255,7 +1255,8 @@ typedef struct embra_panel_mesh_def {
                               oriented, every edge on at most two quads, each quad planar within
                               the world's tolerances (embra_world_set_tolerances; the defaults
                               when none were set): planarity (1 - n1.n2) at most
-                              planarity.target, corner distance at most planarity_distance.target */
+                              planarity.target (the corner distance is reported in the metrics,
+                              not checked here) */
   int32_t quad_count;
   int32_t grid_columns;    /* grid (vertex_count 0): panels along +x (>= 1); default 4 */
   int32_t grid_rows;       /* panels along +y (>= 1); default 4 */

@@ -440,14 +440,18 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     for (int k = 0; k < 4; ++k)
       if (!((P(v[(k + 1) % 4]) - P(v[k])).norm() > 1e-9 * mean_edge))
         invalid(name + " is degenerate: an edge has zero length");
-    // Planar within the tolerances in force: the paper's planarity and the corner distance at most
-    // their targets (a real PQ mesh is planar to its optimiser's tolerance, not to rounding).
+    // Planar within the tolerances in force: the paper's planarity (1 - n1.n2, free of the mesh's
+    // scale) at most its target; a real PQ mesh is planar to its optimiser's tolerance, not to
+    // rounding. The corner distance is measured and reported at every frame but does not decide:
+    // a length in model units, its target (5e-5 m by default) is on a 1 m square with one corner
+    // raised a planarity of 2.5e-9 (1 - n1.n2 = d^2 / (1 + d^2)), 400 times below the planarity
+    // target, and so refused published PQ meshes well within the planarity target (see
+    // docs/design.md, "Panel meshes"). The hard planarity of each top quad takes it down as the
+    // world steps.
     const double planarity = quad_planarity(q0, q1, q2, q3);
-    const double corner = quad_corner_distance(q0, q1, q2, q3);
-    if (!(planarity <= d.tolerances.planarity.target) || !(corner <= d.tolerances.planarity_distance.target))
+    if (!(planarity <= d.tolerances.planarity.target))
       invalid(name + " is not planar within the tolerances: planarity " + g3(planarity) + " (target " +
-              g3(d.tolerances.planarity.target) + "), corner distance " + g3(corner) + " (target " +
-              g3(d.tolerances.planarity_distance.target) + ")");
+              g3(d.tolerances.planarity.target) + "), corner distance " + g3(quad_corner_distance(q0, q1, q2, q3)));
   }
 
   // --- bottom layer: each vertex offset to where its faces' offset planes meet ---

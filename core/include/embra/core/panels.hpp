@@ -59,15 +59,16 @@ struct PanelMeshDesc {
   Id group;                          // group of every constraint; null = the default group
   // The tolerances in force (the world's tolerance document; through the C ABI the one set with
   // embra_world_set_tolerances, in a scene its "tolerances"): a top quad is accepted when its
-  // planarity (quad_planarity) and corner distance (quad_corner_distance) are within their targets.
+  // planarity (quad_planarity) is within its target. The corner distance (quad_corner_distance) is
+  // reported, not a gate (docs/design.md, "Panel meshes").
   Tolerances tolerances{};
 };
 
 /// Builds a panel mesh: one body (8 particles per panel, top and bottom triangles for drawing and
 /// face contact), its constraints, its pins and its layout. Every argument is checked first (a
 /// quad with a repeated or out-of-range vertex, a degenerate quad, a non-manifold edge, a
-/// non-positive thickness, a quad whose planarity or corner distance is beyond the target of
-/// desc.tolerances are refused) and nothing changes on a refusal. Returns the body.
+/// non-positive thickness, a quad whose planarity is beyond the target of desc.tolerances are
+/// refused) and nothing changes on a refusal. Returns the body.
 Id build_panel_mesh(World& world, const PanelMeshDesc& desc);
 
 /// The vertices (3 each) and quads (4 each) of an n x m grid of square panels of side `size` in the
