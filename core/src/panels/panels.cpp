@@ -487,13 +487,16 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   }
 
   // --- boundary joints planar: the offsets moved along what their faces leave free ---
-  // A boundary edge (a, b) of face f: both bottom corners lie on f's offset plane, so its joint
-  // face (a, b and their bottom corners) is planar exactly when the bottom edge is parallel to the
-  // top one: (y_b - y_a) . m = 0 with m = n_f x (b - a), linear in the offsets. Each offset may move
-  // along its free directions (a line for a vertex on two faces, a plane for one on one face); the
-  // moves are the least-norm least-squares solution of these equations, exact when no boundary
-  // vertex is on three faces or more (inner joints are planar wherever the faces round each vertex
-  // decide its offset: a planar quad mesh conical at its inner vertices).
+  // A boundary edge (a, b) of face f, top edge e = b - a, offsets y_a, y_b (bottom - top): its joint
+  // face (a, b and their bottom corners) is planar exactly when g = e . (y_a x y_b) / (t |e|) = 0.
+  // Each offset may move along its free directions (a line for a vertex on two faces, a plane for
+  // one on one face; moves that keep it on every offset plane of its faces). Where a and b lie on
+  // a plane parallel to f's offset plane (a planar quad), g = (y_b - y_a) . (n_f x e / |e|) is
+  // linear in the moves and one least-norm solve makes every boundary joint planar when no boundary
+  // vertex is on three faces or more; a quad planar only to a tolerance has top edges that leave
+  // that plane, and g has a small bilinear part: Newton steps (each the least-norm solution of the
+  // linearised equations) take it to rounding. Inner joints are planar wherever the faces round
+  // each vertex decide its offset: a planar quad mesh conical at its inner vertices.
   {
     std::vector<std::array<int32_t, 3>> edges;  // (a, b, face) of each boundary edge
     for (int64_t q = 0; q < np; ++q) {
@@ -510,22 +513,37 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
           column[v] = static_cast<int32_t>(unknowns);
           unknowns += static_cast<Eigen::Index>(free_dirs[v].size());
         }
-    if (unknowns > 0) {
-      // Least norm: step = A^T (A A^T + eps I)^-1 rhs, A sparse (a row per edge, its two vertices'
-      // directions); eps (1e-12 of A A^T's largest diagonal) keeps it defined where the equations
-      // cannot all hold, and then gives their least-squares solution to that order.
-      std::vector<Eigen::Triplet<double>> entries;
-      const auto rows = static_cast<Eigen::Index>(edges.size());
-      Eigen::VectorXd rhs(rows);
+    const auto rows = static_cast<Eigen::Index>(edges.size());
+    // g of every boundary edge at the current offsets; returns its largest magnitude.
+    auto residual = [&](Eigen::VectorXd& g) {
+      double worst = 0.0;
       for (size_t i = 0; i < edges.size(); ++i) {
         const auto& [va, vb, f] = edges[i];
-        const Vec3 m = face_normal[f].cross((P(vb) - P(va)).normalized());
+        const Vec3 e = P(vb) - P(va);
+        g(static_cast<Eigen::Index>(i)) = e.dot(offset[va].cross(offset[vb])) / (d.thickness * e.norm());
+        worst = std::max(worst, std::abs(g(static_cast<Eigen::Index>(i))));
+      }
+      return worst;
+    };
+    Eigen::VectorXd g(rows);
+    double worst = unknowns > 0 ? residual(g) : 0.0;
+    // At most 8 steps; a step that does not lower the largest |g| is undone and ends the loop.
+    for (int iteration = 0; iteration < 8 && unknowns > 0 && worst > 1e-14 * d.thickness; ++iteration) {
+      // Least norm: step = A^T (A A^T + eps I)^-1 (-g), A sparse (a row per edge: dg over its two
+      // vertices' directions); eps (1e-12 of A A^T's largest diagonal) keeps it defined where the
+      // equations cannot all hold, and then gives their least-squares solution to that order.
+      std::vector<Eigen::Triplet<double>> entries;
+      for (size_t i = 0; i < edges.size(); ++i) {
+        const auto& [va, vb, f] = edges[i];
+        const Vec3 e = P(vb) - P(va);
+        const double scale = 1.0 / (d.thickness * e.norm());
+        const Vec3 db = e.cross(offset[va]) * scale;  // dg/dy_b
+        const Vec3 da = offset[vb].cross(e) * scale;  // dg/dy_a
         const auto row = static_cast<Eigen::Index>(i);
-        rhs(row) = -(offset[vb] - offset[va]).dot(m);
         for (size_t k = 0; k < free_dirs[vb].size(); ++k)
-          entries.emplace_back(row, column[vb] + static_cast<Eigen::Index>(k), free_dirs[vb][k].dot(m));
+          entries.emplace_back(row, column[vb] + static_cast<Eigen::Index>(k), free_dirs[vb][k].dot(db));
         for (size_t k = 0; k < free_dirs[va].size(); ++k)
-          entries.emplace_back(row, column[va] + static_cast<Eigen::Index>(k), -free_dirs[va][k].dot(m));
+          entries.emplace_back(row, column[va] + static_cast<Eigen::Index>(k), free_dirs[va][k].dot(da));
       }
       Eigen::SparseMatrix<double> a(rows, unknowns);
       a.setFromTriplets(entries.begin(), entries.end());
@@ -536,12 +554,21 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
       eps.setIdentity();
       aat += (1e-12 * largest) * eps;
       const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(aat);
-      Eigen::VectorXd step = Eigen::VectorXd::Zero(unknowns);
-      if (largest > 0.0 && ldlt.info() == Eigen::Success) step = a.transpose() * ldlt.solve(rhs);
-      if (!step.allFinite()) step.setZero();
-      for (int64_t v = 0; v < nv; ++v)
-        for (size_t k = 0; column[v] >= 0 && k < free_dirs[v].size(); ++k)
-          offset[v] += step(column[v] + static_cast<Eigen::Index>(k)) * free_dirs[v][k];
+      if (!(largest > 0.0) || ldlt.info() != Eigen::Success) break;
+      const Eigen::VectorXd step = a.transpose() * ldlt.solve(-g);
+      if (!step.allFinite()) break;
+      auto move = [&](double sign) {
+        for (int64_t v = 0; v < nv; ++v)
+          for (size_t k = 0; column[v] >= 0 && k < free_dirs[v].size(); ++k)
+            offset[v] += sign * step(column[v] + static_cast<Eigen::Index>(k)) * free_dirs[v][k];
+      };
+      move(1.0);
+      const double next = residual(g);
+      if (!(next < worst)) {
+        move(-1.0);
+        break;
+      }
+      worst = next;
     }
   }
 
