@@ -62,14 +62,7 @@ std::vector<Vec3> circle(double r, int n) {
 
 Id polyline_support(World& w, int32_t particle, const Vec3& target, const std::vector<Vec3>& pts, bool closed,
                     double compliance = 0.0) {
-  PinDesc d;
-  d.particle = particle;
-  d.target = target;
-  d.support = PinSupport::polyline;
-  d.curve = pts;
-  d.closed = closed;
-  d.compliance = compliance;
-  return w.create_pin(d);
+  return test::shape_support(w, PinSupport::polyline, particle, target, pts, closed, {}, compliance);
 }
 
 TEST(PolylineSupport, DistanceGradientMatchesFiniteDifferences) {
@@ -81,14 +74,8 @@ TEST(PolylineSupport, DistanceGradientMatchesFiniteDifferences) {
       const CurvePoint c = closest_point_on_polyline(pts, closed, q);
       EXPECT_NEAR((q - c.point).norm(), distance_to_polyline(pts, closed, q), 1e-15);
       const Vec3 grad = (q - c.point).normalized();
-      for (int k = 0; k < 3; ++k) {
-        constexpr double e = 1e-6;
-        Vec3 a = q, b = q;
-        a[k] += e;
-        b[k] -= e;
-        const double fd = (distance_to_polyline(pts, closed, a) - distance_to_polyline(pts, closed, b)) / (2 * e);
-        worst = std::max(worst, std::abs(fd - grad[k]));
-      }
+      worst = std::max(
+          worst, test::gradient_error([&](const Vec3& y) { return distance_to_polyline(pts, closed, y); }, q, grad));
       if (c.inside_segment) {
         EXPECT_LT(std::abs(c.tangent.dot(q - c.point)), 1e-14) << "normal to its segment";
       }
@@ -121,22 +108,16 @@ TEST(PolylineSupport, ProjectionPutsTheParticleOnTheCurve) {
 TEST(PolylineSupport, BeadOnACircleStaysOnItAndRestsOnTheLowestSegment) {
   constexpr double r = 0.8;
   const std::vector<Vec3> pts = circle(r, 64);
-  Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG));
-  s.tethers = 0;
-  s.realign_passes = 2;
-  World w(s);
   const double m = 0.4;
   // Released at 60 degrees from the bottom, off the wire by 1 cm: the first projection puts it on.
   const double a0 = -std::numbers::pi / 2 + std::numbers::pi / 3;
   const Vec3 centre(1.0, 2.0, 3.0);
-  const int32_t p = test::add_particles(w, {centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0))}, {m});
-  const Id pin = polyline_support(w, p, centre, pts, true);
-  const double load[3] = {0.5, 0.0, -1.0};  // N
-  w.set_loads(p, load);
+  test::Bead bead(PinSupport::polyline, centre, pts, true, {},
+                  centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0)), m, Vec3(0.5, 0.0, -1.0), kG);
   double off = 0.0, lowest = INFINITY, highest = -INFINITY;
   for (int f = 0; f < 240; ++f) {
-    w.step();
-    const Vec3 x = w.positions()[p] - centre;
+    bead.world.step();
+    const Vec3 x = bead.offset();
     off = std::max(off, distance_to_polyline(pts, true, x));
     lowest = std::min(lowest, x.x());
     highest = std::max(highest, x.x());
@@ -147,20 +128,16 @@ TEST(PolylineSupport, BeadOnACircleStaysOnItAndRestsOnTheLowestSegment) {
   EXPECT_GT(highest, 0.3);
   // Damped, it settles where the wire's normal balances weight and load: on the lowest segment
   // (horizontal) when the load's pull along it is 0 there. Take the side load off and damp.
-  const double down[3] = {0.0, 0.0, -1.0};
-  w.set_loads(p, down);
-  Settings damped = w.settings();
-  damped.damping = 3.0;
-  w.set_settings(damped);
-  for (int f = 0; f < 1200; ++f) w.step();
-  const Vec3 x = w.positions()[p] - centre;
+  bead.set_load(Vec3(0.0, 0.0, -1.0));
+  bead.settle(3.0, 1200);
+  const Vec3 x = bead.offset();
   EXPECT_LT(distance_to_polyline(pts, true, x), 1e-9);
   EXPECT_NEAR(x.z(), pts[0].z(), 1e-9) << "on the lowest segment, z = " << pts[0].z();
   EXPECT_LT(std::abs(x.x()), std::abs(pts[0].x())) << "between its ends";
-  const std::vector<Reaction> reactions = w.reactions();
+  const std::vector<Reaction> reactions = bead.world.reactions();
   ASSERT_EQ(reactions.size(), 1u);
-  EXPECT_EQ(reactions[0].pin, pin);
-  const Vec3 total = Vec3(0.0, 0.0, -m * kG) + Vec3(0.0, 0.0, -1.0);
+  EXPECT_EQ(reactions[0].pin, bead.pin);
+  const Vec3 total = bead.pull();
   const double imbalance = (reactions[0].force + total).norm() / total.norm();
   RecordProperty("reaction_imbalance", test::sci(imbalance));
   EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
@@ -212,27 +189,22 @@ TEST(PolylineSupport, BeadSlidesAcrossVerticesAndRestsAtOneWithItsWholeLoad) {
       ASSERT_GT(far, 0u);
       ASSERT_LT(far, pts.size() - 1) << "an interior vertex";
     }
-    Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG));
-    s.tethers = 0;
-    s.realign_passes = 2;
-    World w(s);
     // Released 70 degrees round from the resting vertex, 1 cm off the wire.
     const double a0 = std::atan2(pts[far].z(), pts[far].x()) + 70.0 * std::numbers::pi / 180.0;
-    const int32_t p = test::add_particles(w, {centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0))}, {m});
-    const Id pin = polyline_support(w, p, centre, pts, true);
-    w.set_loads(p, std::span<const double>(c.load.data(), 3));
+    test::Bead bead(PinSupport::polyline, centre, pts, true, {},
+                    centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0)), m, c.load, kG);
     double off = 0.0, along = 0.0;
     std::set<size_t> visited;
     for (int f = 0; f < 240; ++f) {
-      w.step();
-      const Vec3 x = w.positions()[p] - centre;
+      bead.world.step();
+      const Vec3 x = bead.offset();
       off = std::max(off, distance_to_polyline(pts, true, x));
       // Strictly inside a segment the reaction is normal to it (the particle slides freely).
       const auto [seg, t] = closest_segment(pts, true, x);
       visited.insert(seg);
       if (t > 1e-6 && t < 1.0 - 1e-6) {
         const Vec3 e = (pts[(seg + 1) % n] - pts[seg]).normalized();
-        along = std::max(along, std::abs(w.reactions()[0].force.dot(e)) / pull.norm());
+        along = std::max(along, std::abs(bead.world.reactions()[0].force.dot(e)) / pull.norm());
       }
     }
     RecordProperty(std::string(c.name) + "_max_distance_sliding", test::sci(off));
@@ -240,16 +212,13 @@ TEST(PolylineSupport, BeadSlidesAcrossVerticesAndRestsAtOneWithItsWholeLoad) {
     EXPECT_LT(off, 1e-9) << "on the polyline at every frame while it slides";
     EXPECT_GT(visited.size(), 10u) << "it slid across many vertices";
     EXPECT_LT(along, 1e-9) << "inside a segment the reaction is normal to it";
-    Settings damped = w.settings();
-    damped.damping = 3.0;
-    w.set_settings(damped);
-    for (int f = 0; f < 1500; ++f) w.step();
-    const Vec3 x = w.positions()[p] - centre;
+    bead.settle(3.0, 1500);
+    const Vec3 x = bead.offset();
     RecordProperty(std::string(c.name) + "_rest_offset_from_vertex_m", test::sci((x - pts[far]).norm()));
     EXPECT_LT((x - pts[far]).norm(), 1e-9) << "at vertex " << far;
-    const std::vector<Reaction> reactions = w.reactions();
+    const std::vector<Reaction> reactions = bead.world.reactions();
     ASSERT_EQ(reactions.size(), 1u);
-    EXPECT_EQ(reactions[0].pin, pin);
+    EXPECT_EQ(reactions[0].pin, bead.pin);
     const double imbalance = (reactions[0].force + pull).norm() / pull.norm();
     RecordProperty(std::string(c.name) + "_reaction_imbalance", test::sci(imbalance));
     EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
@@ -273,16 +242,7 @@ TEST(PolylineSupport, OpenEndHoldsAndMovingTheTargetMovesTheCurve) {
 }
 
 TEST(PolylineSupport, SameBitsRunAfterRun) {
-  std::vector<Vec3> runs;
-  for (int run = 0; run < 2; ++run) {
-    Settings s = test::settings(4, 3, Vec3(0.0, 0.0, -kG));
-    s.tethers = 0;
-    World w(s);
-    const int32_t p = test::add_particles(w, {Vec3(0.7, 0.0, 0.1)}, {1.0});
-    polyline_support(w, p, Vec3::Zero(), circle(0.75, 40), true, 1e-5);
-    for (int f = 0; f < 100; ++f) w.step();
-    runs.push_back(w.positions()[p]);
-  }
+  const std::array<Vec3, 2> runs = test::support_run_twice(PinSupport::polyline, circle(0.75, 40), true, {}, kG);
   EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), sizeof(Vec3)));
 }
 
