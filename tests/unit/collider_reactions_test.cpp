@@ -21,16 +21,6 @@ Settings resting_settings() {
   return s;
 }
 
-/// Sum of the applied loads: weights m g of the movable particles and every point load (N).
-Vec3 applied_load(const World& w) {
-  Vec3 total = Vec3::Zero();
-  for (int32_t i = 0; i < w.particle_count(); ++i) {
-    if (w.inverse_masses()[i] > 0.0) total += w.settings().gravity / w.inverse_masses()[i];
-    total += w.loads()[i];
-  }
-  return total;
-}
-
 /// Moment of the applied loads about `about` (N m), each acting at its particle.
 Vec3 applied_moment(const World& w, const Vec3& about) {
   Vec3 total = Vec3::Zero();
@@ -43,28 +33,6 @@ Vec3 applied_moment(const World& w, const Vec3& about) {
   return total;
 }
 
-/// A grid of n x n particles `dx` apart in the plane z = z0, mass `mass` each, joined along its
-/// rows and columns by distance constraints of compliance `compliance` (m/N).
-int32_t add_net(World& w, int n, double dx, double z0, double mass, double compliance, std::vector<Vec3>& x) {
-  x.clear();
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) x.emplace_back(i * dx, j * dx, z0);
-  const int32_t first = test::add_particles(w, x, std::vector<double>(x.size(), mass));
-  std::vector<int32_t> ids;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const int32_t p = first + j * n + i;
-      if (i + 1 < n) ids.insert(ids.end(), {p, p + 1});
-      if (j + 1 < n) ids.insert(ids.end(), {p, p + n});
-    }
-  ConstraintDesc d;
-  d.kind = Kind::distance;
-  d.particles = ids;
-  d.uniform_compliance = compliance;
-  w.add_constraints(d);
-  return first;
-}
-
 /// A 6 x 6 net lying on a ground plane under gravity and three point loads, one of them with a
 /// horizontal part that friction holds. Nothing is pinned, so the plane carries everything: its
 /// force is minus the total weight and load, and its moment about its origin minus the loads'.
@@ -73,7 +41,7 @@ TEST(ColliderReactions, GroundPlaneCarriesTheWeightAndLoads) {
   ColliderDesc ground;  // the plane z = 0, normal +z
   const Id plane = w.create_collider(ground);
   std::vector<Vec3> x;
-  const int32_t first = add_net(w, 6, 0.25, 0.0, 0.5, 1e-4, x);
+  const int32_t first = test::add_net(w, 6, 0.25, 0.0, 0.5, 1e-4, x);
   const double loads[] = {0.0, 0.0, -40.0, 1.5, -0.5, -10.0, 0.0, 0.0, -25.0};
   const int32_t at[] = {first + 14, first + 22, first + 31};
   for (int k = 0; k < 3; ++k) w.set_loads(at[k], std::span<const double>(&loads[3 * k], 3));
@@ -83,7 +51,7 @@ TEST(ColliderReactions, GroundPlaneCarriesTheWeightAndLoads) {
   ASSERT_EQ(r.size(), 1u);
   EXPECT_EQ(r[0].collider.index, plane.index);
   EXPECT_EQ(r[0].contacts, 36);
-  const Vec3 load = applied_load(w);
+  const Vec3 load = test::applied_load(w);
   const double imbalance = (r[0].force + load).norm() / load.norm();
   const Vec3 moment = applied_moment(w, ground.position);
   const double moment_imbalance = (r[0].moment + moment).norm() / moment.norm();
@@ -106,7 +74,7 @@ TEST(ColliderReactions, NetOnSphereAndPinsSumToTheLoad) {
   const Id sphere = w.create_collider(ball);
   constexpr int n = 9;
   std::vector<Vec3> x;
-  const int32_t first = add_net(w, n, 0.25, 0.5, 0.2, 1e-3, x);
+  const int32_t first = test::add_net(w, n, 0.25, 0.5, 0.2, 1e-3, x);
   test::hard_pin(w, first, x[0]);
   test::hard_pin(w, first + n - 1, x[n - 1]);
   const double load[] = {0.0, 0.0, -3.0};
@@ -117,7 +85,7 @@ TEST(ColliderReactions, NetOnSphereAndPinsSumToTheLoad) {
   EXPECT_EQ(r[0].collider.index, sphere.index);
   Vec3 pins = Vec3::Zero();
   for (const Reaction& p : w.reactions()) pins += p.force;
-  const Vec3 total = applied_load(w);
+  const Vec3 total = test::applied_load(w);
   const double imbalance = (pins + r[0].force + total).norm() / total.norm();
   // The sphere carries a real share, and not straight up only (slanted contacts, friction).
   const double share = r[0].force.z() / -total.z();
@@ -147,7 +115,7 @@ TEST(ColliderReactions, SameBitsRunAfterRunAndOnThreeThreads) {
     w.create_collider(ball);
     w.create_collider(ColliderDesc{});  // and the ground plane z = 0 the net's free corners reach
     std::vector<Vec3> x;
-    const int32_t first = add_net(w, 9, 0.25, 0.5, 0.2, 1e-3, x);
+    const int32_t first = test::add_net(w, 9, 0.25, 0.5, 0.2, 1e-3, x);
     test::hard_pin(w, first, x[0]);
     for (int f = 0; f < 60; ++f) w.step();
     std::vector<double> out;
@@ -173,7 +141,7 @@ TEST(ColliderReactions, ListsLiveCollidersInSlotOrder) {
   const Id c = w.create_collider(far);
   w.destroy_collider(b);
   std::vector<Vec3> x;
-  add_net(w, 3, 0.25, 0.0, 0.5, 0.0, x);
+  test::add_net(w, 3, 0.25, 0.0, 0.5, 0.0, x);
   w.step();
   const std::vector<ColliderReaction> r = w.collider_reactions();
   ASSERT_EQ(r.size(), 2u);

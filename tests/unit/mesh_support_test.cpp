@@ -12,6 +12,7 @@
 //     the vertex farthest along weight + load (the mesh's lowest point for that pull) with a reaction
 //     that balances weight and load;
 //   - moving the target moves the mesh; the same bits run after run; bad meshes are refused.
+#include "closed_meshes.hpp"  // io::icosphere, the scenes' sphere (core/io/src)
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -19,7 +20,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <numbers>
 #include <vector>
 
@@ -54,47 +54,22 @@ double distance_to_mesh(const std::vector<Vec3>& v, const std::vector<Tri>& tris
   return best;
 }
 
-/// A unit icosphere: the icosahedron with each triangle split in four `levels` times, the new
-/// vertices pushed out to the sphere. Counter-clockwise seen from outside.
+/// The scenes' icosphere of `radius` (io::icosphere: the icosahedron with each triangle split in
+/// four `levels` times, the new vertices pushed out to the sphere; counter-clockwise seen from
+/// outside), as vertices and triangles.
 void icosphere(int levels, double radius, std::vector<Vec3>& v, std::vector<Tri>& tris) {
-  const double p = (1.0 + std::sqrt(5.0)) / 2.0;
-  v = {Vec3(-1, p, 0),  Vec3(1, p, 0),  Vec3(-1, -p, 0), Vec3(1, -p, 0), Vec3(0, -1, p),  Vec3(0, 1, p),
-       Vec3(0, -1, -p), Vec3(0, 1, -p), Vec3(p, 0, -1),  Vec3(p, 0, 1),  Vec3(-p, 0, -1), Vec3(-p, 0, 1)};
-  for (Vec3& x : v) x.normalize();
-  tris = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-          {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-          {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<int32_t, int32_t>, int32_t> mid;
-    auto midpoint = [&](int32_t a, int32_t b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      const int32_t i = static_cast<int32_t>(v.size() - 1);
-      mid[key] = i;
-      return i;
-    };
-    std::vector<Tri> finer;
-    for (const Tri& t : tris) {
-      const int32_t ab = midpoint(t[0], t[1]), bc = midpoint(t[1], t[2]), ca = midpoint(t[2], t[0]);
-      finer.insert(finer.end(), {Tri{t[0], ab, ca}, Tri{t[1], bc, ab}, Tri{t[2], ca, bc}, Tri{ab, bc, ca}});
-    }
-    tris = finer;
-  }
-  for (Vec3& x : v) x *= radius;
+  const io::SurfaceMesh m = io::icosphere(radius, levels);
+  v.clear();
+  tris.clear();
+  for (size_t i = 0; i + 2 < m.positions.size(); i += 3)
+    v.emplace_back(m.positions[i], m.positions[i + 1], m.positions[i + 2]);
+  for (size_t i = 0; i + 2 < m.triangles.size(); i += 3)
+    tris.push_back({m.triangles[i], m.triangles[i + 1], m.triangles[i + 2]});
 }
 
 Id mesh_support(World& w, int32_t particle, const Vec3& target, const std::vector<Vec3>& v,
                 const std::vector<Tri>& tris, double compliance = 0.0) {
-  PinDesc d;
-  d.particle = particle;
-  d.target = target;
-  d.support = PinSupport::mesh;
-  d.curve = v;
-  d.triangles = tris;
-  d.compliance = compliance;
-  return w.create_pin(d);
+  return test::shape_support(w, PinSupport::mesh, particle, target, v, false, tris, compliance);
 }
 
 TEST(MeshSupport, DistanceGradientMatchesFiniteDifferences) {
@@ -110,14 +85,7 @@ TEST(MeshSupport, DistanceGradientMatchesFiniteDifferences) {
     const SurfacePoint c = closest_point_on_mesh(v, tris, q);
     worst_value = std::max(worst_value, std::abs((q - c.point).norm() - distance_to_mesh(v, tris, q)));
     const Vec3 grad = (q - c.point).normalized();
-    for (int k = 0; k < 3; ++k) {
-      constexpr double e = 1e-6;
-      Vec3 a = q, b = q;
-      a[k] += e;
-      b[k] -= e;
-      const double fd = (distance_to_mesh(v, tris, a) - distance_to_mesh(v, tris, b)) / (2 * e);
-      worst = std::max(worst, std::abs(fd - grad[k]));
-    }
+    worst = std::max(worst, test::gradient_error([&](const Vec3& y) { return distance_to_mesh(v, tris, y); }, q, grad));
     if (c.inside_face) {
       ++inside;
       EXPECT_LT((q - c.point).cross(c.normal).norm(), 1e-14) << "along its face's normal";
@@ -190,22 +158,16 @@ TEST(MeshSupport, BeadOnASphereMeshStaysOnItAndRestsAtItsLowestVertex) {
   std::vector<Tri> tris;
   icosphere(2, R, v, tris);
   ASSERT_EQ(tris.size(), 320u);
-  Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG));
-  s.tethers = 0;
-  s.realign_passes = 2;
-  World w(s);
   const double m = 0.4;
   const Vec3 centre(1.0, 2.0, 3.0);
   // Released on the equator's side, 1 cm off the mesh: the first projection puts it on.
   const Vec3 start_dir = Vec3(0.9, 0.3, 0.1).normalized();
-  const int32_t p = test::add_particles(w, {centre + (R + 0.01) * start_dir}, {m});
-  const Id pin = mesh_support(w, p, centre, v, tris);
-  const double load[3] = {0.5, -0.3, -1.0};  // N
-  w.set_loads(p, load);
+  const Vec3 load(0.5, -0.3, -1.0);  // N
+  test::Bead bead(PinSupport::mesh, centre, v, false, tris, centre + (R + 0.01) * start_dir, m, load, kG);
   double off = 0.0, lowest = INFINITY;
   for (int f = 0; f < 240; ++f) {
-    w.step();
-    const Vec3 x = w.positions()[p] - centre;
+    bead.world.step();
+    const Vec3 x = bead.offset();
     off = std::max(off, distance_to_mesh(v, tris, x));
     lowest = std::min(lowest, x.z());
   }
@@ -214,21 +176,18 @@ TEST(MeshSupport, BeadOnASphereMeshStaysOnItAndRestsAtItsLowestVertex) {
   EXPECT_LT(lowest, -0.5 * R) << "it slid down round the sphere";
   // Damped, it settles where the pull (weight + load) is in the mesh's normal cone: at the vertex
   // farthest along the pull (a linear function over a convex polyhedron is largest at a vertex).
-  Settings damped = w.settings();
-  damped.damping = 3.0;
-  w.set_settings(damped);
-  for (int f = 0; f < 1500; ++f) w.step();
-  const Vec3 pull = Vec3(0.0, 0.0, -m * kG) + Vec3(load[0], load[1], load[2]);
+  bead.settle(3.0, 1500);
+  const Vec3 pull = bead.pull();
   size_t far = 0;
   for (size_t i = 1; i < v.size(); ++i)
     if (v[i].dot(pull) > v[far].dot(pull)) far = i;
-  const Vec3 x = w.positions()[p] - centre;
+  const Vec3 x = bead.offset();
   RecordProperty("rest_offset_from_vertex_m", test::sci((x - v[far]).norm()));
   EXPECT_LT((x - v[far]).norm(), 1e-9) << "at vertex " << far;
   EXPECT_LT(v[far].z(), -0.8 * R) << "in the sphere's lowest region";
-  const std::vector<Reaction> reactions = w.reactions();
+  const std::vector<Reaction> reactions = bead.world.reactions();
   ASSERT_EQ(reactions.size(), 1u);
-  EXPECT_EQ(reactions[0].pin, pin);
+  EXPECT_EQ(reactions[0].pin, bead.pin);
   const double imbalance = (reactions[0].force + pull).norm() / pull.norm();
   RecordProperty("reaction_imbalance", test::sci(imbalance));
   EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
@@ -257,16 +216,7 @@ TEST(MeshSupport, SameBitsRunAfterRun) {
   std::vector<Vec3> v;
   std::vector<Tri> tris;
   icosphere(2, 0.75, v, tris);
-  std::vector<Vec3> runs;
-  for (int run = 0; run < 2; ++run) {
-    Settings s = test::settings(4, 3, Vec3(0.0, 0.0, -kG));
-    s.tethers = 0;
-    World w(s);
-    const int32_t p = test::add_particles(w, {Vec3(0.7, 0.0, 0.1)}, {1.0});
-    mesh_support(w, p, Vec3::Zero(), v, tris, 1e-5);
-    for (int f = 0; f < 100; ++f) w.step();
-    runs.push_back(w.positions()[p]);
-  }
+  const std::array<Vec3, 2> runs = test::support_run_twice(PinSupport::mesh, v, false, tris, kG);
   EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), sizeof(Vec3)));
 }
 

@@ -8,6 +8,11 @@
 //   - a bead on a circle-shaped polyline (64 segments, a vertical wire) pulled by gravity and a
 //     point load swings and stays on the polyline to 1e-9 m at every frame; damped, it comes to rest
 //     on the lowest segment with a reaction normal to it that balances its weight and load;
+//   - a bead on a 48-gon sliding across its vertices stays on it to 1e-9 m with its reaction normal
+//     to the segment it is inside; damped, it rests at the vertex farthest along its pull (the
+//     closed polyline's seam, point 0, or an interior vertex), there to 1e-9 m, with a reaction that
+//     balances weight and load (a particle held at a vertex, its closest point inside a segment by
+//     rounding only, keeps its whole multiplier);
 //   - an open polyline holds its particle at its end; moving the target moves the curve;
 //   - the same bits run after run; bad curves are refused and change nothing.
 #include "test_support.hpp"
@@ -17,6 +22,9 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace embra {
@@ -36,26 +44,25 @@ double distance_to_polyline(const std::vector<Vec3>& pts, bool closed, const Vec
   return best;
 }
 
-/// A circle of radius r about the origin in the x-z plane, n points, the lowest segment horizontal.
-std::vector<Vec3> circle(double r, int n) {
+/// A circle of radius r about the origin in the x-z plane, n points, point k at the angle
+/// first + 2 pi k / n from +x (counter-clockwise seen from -y).
+std::vector<Vec3> circle(double r, int n, double first) {
   std::vector<Vec3> pts;
   for (int k = 0; k < n; ++k) {
-    const double a = -std::numbers::pi / 2 + std::numbers::pi / n + 2.0 * std::numbers::pi * k / n;
+    const double a = first + 2.0 * std::numbers::pi * k / n;
     pts.emplace_back(r * std::cos(a), 0.0, r * std::sin(a));
   }
   return pts;
 }
 
+/// The same circle with its lowest segment horizontal: the closing one, from point n - 1 to point 0.
+std::vector<Vec3> circle(double r, int n) {
+  return circle(r, n, -std::numbers::pi / 2 + std::numbers::pi / n);
+}
+
 Id polyline_support(World& w, int32_t particle, const Vec3& target, const std::vector<Vec3>& pts, bool closed,
                     double compliance = 0.0) {
-  PinDesc d;
-  d.particle = particle;
-  d.target = target;
-  d.support = PinSupport::polyline;
-  d.curve = pts;
-  d.closed = closed;
-  d.compliance = compliance;
-  return w.create_pin(d);
+  return test::shape_support(w, PinSupport::polyline, particle, target, pts, closed, {}, compliance);
 }
 
 TEST(PolylineSupport, DistanceGradientMatchesFiniteDifferences) {
@@ -67,14 +74,8 @@ TEST(PolylineSupport, DistanceGradientMatchesFiniteDifferences) {
       const CurvePoint c = closest_point_on_polyline(pts, closed, q);
       EXPECT_NEAR((q - c.point).norm(), distance_to_polyline(pts, closed, q), 1e-15);
       const Vec3 grad = (q - c.point).normalized();
-      for (int k = 0; k < 3; ++k) {
-        constexpr double e = 1e-6;
-        Vec3 a = q, b = q;
-        a[k] += e;
-        b[k] -= e;
-        const double fd = (distance_to_polyline(pts, closed, a) - distance_to_polyline(pts, closed, b)) / (2 * e);
-        worst = std::max(worst, std::abs(fd - grad[k]));
-      }
+      worst = std::max(
+          worst, test::gradient_error([&](const Vec3& y) { return distance_to_polyline(pts, closed, y); }, q, grad));
       if (c.inside_segment) {
         EXPECT_LT(std::abs(c.tangent.dot(q - c.point)), 1e-14) << "normal to its segment";
       }
@@ -107,22 +108,16 @@ TEST(PolylineSupport, ProjectionPutsTheParticleOnTheCurve) {
 TEST(PolylineSupport, BeadOnACircleStaysOnItAndRestsOnTheLowestSegment) {
   constexpr double r = 0.8;
   const std::vector<Vec3> pts = circle(r, 64);
-  Settings s = test::settings(8, 2, Vec3(0.0, 0.0, -kG));
-  s.tethers = 0;
-  s.realign_passes = 2;
-  World w(s);
   const double m = 0.4;
   // Released at 60 degrees from the bottom, off the wire by 1 cm: the first projection puts it on.
   const double a0 = -std::numbers::pi / 2 + std::numbers::pi / 3;
   const Vec3 centre(1.0, 2.0, 3.0);
-  const int32_t p = test::add_particles(w, {centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0))}, {m});
-  const Id pin = polyline_support(w, p, centre, pts, true);
-  const double load[3] = {0.5, 0.0, -1.0};  // N
-  w.set_loads(p, load);
+  test::Bead bead(PinSupport::polyline, centre, pts, true, {},
+                  centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0)), m, Vec3(0.5, 0.0, -1.0), kG);
   double off = 0.0, lowest = INFINITY, highest = -INFINITY;
   for (int f = 0; f < 240; ++f) {
-    w.step();
-    const Vec3 x = w.positions()[p] - centre;
+    bead.world.step();
+    const Vec3 x = bead.offset();
     off = std::max(off, distance_to_polyline(pts, true, x));
     lowest = std::min(lowest, x.x());
     highest = std::max(highest, x.x());
@@ -133,24 +128,101 @@ TEST(PolylineSupport, BeadOnACircleStaysOnItAndRestsOnTheLowestSegment) {
   EXPECT_GT(highest, 0.3);
   // Damped, it settles where the wire's normal balances weight and load: on the lowest segment
   // (horizontal) when the load's pull along it is 0 there. Take the side load off and damp.
-  const double down[3] = {0.0, 0.0, -1.0};
-  w.set_loads(p, down);
-  Settings damped = w.settings();
-  damped.damping = 3.0;
-  w.set_settings(damped);
-  for (int f = 0; f < 1200; ++f) w.step();
-  const Vec3 x = w.positions()[p] - centre;
+  bead.set_load(Vec3(0.0, 0.0, -1.0));
+  bead.settle(3.0, 1200);
+  const Vec3 x = bead.offset();
   EXPECT_LT(distance_to_polyline(pts, true, x), 1e-9);
   EXPECT_NEAR(x.z(), pts[0].z(), 1e-9) << "on the lowest segment, z = " << pts[0].z();
   EXPECT_LT(std::abs(x.x()), std::abs(pts[0].x())) << "between its ends";
-  const std::vector<Reaction> reactions = w.reactions();
+  const std::vector<Reaction> reactions = bead.world.reactions();
   ASSERT_EQ(reactions.size(), 1u);
-  EXPECT_EQ(reactions[0].pin, pin);
-  const Vec3 total = Vec3(0.0, 0.0, -m * kG) + Vec3(0.0, 0.0, -1.0);
+  EXPECT_EQ(reactions[0].pin, bead.pin);
+  const Vec3 total = bead.pull();
   const double imbalance = (reactions[0].force + total).norm() / total.norm();
   RecordProperty("reaction_imbalance", test::sci(imbalance));
   EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
   EXPECT_LT(std::abs(reactions[0].force.x()), 1e-9 * total.norm()) << "normal to the (horizontal) segment";
+}
+
+/// Where q's closest point on the polyline lies, the test's own way: the segment s and the
+/// parameter t along it of the nearest of every segment's clamped projection.
+std::pair<size_t, double> closest_segment(const std::vector<Vec3>& pts, bool closed, const Vec3& q) {
+  double best = INFINITY, best_t = 0.0;
+  size_t best_s = 0;
+  const size_t n = pts.size();
+  for (size_t s = 0; s < (closed ? n : n - 1); ++s) {
+    const Vec3 a = pts[s], b = pts[(s + 1) % n];
+    const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    const double d = (q - (a + t * (b - a))).norm();
+    if (d < best) best = d, best_t = t, best_s = s;
+  }
+  return {best_s, best_t};
+}
+
+TEST(PolylineSupport, BeadSlidesAcrossVerticesAndRestsAtOneWithItsWholeLoad) {
+  // A bead on a 48-gon of radius 0.8 m pulled by weight and a point load slides across its vertices
+  // and, damped, comes to rest at the vertex farthest along the pull: a linear function over the
+  // polygon is largest at a vertex, where the wire's normal cone holds any pull between its two
+  // segments' normals. There the whole multiplier must be kept, so the reaction balances weight and
+  // load. The polygon is turned so that this vertex is (a) its seam, point 0, where the closing
+  // segment meets the first, and (b) an interior vertex, with a sideways load.
+  constexpr double r = 0.8, m = 0.4;
+  constexpr int n = 48;
+  const Vec3 centre(1.0, 2.0, 3.0);
+  struct Case {
+    const char* name;
+    double first;  // the angle of point 0
+    Vec3 load;     // N
+  };
+  const Case cases[] = {{"seam", -std::numbers::pi / 2, Vec3(0.0, 0.0, -1.0)},
+                        {"interior", -std::numbers::pi / 2 + 0.05, Vec3(1.2, 0.0, -1.0)}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::vector<Vec3> pts = circle(r, n, c.first);
+    const Vec3 pull = Vec3(0.0, 0.0, -m * kG) + c.load;
+    size_t far = 0;
+    for (size_t i = 1; i < pts.size(); ++i)
+      if (pts[i].dot(pull) > pts[far].dot(pull)) far = i;
+    if (std::string(c.name) == "seam") {
+      ASSERT_EQ(far, 0u) << "the seam is the lowest point";
+    } else {
+      ASSERT_GT(far, 0u);
+      ASSERT_LT(far, pts.size() - 1) << "an interior vertex";
+    }
+    // Released 70 degrees round from the resting vertex, 1 cm off the wire.
+    const double a0 = std::atan2(pts[far].z(), pts[far].x()) + 70.0 * std::numbers::pi / 180.0;
+    test::Bead bead(PinSupport::polyline, centre, pts, true, {},
+                    centre + (r + 0.01) * Vec3(std::cos(a0), 0.0, std::sin(a0)), m, c.load, kG);
+    double off = 0.0, along = 0.0;
+    std::set<size_t> visited;
+    for (int f = 0; f < 240; ++f) {
+      bead.world.step();
+      const Vec3 x = bead.offset();
+      off = std::max(off, distance_to_polyline(pts, true, x));
+      // Strictly inside a segment the reaction is normal to it (the particle slides freely).
+      const auto [seg, t] = closest_segment(pts, true, x);
+      visited.insert(seg);
+      if (t > 1e-6 && t < 1.0 - 1e-6) {
+        const Vec3 e = (pts[(seg + 1) % n] - pts[seg]).normalized();
+        along = std::max(along, std::abs(bead.world.reactions()[0].force.dot(e)) / pull.norm());
+      }
+    }
+    RecordProperty(std::string(c.name) + "_max_distance_sliding", test::sci(off));
+    RecordProperty(std::string(c.name) + "_max_reaction_along_segment", test::sci(along));
+    EXPECT_LT(off, 1e-9) << "on the polyline at every frame while it slides";
+    EXPECT_GT(visited.size(), 10u) << "it slid across many vertices";
+    EXPECT_LT(along, 1e-9) << "inside a segment the reaction is normal to it";
+    bead.settle(3.0, 1500);
+    const Vec3 x = bead.offset();
+    RecordProperty(std::string(c.name) + "_rest_offset_from_vertex_m", test::sci((x - pts[far]).norm()));
+    EXPECT_LT((x - pts[far]).norm(), 1e-9) << "at vertex " << far;
+    const std::vector<Reaction> reactions = bead.world.reactions();
+    ASSERT_EQ(reactions.size(), 1u);
+    EXPECT_EQ(reactions[0].pin, bead.pin);
+    const double imbalance = (reactions[0].force + pull).norm() / pull.norm();
+    RecordProperty(std::string(c.name) + "_reaction_imbalance", test::sci(imbalance));
+    EXPECT_LT(imbalance, 1e-9) << "the reaction balances weight and load";
+  }
 }
 
 TEST(PolylineSupport, OpenEndHoldsAndMovingTheTargetMovesTheCurve) {
@@ -170,16 +242,7 @@ TEST(PolylineSupport, OpenEndHoldsAndMovingTheTargetMovesTheCurve) {
 }
 
 TEST(PolylineSupport, SameBitsRunAfterRun) {
-  std::vector<Vec3> runs;
-  for (int run = 0; run < 2; ++run) {
-    Settings s = test::settings(4, 3, Vec3(0.0, 0.0, -kG));
-    s.tethers = 0;
-    World w(s);
-    const int32_t p = test::add_particles(w, {Vec3(0.7, 0.0, 0.1)}, {1.0});
-    polyline_support(w, p, Vec3::Zero(), circle(0.75, 40), true, 1e-5);
-    for (int f = 0; f < 100; ++f) w.step();
-    runs.push_back(w.positions()[p]);
-  }
+  const std::array<Vec3, 2> runs = test::support_run_twice(PinSupport::polyline, circle(0.75, 40), true, {}, kG);
   EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), sizeof(Vec3)));
 }
 

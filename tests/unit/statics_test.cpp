@@ -180,20 +180,10 @@ TEST(Statics, CantileverTrussMemberForcesAreTheMethodOfJoints) {
   }
 }
 
-/// Sum of the applied loads: weights m g of the movable particles and every point load.
-Vec3 applied_load(const World& w) {
-  Vec3 total = Vec3::Zero();
-  for (int32_t i = 0; i < w.particle_count(); ++i) {
-    if (w.inverse_masses()[i] > 0.0) total += w.settings().gravity / w.inverse_masses()[i];
-    total += w.loads()[i];
-  }
-  return total;
-}
-
 double reaction_imbalance(const World& w) {
   Vec3 sum = Vec3::Zero();
   for (const Reaction& r : w.reactions()) sum += r.force;
-  const Vec3 load = applied_load(w);
+  const Vec3 load = test::applied_load(w);
   return (sum + load).norm() / load.norm();
 }
 
@@ -218,21 +208,7 @@ TEST(Statics, CableNetReactionsSumToTheAppliedLoad) {
   for (const int realign : {4, 0}) {
     World w(statics_settings(Vec3(0.0, 0.0, -kG), realign));
     std::vector<Vec3> x;
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) x.emplace_back(i * dx, j * dx, 0.0);
-    const int32_t first = test::add_particles(w, x, std::vector<double>(x.size(), 0.5));
-    std::vector<int32_t> ids;
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const int32_t p = first + j * n + i;
-        if (i + 1 < n) ids.insert(ids.end(), {p, p + 1});
-        if (j + 1 < n) ids.insert(ids.end(), {p, p + n});
-      }
-    ConstraintDesc d;
-    d.kind = Kind::distance;
-    d.particles = ids;
-    d.uniform_compliance = 1e-4;
-    w.add_constraints(d);
+    const int32_t first = test::add_net(w, n, dx, 0.0, 0.5, 1e-4, x);
     for (const int32_t c : {0, n - 1, n * (n - 1), n * n - 1}) test::hard_pin(w, first + c, x[c]);
     PinDesc soft;
     soft.particle = first + n / 2;

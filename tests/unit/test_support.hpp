@@ -6,10 +6,12 @@
 #include "embra/core/world.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -77,6 +79,137 @@ inline Id hard_pin(World& world, int32_t particle, const Vec3& target) {
   p.particle = particle;
   p.target = target;
   return world.create_pin(p);
+}
+
+/// A net of n x n particles `dx` apart in the plane z = z0 (row j, column i: the returned first
+/// particle + j n + i), of mass `mass` each, joined along its rows and columns by distance
+/// constraints of compliance `compliance` (m/N) in the default group, each particle's row link
+/// before its column link. `x` receives the particles' positions.
+inline int32_t add_net(World& w, int n, double dx, double z0, double mass, double compliance, std::vector<Vec3>& x) {
+  x.clear();
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.emplace_back(i * dx, j * dx, z0);
+  const int32_t first = add_particles(w, x, std::vector<double>(x.size(), mass));
+  std::vector<int32_t> ids;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int32_t p = first + j * n + i;
+      if (i + 1 < n) ids.insert(ids.end(), {p, p + 1});
+      if (j + 1 < n) ids.insert(ids.end(), {p, p + n});
+    }
+  ConstraintDesc d;
+  d.kind = Kind::distance;
+  d.particles = ids;
+  d.uniform_compliance = compliance;
+  w.add_constraints(d);
+  return first;
+}
+
+/// Sum of the applied loads (N): the weight m g of every movable particle and every point load,
+/// worked out from the masses, gravity and loads as set (not the solver's own sum).
+inline Vec3 applied_load(const World& w) {
+  Vec3 total = Vec3::Zero();
+  for (int32_t i = 0; i < w.particle_count(); ++i) {
+    if (w.inverse_masses()[i] > 0.0) total += w.settings().gravity / w.inverse_masses()[i];
+    total += w.loads()[i];
+  }
+  return total;
+}
+
+/// The largest difference over the three axes between `grad` and the central difference, step
+/// `e`, of the scalar function f at q: (f(q + e u_k) - f(q - e u_k)) / 2e.
+template <class F>
+double gradient_error(const F& f, const Vec3& q, const Vec3& grad, double e = 1e-6) {
+  double worst = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 a = q, b = q;
+    a[k] += e;
+    b[k] -= e;
+    const double fd = (f(a) - f(b)) / (2 * e);
+    worst = std::max(worst, std::abs(fd - grad[k]));
+  }
+  return worst;
+}
+
+/// A pin holding `particle` on a support whose geometry is given as offsets from `target` (moving
+/// the target moves it): a polyline (PinSupport::polyline: `points` in order, the last joined back
+/// to the first when `closed`) or a triangle mesh (PinSupport::mesh: `points` its vertices,
+/// `triangles` its triangles). Hard when `compliance` is 0, else compliant (m/N).
+inline Id shape_support(World& w, PinSupport support, int32_t particle, const Vec3& target,
+                        const std::vector<Vec3>& points, bool closed,
+                        const std::vector<std::array<int32_t, 3>>& triangles, double compliance) {
+  PinDesc d;
+  d.particle = particle;
+  d.target = target;
+  d.support = support;
+  d.curve = points;
+  d.closed = closed;
+  d.triangles = triangles;
+  d.compliance = compliance;
+  return w.create_pin(d);
+}
+
+/// A bead: one particle of mass `mass` released at `start` and held by a hard polyline or mesh
+/// support round `target` (shape_support), pulled by gravity (0, 0, -g) and the point load `load`;
+/// 8 substeps of 2 iterations a frame with 2 realignment passes (so that at rest its reaction is the
+/// exact static one), no automatic tethers. The supports' tests slide it over their curve or surface
+/// and let it come to rest.
+struct Bead {
+  World world;
+  int32_t particle = -1;
+  Id pin;
+  Vec3 target;
+  double mass = 0.0;
+  Vec3 load;
+
+  Bead(PinSupport support, const Vec3& at, const std::vector<Vec3>& points, bool closed,
+       const std::vector<std::array<int32_t, 3>>& triangles, const Vec3& start, double m, const Vec3& f, double g)
+      : world(bead_settings(g)), target(at), mass(m) {
+    particle = add_particles(world, {start}, {m});
+    pin = shape_support(world, support, particle, at, points, closed, triangles, 0.0);
+    set_load(f);
+  }
+  /// Where the bead is, from the support's target (m): in the support's own coordinates.
+  Vec3 offset() const { return world.positions()[particle] - target; }
+  /// Weight plus point load (N): what the support's reaction balances at rest.
+  Vec3 pull() const { return mass * world.settings().gravity + load; }
+  void set_load(const Vec3& f) {
+    load = f;
+    world.set_loads(particle, std::span<const double>(f.data(), 3));
+  }
+  /// Damps the motion at `rate` (1/s) and steps `frames` frames.
+  void settle(double rate, int frames) {
+    Settings damped = world.settings();
+    damped.damping = rate;
+    world.set_settings(damped);
+    for (int f = 0; f < frames; ++f) world.step();
+  }
+
+ private:
+  static Settings bead_settings(double g) {
+    Settings s = settings(8, 2, Vec3(0.0, 0.0, -g));
+    s.tethers = 0;
+    s.realign_passes = 2;
+    return s;
+  }
+};
+
+/// Where a particle of mass 1 released at (0.7, 0, 0.1) under gravity (0, 0, -g) and held by a
+/// compliant (1e-5 m/N) shape support round the origin (shape_support) is after 100 frames of 4
+/// substeps of 3 iterations, run twice in fresh worlds: the supports' same-bits check.
+inline std::array<Vec3, 2> support_run_twice(PinSupport support, const std::vector<Vec3>& points, bool closed,
+                                             const std::vector<std::array<int32_t, 3>>& triangles, double g) {
+  std::array<Vec3, 2> runs;
+  for (Vec3& end : runs) {
+    Settings s = settings(4, 3, Vec3(0.0, 0.0, -g));
+    s.tethers = 0;
+    World w(s);
+    const int32_t p = add_particles(w, {Vec3(0.7, 0.0, 0.1)}, {1.0});
+    shape_support(w, support, p, Vec3::Zero(), points, closed, triangles, 1e-5);
+    for (int f = 0; f < 100; ++f) w.step();
+    end = w.positions()[p];
+  }
+  return runs;
 }
 
 /// A flat grid cloth of nx by ny vertices in the plane z = z0, spacing `dx`, two triangles per cell;

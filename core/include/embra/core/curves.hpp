@@ -12,11 +12,17 @@
 
 namespace embra {
 
+/// A closest point counts as inside its segment (weights 1 - t and t) or triangle (barycentric
+/// weights) when each weight exceeds this: a particle held at a vertex or on an edge sits there only
+/// to rounding (weights of 1e-16), and must still read as held there (its whole multiplier kept), not
+/// as inside a segment or a face, whose multiplier keeps only its part across it.
+inline constexpr double kInsideWeight = 1e-9;
+
 /// The closest point of a polyline to q, and where it lies.
 struct CurvePoint {
   Vec3 point = Vec3::Zero();
   Vec3 tangent = Vec3::Zero();  // the unit direction of its segment, when inside one (else zero)
-  bool inside_segment = false;  // strictly between a segment's ends (else at a vertex)
+  bool inside_segment = false;  // between a segment's ends, t and 1 - t above kInsideWeight (else at a vertex)
   int64_t segment = -1;
 };
 
@@ -38,7 +44,7 @@ inline CurvePoint closest_point_on_polyline(std::span<const Vec3> points, bool c
     if (d2 < best_d2) {
       best_d2 = d2;
       best.point = c;
-      best.inside_segment = t > 0.0 && t < 1.0;
+      best.inside_segment = t > kInsideWeight && 1.0 - t > kInsideWeight;
       best.tangent = best.inside_segment ? Vec3(e.normalized()) : Vec3(Vec3::Zero());
       best.segment = static_cast<int64_t>(s);
     }
@@ -46,16 +52,11 @@ inline CurvePoint closest_point_on_polyline(std::span<const Vec3> points, bool c
   return best;
 }
 
-/// A closest point counts as inside its triangle when each barycentric weight exceeds this: a
-/// particle held at a vertex or on an edge sits there only to rounding (weights of 1e-16), and must
-/// still read as held there (its whole multiplier kept), not as inside a face.
-inline constexpr double kInsideFace = 1e-9;
-
 /// The closest point of a triangle mesh to q, and where it lies.
 struct SurfacePoint {
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::Zero();  // the unit normal of its triangle, when inside one (else zero)
-  bool inside_face = false;    // inside a triangle, every weight above kInsideFace (else on an edge or at a vertex)
+  bool inside_face = false;    // inside a triangle, every weight above kInsideWeight (else on an edge or at a vertex)
   int64_t triangle = -1;
 };
 
@@ -122,7 +123,7 @@ inline SurfacePoint closest_point_on_mesh(std::span<const Vec3> vertices,
     if (d2 < best_d2) {
       best_d2 = d2;
       best.point = p;
-      best.inside_face = weights.minCoeff() > kInsideFace;
+      best.inside_face = weights.minCoeff() > kInsideWeight;
       best.normal = best.inside_face ? Vec3((b - a).cross(c - a).normalized()) : Vec3(Vec3::Zero());
       best.triangle = static_cast<int64_t>(t);
     }
