@@ -284,12 +284,7 @@ TEST(PanelMesh, PerturbedConicalMeshPlanarWithinTheTolerancesIsBuiltWithinThem) 
   const Id body = build_panel_mesh(w, d);
   const PanelLayout& l = *w.panel_layout(body);
   const PanelReport r0 = report_panels(measure_panels(l, w.positions()), tol);
-  RecordProperty("frame0_planarity_top", test::sci(r0.planarity_top.max));
-  RecordProperty("frame0_corner_distance_top", test::sci(r0.corner_distance_top.max));
-  RecordProperty("frame0_thickness", test::sci(r0.thickness.max));
-  RecordProperty("frame0_miter", test::sci(r0.miter.max));
-  RecordProperty("frame0_planarity_bottom", test::sci(r0.planarity_bottom.max));
-  RecordProperty("frame0_corner_distance_bottom", test::sci(r0.corner_distance_bottom.max));
+  test::record_panel_report("frame0_", r0);
   EXPECT_LE(r0.planarity_top.max, tol.planarity.target);
   EXPECT_LE(r0.planarity_bottom.max, tol.planarity.target);
   EXPECT_LE(r0.corner_distance_top.max, tol.planarity_distance.target);

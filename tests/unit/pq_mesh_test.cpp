@@ -125,13 +125,7 @@ TEST(PublishedPqMesh, ConicalMeshFromDosIsBuiltWithinTheTolerances) {
 
   const PanelErrors e0 = measure_panels(l, w.positions());
   const PanelReport r0 = report_panels(e0, tol);
-  RecordProperty("frame0_planarity_top", test::sci(r0.planarity_top.max));
-  RecordProperty("frame0_planarity_bottom", test::sci(r0.planarity_bottom.max));
-  RecordProperty("frame0_thickness", test::sci(r0.thickness.max));
-  RecordProperty("frame0_miter", test::sci(r0.miter.max));
-  RecordProperty("frame0_corner_distance_top", test::sci(r0.corner_distance_top.max));
-  RecordProperty("frame0_corner_distance_bottom", test::sci(r0.corner_distance_bottom.max));
-  RecordProperty("frame0_conical_defect_rad", test::sci(r0.conical.max));
+  test::record_panel_report("frame0_", r0);
   EXPECT_LE(r0.planarity_top.max, tol.planarity.target);
   EXPECT_LE(r0.planarity_bottom.max, tol.planarity.target);
   EXPECT_LE(r0.thickness.max, tol.thickness.target);
@@ -162,10 +156,7 @@ TEST(PublishedPqMesh, ConicalMeshFromDosIsBuiltWithinTheTolerances) {
   // distance too.
   w.step();
   const PanelReport r1 = report_panels(measure_panels(l, w.positions()), tol);
-  RecordProperty("frame1_corner_distance_top", test::sci(r1.corner_distance_top.max));
-  RecordProperty("frame1_planarity_top", test::sci(r1.planarity_top.max));
-  RecordProperty("frame1_thickness", test::sci(r1.thickness.max));
-  RecordProperty("frame1_miter", test::sci(r1.miter.max));
+  test::record_panel_report("frame1_", r1);
   EXPECT_LE(r1.corner_distance_top.max, tol.planarity_distance.target);
   EXPECT_LE(r1.corner_distance_bottom.max, tol.planarity_distance.target);
   EXPECT_TRUE(r1.within_tolerance);

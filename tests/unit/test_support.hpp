@@ -3,7 +3,10 @@
 #pragma once
 
 #include "embra/core/constraint_math.hpp"
+#include "embra/core/panels.hpp"
 #include "embra/core/world.hpp"
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
@@ -42,6 +45,18 @@ inline std::string sci(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3e", v);
   return buf;
+}
+
+/// Records a panel report's worst planarity, corner distance (both layers), thickness, miter and
+/// conical defect as test properties, each name after `prefix` (as "frame0_").
+inline void record_panel_report(const std::string& prefix, const PanelReport& r) {
+  ::testing::Test::RecordProperty(prefix + "planarity_top", sci(r.planarity_top.max));
+  ::testing::Test::RecordProperty(prefix + "planarity_bottom", sci(r.planarity_bottom.max));
+  ::testing::Test::RecordProperty(prefix + "corner_distance_top", sci(r.corner_distance_top.max));
+  ::testing::Test::RecordProperty(prefix + "corner_distance_bottom", sci(r.corner_distance_bottom.max));
+  ::testing::Test::RecordProperty(prefix + "thickness", sci(r.thickness.max));
+  ::testing::Test::RecordProperty(prefix + "miter", sci(r.miter.max));
+  ::testing::Test::RecordProperty(prefix + "conical_defect_rad", sci(r.conical.max));
 }
 
 inline std::vector<double> flatten(const std::vector<Vec3>& xs) {

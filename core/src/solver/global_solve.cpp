@@ -294,9 +294,9 @@ void World::global_step(double h) {
     gs.ldlt.factorize(A);
     ++gs.factorisations;
     if (gs.ldlt.info() != Eigen::Success) break;
-    Eigen::VectorXd rhs = gs.residual;
-    rhs.head(3 * blocks) = -rhs.head(3 * blocks);
-    gs.step = gs.ldlt.solve(rhs);
+    gs.rhs = gs.residual;
+    gs.rhs.head(3 * blocks) = -gs.rhs.head(3 * blocks);
+    gs.step = gs.ldlt.solve(gs.rhs);
     if (!gs.step.allFinite()) break;
     double t = 1.0, tried = merit;
     for (int k = 0; k < kHalvings; ++k, t *= 0.5) {

@@ -27,7 +27,7 @@ struct GlobalSolve {
   std::vector<int64_t> pattern_outer;  // the pattern the symbolic factorisation was made for
   std::vector<int32_t> pattern_inner;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> ldlt;
-  Eigen::VectorXd residual, step;         // [F1 per block; F2 per row], [dx; dl]
+  Eigen::VectorXd residual, rhs, step;    // [F1 per block; F2 per row], [-F1; F2], [dx; dl]
   std::vector<Eigen::Vector3d> inertial;  // per particle: x~, where it goes with no constraint
   std::vector<Eigen::Vector3d> trial;     // per particle: a step's trial position
   int64_t factorisations = 0;             // numeric factorisations so far
