@@ -498,12 +498,11 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   // linearised equations) take it to rounding. Inner joints are planar wherever the faces round
   // each vertex decide its offset: a planar quad mesh conical at its inner vertices.
   {
-    std::vector<std::array<int32_t, 3>> edges;  // (a, b, face) of each boundary edge
+    std::vector<std::array<int32_t, 2>> edges;  // (a, b) of each boundary edge
     for (int64_t q = 0; q < np; ++q) {
       const int32_t* v = &d.quads[4 * q];
       for (int k = 0; k < 4; ++k)
-        if (undirected[edge_key(v[k], v[(k + 1) % 4])] == 1)
-          edges.push_back({v[k], v[(k + 1) % 4], static_cast<int32_t>(q)});
+        if (undirected[edge_key(v[k], v[(k + 1) % 4])] == 1) edges.push_back({v[k], v[(k + 1) % 4]});
     }
     std::vector<int32_t> column(nv, -1);  // the first unknown of each vertex's moves
     Eigen::Index unknowns = 0;
@@ -518,7 +517,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     auto residual = [&](Eigen::VectorXd& g) {
       double worst = 0.0;
       for (size_t i = 0; i < edges.size(); ++i) {
-        const auto& [va, vb, f] = edges[i];
+        const auto& [va, vb] = edges[i];
         const Vec3 e = P(vb) - P(va);
         g(static_cast<Eigen::Index>(i)) = e.dot(offset[va].cross(offset[vb])) / (d.thickness * e.norm());
         worst = std::max(worst, std::abs(g(static_cast<Eigen::Index>(i))));
@@ -534,7 +533,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
       // equations cannot all hold, and then gives their least-squares solution to that order.
       std::vector<Eigen::Triplet<double>> entries;
       for (size_t i = 0; i < edges.size(); ++i) {
-        const auto& [va, vb, f] = edges[i];
+        const auto& [va, vb] = edges[i];
         const Vec3 e = P(vb) - P(va);
         const double scale = 1.0 / (d.thickness * e.norm());
         const Vec3 db = e.cross(offset[va]) * scale;  // dg/dy_b
