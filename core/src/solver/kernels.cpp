@@ -744,30 +744,10 @@ const Kernels& kernels() {
 
 namespace {
 
-// Items per thread below which a range is not split: a part must outweigh the hand-over (a few
-// microseconds). A constraint costs tens of nanoseconds, a chain a few links' worth each.
-constexpr size_t kGrain = 512;
-constexpr size_t kChainGrain = 16;
-constexpr size_t kAlign = 4;  // parts start on a block of the widest lanes
-
-}  // namespace
-
-namespace {
-
-/// Calls run(begin, end, in_lanes, part) for each colour [starts[c], starts[c + 1]) in order: split
-/// over the pool's threads in blocks of lanes, except a shared tail (the last colour, when
-/// `shared_tail`: its items may overlap), which runs whole on the caller, one item at a time.
-template <class F>
-void each_colour(ThreadPool& pool, const std::vector<int32_t>& starts, bool shared_tail, size_t grain, F&& run) {
-  const size_t colours = starts.empty() ? 0 : starts.size() - 1;
-  for (size_t c = 0; c < colours; ++c) {
-    const size_t begin = static_cast<size_t>(starts[c]), end = static_cast<size_t>(starts[c + 1]);
-    if (shared_tail && c + 1 == colours)
-      run(begin, end, false, 0);
-    else
-      pool.run(begin, end, kAlign, grain, [&](size_t b, size_t e, int part) { run(b, e, true, part); });
-  }
-}
+using passes::each_colour;
+using passes::kAlign;
+using passes::kChainGrain;
+using passes::kGrain;
 
 }  // namespace
 

@@ -45,6 +45,42 @@ struct Kernels {
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels();
 
+namespace passes {
+
+// Items per thread below which a range is not split: a part must outweigh the hand-over (a few
+// microseconds). A constraint costs tens of nanoseconds, a chain a few links' worth each.
+inline constexpr size_t kGrain = 512;
+inline constexpr size_t kChainGrain = 16;
+inline constexpr size_t kAlign = 4;  // parts start on a block of the widest lanes
+
+/// Calls run(begin, end, in_lanes, part) for each colour [starts[c], starts[c + 1]) in order: split
+/// over the pool's threads in blocks of lanes, except a shared tail (the last colour, when
+/// `shared_tail`: its items may overlap), which runs whole on the caller, one item at a time.
+template <class F>
+void each_colour(ThreadPool& pool, const std::vector<int32_t>& starts, bool shared_tail, size_t grain, F&& run) {
+  const size_t colours = starts.empty() ? 0 : starts.size() - 1;
+  for (size_t c = 0; c < colours; ++c) {
+    const size_t begin = static_cast<size_t>(starts[c]), end = static_cast<size_t>(starts[c + 1]);
+    if (shared_tail && c + 1 == colours)
+      run(begin, end, false, 0);
+    else
+      pool.run(begin, end, kAlign, grain, [&](size_t b, size_t e, int part) { run(b, e, true, part); });
+  }
+}
+
+/// Calls project(i) for every constraint i of `a`, colour by colour, each colour's constraints
+/// split over the pool's threads (a shared tail in order on the caller): for the kinds projected
+/// one constraint at a time. Constraints of one colour share no particle, so every split gives the
+/// bits of the serial pass in colour order.
+template <class F>
+void each_constraint(ThreadPool& pool, const SolverArray& a, F&& project) {
+  each_colour(pool, a.colour_start, a.shared_tail, kGrain, [&](size_t b, size_t e, bool, int) {
+    for (size_t i = b; i < e; ++i) project(i);
+  });
+}
+
+}  // namespace passes
+
 // Whole passes, colour by colour, each colour's items split over the pool's threads. Items of one
 // colour share no movable particle and every kernel gives an item the same bits in a block or alone,
 // so the result does not depend on the thread count.

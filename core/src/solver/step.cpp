@@ -50,32 +50,33 @@ void each_particle(ThreadPool& pool, size_t n, F&& f) {
   });
 }
 
-/// Welds x0 = x1 (three multipliers each).
-void project_weld(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
-  for (size_t i = 0; i < a.size(); ++i) {
+/// Welds x0 = x1 (three multipliers each), colour by colour over the pool's threads.
+void project_weld(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
+  passes::each_constraint(pool, a, [&](size_t i) {
     const int32_t p0 = a.ids[2 * i], p1 = a.ids[2 * i + 1];
     const double alpha = a.compliance[i] * inv_h2;
     const double denom = w[p0] + w[p1] + alpha;
-    if (denom <= 0.0) continue;
+    if (denom <= 0.0) return;
     const Vec3 l(a.lambda[3 * i], a.lambda[3 * i + 1], a.lambda[3 * i + 2]);
     const Vec3 dl = (-(x[p0] - x[p1]) - alpha * l) / denom;
     for (int k = 0; k < 3; ++k) a.lambda[3 * i + k] += dl[k];
     x[p0] += w[p0] * dl;
     x[p1] -= w[p1] * dl;
-  }
+  });
 }
 
-/// The generic pass, through constraint_math.hpp (edge angle, tet volume, equal length, ...). A
-/// one-sided kind (KindTraits::side) that holds with no multiplier left is skipped, and its
-/// accumulated multiplier is kept on its side (the tether kernel's clamp, kernels.cpp).
+/// The generic pass, through constraint_math.hpp (edge angle, tet volume, equal length, ...),
+/// colour by colour over the pool's threads. A one-sided kind (KindTraits::side) that holds with no
+/// multiplier left is skipped, and its accumulated multiplier is kept on its side (the tether
+/// kernel's clamp, kernels.cpp).
 template <Kind K>
-void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
+void project_generic(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x,
+                     const std::vector<double>& w) {
   constexpr int N = arity(K);
-  const size_t n = a.size();
-  for (size_t i = 0; i < n; ++i) {
+  passes::each_constraint(pool, a, [&](size_t i) {
     const int32_t* p = &a.ids[i * N];
     auto e = KindTraits<K>::evaluate(p, x);
-    if (!e.valid) continue;
+    if (!e.valid) return;
     if constexpr (shares_operands<K>()) {
       // A particle in two slots moves along the sum of their gradients, once: the later slot's
       // gradient joins the earlier one's and is zeroed.
@@ -90,17 +91,17 @@ void project_generic(SolverArray& a, double inv_h2, std::vector<Vec3>& x, const 
     const double c = KindTraits<K>::deviation(e.value, a.rest[i]);
     constexpr int side = KindTraits<K>::side;
     if constexpr (side != 0)
-      if (side * c >= 0.0 && a.lambda[i] == 0.0) continue;
+      if (side * c >= 0.0 && a.lambda[i] == 0.0) return;
     const double alpha = a.compliance[i] * inv_h2;
     double denom = alpha;
     for (int k = 0; k < N; ++k) denom += w[p[k]] * e.grad[k].squaredNorm();
-    if (denom <= 0.0) continue;
+    if (denom <= 0.0) return;
     double dl = (-c - alpha * a.lambda[i]) / denom;
     if constexpr (side > 0) dl = std::max(a.lambda[i] + dl, 0.0) - a.lambda[i];
     if constexpr (side < 0) dl = std::min(a.lambda[i] + dl, 0.0) - a.lambda[i];
     a.lambda[i] += dl;
     for (int k = 0; k < N; ++k) x[p[k]] += (w[p[k]] * dl) * e.grad[k];
-  }
+  });
 }
 
 /// Adds w_k lambda grad_k C(x) of every constraint of a solver array to `out`.
@@ -253,7 +254,7 @@ void World::project_group(Group& g, double h, bool first) {
   }
   double* x = coords(x_);
   const double* w = w_.data();
-  project_weld(g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
+  project_weld(*pool_, g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
   const Kernels& k = kernels();
   // Bending before stretching, so that stretch has the final word in a projection: a dihedral step
   // is linear in the positions and, when a fast fold turns a hinge by tenths of a radian in a substep
@@ -261,7 +262,7 @@ void World::project_group(Group& g, double h, bool first) {
   // their edges. Projected after the stretch it left that for the next substep: edges across such
   // a fold ended 14 % long (the 128 x 128 acceptance cloth, frame 81 at 20 substeps); projected
   // before it, 2.9 %.
-  project_generic<Kind::edge_angle>(g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
+  project_generic<Kind::edge_angle>(*pool_, g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
   project_pass(*pool_, k.dihedral, g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
   // Tethers before stretching too: a tether pulls each particle on its own toward its anchor, and
   // during a whip that squeezes the edges between neighbours it pulls unequally; the stretch pass
@@ -279,17 +280,17 @@ void World::project_group(Group& g, double h, bool first) {
     project_pass(*pool_, k.distance, distance, inv_h2, x, w);
   else
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
-  project_generic<Kind::tet_volume>(g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
-  project_generic<Kind::equal_length>(g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
-  project_generic<Kind::conical>(g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_);
+  project_generic<Kind::tet_volume>(*pool_, g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
+  project_generic<Kind::equal_length>(*pool_, g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
+  project_generic<Kind::conical>(*pool_, g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_);
   // The geometry goals: length and angle ranges, co-linear, direction, co-circular, co-spherical.
-  project_generic<Kind::length_min>(g.solve[static_cast<int>(Kind::length_min)], inv_h2, x_, w_);
-  project_generic<Kind::angle_min>(g.solve[static_cast<int>(Kind::angle_min)], inv_h2, x_, w_);
-  project_generic<Kind::angle_max>(g.solve[static_cast<int>(Kind::angle_max)], inv_h2, x_, w_);
-  project_generic<Kind::colinear>(g.solve[static_cast<int>(Kind::colinear)], inv_h2, x_, w_);
-  project_generic<Kind::direction>(g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_);
-  project_generic<Kind::cocircular>(g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_);
-  project_generic<Kind::cospherical>(g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_);
+  project_generic<Kind::length_min>(*pool_, g.solve[static_cast<int>(Kind::length_min)], inv_h2, x_, w_);
+  project_generic<Kind::angle_min>(*pool_, g.solve[static_cast<int>(Kind::angle_min)], inv_h2, x_, w_);
+  project_generic<Kind::angle_max>(*pool_, g.solve[static_cast<int>(Kind::angle_max)], inv_h2, x_, w_);
+  project_generic<Kind::colinear>(*pool_, g.solve[static_cast<int>(Kind::colinear)], inv_h2, x_, w_);
+  project_generic<Kind::direction>(*pool_, g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_);
+  project_generic<Kind::cocircular>(*pool_, g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_);
+  project_generic<Kind::cospherical>(*pool_, g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_);
   project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
