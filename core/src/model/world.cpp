@@ -6,6 +6,7 @@
 #include "common/check.hpp"
 #include "common/pool.hpp"
 #include "common/slots.hpp"
+#include "embra/core/panels.hpp"
 #include "model/kind_traits.hpp"
 #include "solver/global_solve.hpp"
 
@@ -789,6 +790,7 @@ void World::set_panel_layout(const PanelLayout& layout) {
     if (l.body == layout.body) invalid("the body already has a panel layout");
   PanelLayout copy = layout;
   copy.first_particle = b.first_particle;
+  copy.topology = std::make_shared<const PanelTopology>(panel_topology(copy));
   panel_layouts_.push_back(std::move(copy));
 }
 

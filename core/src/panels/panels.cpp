@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <utility>
 
 namespace embra {
@@ -145,7 +146,23 @@ std::vector<ConicalVertex> conical_vertices(const PanelLayout& layout) {
   return out;
 }
 
+PanelTopology panel_topology(const PanelLayout& layout) {
+  return PanelTopology{panel_joints(layout), conical_vertices(layout),
+                       corners_around(layout.quads, layout.vertex_count)};
+}
+
+namespace {
+
+/// The layout's topology: the one World::set_panel_layout derived, else derived now into `own`.
+const PanelTopology& topology_of(const PanelLayout& layout, std::optional<PanelTopology>& own) {
+  return layout.topology ? *layout.topology : own.emplace(panel_topology(layout));
+}
+
+}  // namespace
+
 PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
+  std::optional<PanelTopology> own;
+  const PanelTopology& topology = topology_of(layout, own);
   PanelErrors e;
   const int32_t n = layout.panel_count();
   for (int32_t p = 0; p < n; ++p) {
@@ -162,12 +179,12 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
     e.diagonal_bottom.push_back(quad_diagonal_distance(b[0], b[1], b[2], b[3]));
     e.thickness.push_back(panel_thickness_error(t, b, layout.thickness));
   }
-  for (const PanelJoint& j : panel_joints(layout)) {
+  for (const PanelJoint& j : topology.joints) {
     const int k = j.corner, k1 = (j.corner + 1) % 4;
     e.miter.push_back(miter_twist(x[layout.top(j.panel, k)], x[layout.top(j.panel, k1)], x[layout.bottom(j.panel, k)],
                                   x[layout.bottom(j.panel, k1)]));
   }
-  for (const ConicalVertex& c : conical_vertices(layout)) {
+  for (const ConicalVertex& c : topology.conical) {
     double a[4];
     for (int i = 0; i < 4; ++i) {
       const int32_t p = c.panel[i];
@@ -178,7 +195,7 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
     }
     e.conical.push_back(std::abs((a[0] + a[2]) - (a[1] + a[3])));
   }
-  for (const auto& copies : corners_around(layout.quads, layout.vertex_count)) {
+  for (const auto& copies : topology.around) {
     if (copies.size() < 2) continue;
     double gap = 0.0;
     for (size_t i = 0; i < copies.size(); ++i)
@@ -232,6 +249,8 @@ PanelReport report_panels(const PanelErrors& e, const Tolerances& t) {
 }
 
 std::vector<double> vertex_errors(const PanelLayout& layout, const PanelErrors& e, PanelMetric metric) {
+  std::optional<PanelTopology> own;
+  const PanelTopology& topology = topology_of(layout, own);
   const int32_t n = layout.panel_count();
   std::vector<double> out(static_cast<size_t>(8) * n, 0.0);
   auto raise = [&](int32_t particle, double v) {
@@ -257,7 +276,7 @@ std::vector<double> vertex_errors(const PanelLayout& layout, const PanelErrors& 
         }
       break;
     case PanelMetric::miter: {
-      const std::vector<PanelJoint> joints = panel_joints(layout);
+      const std::vector<PanelJoint>& joints = topology.joints;
       for (size_t j = 0; j < joints.size(); ++j) {
         const PanelJoint& jt = joints[j];
         for (int side = 0; side < (jt.other_panel >= 0 ? 2 : 1); ++side) {
@@ -272,7 +291,7 @@ std::vector<double> vertex_errors(const PanelLayout& layout, const PanelErrors& 
       break;
     }
     case PanelMetric::conical: {
-      const std::vector<ConicalVertex> cv = conical_vertices(layout);
+      const std::vector<ConicalVertex>& cv = topology.conical;
       for (size_t i = 0; i < cv.size(); ++i)
         for (int f = 0; f < 4; ++f) {
           raise(layout.top(cv[i].panel[f], cv[i].corner[f]), e.conical[i]);

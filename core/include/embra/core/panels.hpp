@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace embra {
@@ -112,6 +113,14 @@ struct ConicalVertex {
   int32_t corner[4] = {0, 0, 0, 0};
 };
 std::vector<ConicalVertex> conical_vertices(const PanelLayout& layout);
+
+/// What the metrics read of a layout's connectivity, derived from its quads once.
+struct PanelTopology {
+  std::vector<PanelJoint> joints;                                // panel_joints
+  std::vector<ConicalVertex> conical;                            // conical_vertices
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> around;  // per mesh vertex: its (panel, corner)s
+};
+PanelTopology panel_topology(const PanelLayout& layout);
 
 /// Every metric of a panel mesh at positions `x` (world particle positions).
 struct PanelErrors {

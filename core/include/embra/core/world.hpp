@@ -533,12 +533,17 @@ std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<c
 /// bottom layer, `thickness` below the top on the side opposite the top's normal). `quads` gives,
 /// per panel, the vertex of the top mesh each corner sits on (counter-clockwise seen from the top's
 /// normal side): corners of different panels on one mesh vertex are welded.
+struct PanelTopology;  // panels.hpp
+
 struct PanelLayout {
   Id body;
   int32_t first_particle = 0;
   int32_t vertex_count = 0;    // vertices of the top mesh
   std::vector<int32_t> quads;  // 4 mesh vertex indices per panel
   double thickness = 0.0;      // model units
+  // Derived from the quads by World::set_panel_layout (panel_topology, panels.hpp) for the metrics;
+  // null in a layout made by hand, for which the metrics derive it each time.
+  std::shared_ptr<const PanelTopology> topology;
   int32_t panel_count() const { return static_cast<int32_t>(quads.size() / 4); }
   int32_t top(int32_t panel, int corner) const { return first_particle + 8 * panel + corner; }
   int32_t bottom(int32_t panel, int corner) const { return first_particle + 8 * panel + 4 + corner; }
