@@ -53,27 +53,44 @@ class Grid {
     boxes_ = boxes;
     inv_cell_ = 1.0 / cell;
     big_.clear();
-    int64_t entries = 0;
-    for (const Box& b : boxes) {
-      const int64_t n = cells(b);
-      if (n <= kMaxCells) entries += n;
-    }
-    size_t size = 16;
-    while (size < 2 * static_cast<size_t>(entries)) size *= 2;
-    mask_ = size - 1;
-    start_.assign(size + 1, 0);
-    for (size_t i = 0; i < boxes.size(); ++i)
-      visit(boxes[i], [&](size_t bucket, int64_t, int64_t, int64_t) { ++start_[bucket + 1]; });
-    for (size_t k = 0; k < size; ++k) start_[k + 1] += start_[k];
-    items_.resize(static_cast<size_t>(entries));
-    fill_.assign(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < boxes.size(); ++i) {
-      if (cells(boxes[i]) > kMaxCells) {
+    // Each box's cells once (the six floors), its entry and its cells' buckets in the order the
+    // fill reads them; then a counting sort of the entries by bucket.
+    const size_t n = boxes.size();
+    box_entry_.resize(n);
+    box_cells_.resize(n);
+    bucket_of_.clear();
+    for (size_t i = 0; i < n; ++i) {
+      const Span c = span_of(boxes[i]);
+      box_cells_[i] = c.cells;
+      if (c.cells > kMaxCells) {
         big_.push_back(static_cast<int32_t>(i));
         continue;
       }
-      const Entry entry = entry_of(boxes[i], static_cast<int32_t>(i));
-      visit(boxes[i], [&](size_t bucket, int64_t, int64_t, int64_t) { items_[fill_[bucket]++] = entry; });
+      box_entry_[i] = entry_of(boxes[i], c, static_cast<int32_t>(i));
+      for_cells(c, [&](uint32_t bucket_hash, int64_t, int64_t, int64_t) { bucket_of_.push_back(bucket_hash); });
+    }
+    const size_t entries = bucket_of_.size();
+    size_t size = 16;
+    while (size < 2 * entries) size *= 2;
+    mask_ = size - 1;
+    // start_[b] counts bucket b's entries, then becomes the end of its range (a running sum); the
+    // fill walks the boxes backwards, placing each entry just below its bucket's end, so each bucket
+    // lists its boxes in increasing index and start_[b] ends as its beginning.
+    start_.assign(size + 1, 0);
+    for (uint32_t& h : bucket_of_) {
+      h &= static_cast<uint32_t>(mask_);
+      ++start_[h];
+    }
+    int32_t sum = 0;
+    for (size_t k = 0; k < size; ++k) start_[k] = sum += start_[k];
+    start_[size] = sum;
+    items_.resize(entries);
+    size_t at = entries;
+    for (size_t i = n; i-- > 0;) {
+      if (box_cells_[i] > kMaxCells) continue;
+      at -= static_cast<size_t>(box_cells_[i]);
+      const Entry& entry = box_entry_[i];
+      for (int64_t c = box_cells_[i]; c-- > 0;) items_[--start_[bucket_of_[at + static_cast<size_t>(c)]]] = entry.index;
     }
   }
 
@@ -81,17 +98,19 @@ class Grid {
   /// increasing index within a cell). A pair is reported only in the cell holding the low corner of
   /// the two boxes' intersection, so no sort is needed to drop the duplicates.
   void query(const Box& q, std::vector<int32_t>& out) const {
-    const int64_t n = cells(q);
-    if (n > kMaxCells) {  // a huge query: every box
+    const Span c = span_of(q);
+    if (c.cells > kMaxCells) {  // a huge query: every box
       for (size_t i = 0; i < boxes_.size(); ++i)
         if (boxes_[i].overlaps(q)) out.push_back(static_cast<int32_t>(i));
       return;
     }
-    const std::array<int64_t, 3> ql = {coord(q.lo.x()), coord(q.lo.y()), coord(q.lo.z())};
-    const Entry qf = entry_of(q, -1);
-    visit(q, [&](size_t bucket, int64_t i, int64_t j, int64_t k) {
-      for (int32_t e = start_[bucket]; e < start_[bucket + 1]; ++e) {
-        const Entry& f = items_[e];
+    const int64_t* ql = c.lo;
+    const Entry qf = entry_of(q, c, -1);
+    for_cells(c, [&](uint32_t hash, int64_t i, int64_t j, int64_t k) {
+      const size_t bucket = hash & mask_;
+      const int32_t first = start_[bucket], last = start_[bucket + 1];
+      for (int32_t e = first; e < last; ++e) {
+        const Entry& f = box_entry_[items_[e]];
         if (!f.overlaps(qf)) continue;  // the float boxes hold the double ones: nothing overlapping is missed
         if (f.low[0] != kFar) {         // the low cell, when it fits in 32 bits
           if (std::max<int64_t>(f.low[0], ql[0]) != i || std::max<int64_t>(f.low[1], ql[1]) != j ||
@@ -103,7 +122,7 @@ class Grid {
         if (f.low[0] == kFar && (std::max(coord(b.lo.x()), ql[0]) != i || std::max(coord(b.lo.y()), ql[1]) != j ||
                                  std::max(coord(b.lo.z()), ql[2]) != k))
           continue;
-        if (e > start_[bucket] && f.index == items_[e - 1].index) continue;  // two of its cells share the bucket
+        if (e > first && f.index == items_[e - 1]) continue;  // two of its cells share the bucket
         out.push_back(f.index);
       }
     });
@@ -121,36 +140,44 @@ class Grid {
     if (!(c < 1e15)) return 1000000000000000;
     return static_cast<int64_t>(c);
   }
-  /// Cells a box covers, or kMaxCells + 1 for more (or for a box whose corners are not ordered,
-  /// which only non-finite coordinates make).
-  int64_t cells(const Box& b) const {
-    int64_t n = 1;
+  /// The cells a box covers: its lowest and highest cell and their count, or kMaxCells + 1 for more
+  /// (or for a box whose corners are not ordered, which only non-finite coordinates make).
+  struct Span {
+    int64_t lo[3], hi[3];
+    int64_t cells;
+  };
+  Span span_of(const Box& b) const {
+    Span s{};
+    s.cells = 1;
     for (int a = 0; a < 3; ++a) {
-      const int64_t span = coord(b.hi[a]) - coord(b.lo[a]) + 1;
-      if (span < 1 || span > kMaxCells) return kMaxCells + 1;
-      n *= span;
-      if (n > kMaxCells) return kMaxCells + 1;
+      s.lo[a] = coord(b.lo[a]);
+      s.hi[a] = coord(b.hi[a]);
+      const int64_t span = s.hi[a] - s.lo[a] + 1;
+      if (span < 1 || span > kMaxCells || s.cells > kMaxCells)
+        s.cells = kMaxCells + 1;
+      else
+        s.cells = std::min(s.cells * span, kMaxCells + 1);
     }
-    return n;
+    return s;
   }
+  /// Calls f(hash, i, j, k) for each cell (i, j, k) of a span of at most kMaxCells cells, in the
+  /// order k, j, i (slowest to fastest); hash & mask_ is the cell's bucket.
   template <class F>
-  void visit(const Box& b, F&& f) const {
-    if (cells(b) > kMaxCells) return;
-    const int64_t i0 = coord(b.lo.x()), i1 = coord(b.hi.x()), j0 = coord(b.lo.y()), j1 = coord(b.hi.y()),
-                  k0 = coord(b.lo.z()), k1 = coord(b.hi.z());
-    for (int64_t k = k0; k <= k1; ++k)
-      for (int64_t j = j0; j <= j1; ++j)
-        for (int64_t i = i0; i <= i1; ++i) {
-          // A block of 4 x 4 x 4 cells hashed together, its cells in consecutive buckets: a query's
-          // cells, and the next primitive's, lie close in memory.
-          const uint64_t bi = static_cast<uint64_t>(i) >> 2, bj = static_cast<uint64_t>(j) >> 2,
-                         bk = static_cast<uint64_t>(k) >> 2;
-          uint64_t h = bi * 73856093u ^ bj * 19349663u ^ bk * 83492791u;
-          h = ((h * 0x9E3779B97F4A7C15ull) >> 20) << 6 |
-              ((static_cast<uint64_t>(i) & 3) | (static_cast<uint64_t>(j) & 3) << 2 |
-               (static_cast<uint64_t>(k) & 3) << 4);
-          f(static_cast<size_t>(h & mask_), i, j, k);
+  static void for_cells(const Span& s, F&& f) {
+    for (int64_t k = s.lo[2]; k <= s.hi[2]; ++k) {
+      // A block of 4 x 4 x 4 cells hashed together, its cells in consecutive buckets: a query's
+      // cells, and the next primitive's, lie close in memory.
+      const uint64_t hk = (static_cast<uint64_t>(k) >> 2) * 83492791u, lk = (static_cast<uint64_t>(k) & 3) << 4;
+      for (int64_t j = s.lo[1]; j <= s.hi[1]; ++j) {
+        const uint64_t hj = hk ^ (static_cast<uint64_t>(j) >> 2) * 19349663u, lj = lk | (static_cast<uint64_t>(j) & 3)
+                                                                                            << 2;
+        for (int64_t i = s.lo[0]; i <= s.hi[0]; ++i) {
+          const uint64_t h = (((static_cast<uint64_t>(i) >> 2) * 73856093u ^ hj) * 0x9E3779B97F4A7C15ull) >> 20 << 6 |
+                             lj | (static_cast<uint64_t>(i) & 3);
+          f(static_cast<uint32_t>(h), i, j, k);
         }
+      }
+    }
   }
 
   std::span<const Box> boxes_;
@@ -169,13 +196,13 @@ class Grid {
                                static_cast<int>(lo[2] <= o.hi[2]) & static_cast<int>(o.lo[2] <= hi[2]));
     }
   };
-  Entry entry_of(const Box& b, int32_t index) const {
+  Entry entry_of(const Box& b, const Span& s, int32_t index) const {
     Entry e{};
     bool fits = true;
     for (int a = 0; a < 3; ++a) {
       e.lo[a] = to_float(b.lo[a], -1.0f);
       e.hi[a] = to_float(b.hi[a], 1.0f);
-      const int64_t c = coord(b.lo[a]);
+      const int64_t c = s.lo[a];
       fits = fits && c > kFar && c <= std::numeric_limits<int32_t>::max();
       e.low[a] = fits ? static_cast<int32_t>(c) : kFar;
     }
@@ -196,8 +223,12 @@ class Grid {
     const uint32_t bits = std::bit_cast<uint32_t>(f);
     return std::bit_cast<float>((f > 0.0f) == (dir > 0.0f) ? bits + 1 : bits - 1);
   }
-  std::vector<int32_t> start_, fill_, big_;
-  std::vector<Entry> items_;  // the boxes of each bucket, copied so a query reads them in sequence
+  std::vector<int32_t> start_, big_;
+  std::vector<int32_t> items_;  // the boxes of each bucket
+  // The build's scratch: each box's entry and cell count, and the buckets of its cells in order.
+  std::vector<Entry> box_entry_;
+  std::vector<int64_t> box_cells_;
+  std::vector<uint32_t> bucket_of_;
 };
 
 /// Mean of the boxes' largest extents: the cell size that keeps the cells per box bounded.
