@@ -477,8 +477,9 @@ int64_t World::add_shape_match(Id group_id, std::span<const int32_t> particles, 
   double off = 0.0;
   for (size_t i = 0; i < n; ++i) off = std::max(off, (r[i] - r[0]).cross(axis).norm());
   if (!(off > 1e-6 * reach))
-    invalid("the shape match's rest points are on one line (the farthest is " + std::to_string(off / reach) +
-            " of their reach off it): no rotation about it to fit");
+    invalid(
+        "the shape match's rest points are on one line (within 1e-6 of their reach): no rotation about it to "
+        "fit");
   // Everything is valid: append.
   ShapeMatch s;
   s.particles.assign(particles.begin(), particles.end());
