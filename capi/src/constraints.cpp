@@ -197,6 +197,29 @@ embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const
 
 // --- edits -------------------------------------------------------------------------------------
 
+embra_status embra_shape_match_add(embra_world* world, embra_group_id group, const int32_t* particles, int32_t count,
+                                   double compliance, int32_t* out_index) {
+  return guard("embra_shape_match_add", world, [&] {
+    if (count < 3) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be >= 3 (fewer points have no rotation to fit)");
+    if (count > embra::limits::kMaxParticles)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "count must be <= " + num(embra::limits::kMaxParticles));
+    const std::span<const int32_t> ids = view(particles, count, "particles");
+    const int64_t index = world->world.add_shape_match(to_id(group), ids, {}, compliance);
+    if (out_index != nullptr) *out_index = static_cast<int32_t>(index);
+  });
+}
+
+embra_status embra_shape_match_remove(embra_world* world, embra_group_id group, int32_t index) {
+  return guard("embra_shape_match_remove", world, [&] { world->world.remove_shape_match(to_id(group), index); });
+}
+
+embra_status embra_group_get_shape_match_count(const embra_world* world, embra_group_id group, int32_t* out_count) {
+  return guard("embra_group_get_shape_match_count", world, [&] {
+    need(out_count, "out_count");
+    *out_count = static_cast<int32_t>(world->world.shape_matches(to_id(group)).size());
+  });
+}
+
 embra_status embra_group_get_constraint_count(const embra_world* world, embra_group_id group,
                                               embra_constraint_kind kind, int32_t* out_count, int32_t* out_generated) {
   return guard("embra_group_get_constraint_count", world, [&] {

@@ -641,6 +641,9 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraints_add(IntPtr world, ref ConstraintBatchDef def);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_polygon_planarity_add(IntPtr world, GroupId group, int[] particles, int count, double compliance, out int added);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_rigid_set_add(IntPtr world, GroupId group, int[] particles, int count, double compliance, out int added);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_shape_match_add(IntPtr world, GroupId group, int[] particles, int count, double compliance, out int index);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_shape_match_remove(IntPtr world, GroupId group, int index);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_shape_match_count(IntPtr world, GroupId group, out int count);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_group_get_constraint_count(IntPtr world, GroupId group, int kind, out int count, out int generated);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_get(IntPtr world, GroupId group, int kind, int index, out ConstraintDef def);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_constraint_set_compliance(IntPtr world, GroupId group, int kind, int index, double compliance);

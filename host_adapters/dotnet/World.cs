@@ -671,6 +671,32 @@ namespace Embra
             return added;
         }
 
+        /// <summary>Shape matching (embra_shape_match_add): three or more points (particle indices), not
+        /// on one line, pulled every projection toward the best-fit rigid placement (mass-weighted, proper
+        /// rotation) of their current shape; compliance in m/N (0 = hard). Returns its index among the
+        /// group's shape matches.</summary>
+        public int AddShapeMatch(int[] particles, double compliance = 0.0, GroupId group = default(GroupId))
+        {
+            Need(particles != null, "particles: required");
+            int index = 0;
+            Call(w => Native.embra_shape_match_add(w, group, particles, particles.Length, compliance, out index));
+            return index;
+        }
+
+        /// <summary>Removes shape match `index` of the group (embra_shape_match_remove).</summary>
+        public void RemoveShapeMatch(int index, GroupId group = default(GroupId))
+        {
+            Call(w => Native.embra_shape_match_remove(w, group, index));
+        }
+
+        /// <summary>How many shape matches the group holds (embra_group_get_shape_match_count).</summary>
+        public int ShapeMatchCount(GroupId group = default(GroupId))
+        {
+            int count = 0;
+            Call(w => Native.embra_group_get_shape_match_count(w, group, out count));
+            return count;
+        }
+
         // Edits of one constraint, named as the diagnostics name it: group (default: the default group),
         // kind and index among the group's constraints of that kind (those bodies generated first, then the
         // added ones in the order added). Only added constraints are edited; a body's follow its material.

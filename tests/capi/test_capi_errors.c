@@ -1191,6 +1191,58 @@ static void test_rigid_set_add(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
 }
 
+/* embra_shape_match_add / _remove / embra_group_get_shape_match_count: the flat cloth (nine
+ * points, a rest shape in a plane) and the tetrahedron with the free point are accepted, then removed. */
+static void test_shape_match_add(void) {
+  const int32_t c = g_ref.cloth;
+  int32_t cloth[9], solid[5], bad[3], index = -1, count = -1, i;
+  const embra_group_id deflt = {0, 0};
+  for (i = 0; i < 9; ++i) cloth[i] = c + i;
+  for (i = 0; i < 4; ++i) solid[i] = g_ref.tet + i;
+  solid[4] = g_ref.point;
+  {
+    scene s;
+    CHECK(scene_build(&s));
+    CHECK_OK(embra_shape_match_add(s.w, deflt, cloth, 9, 0.0, &index));
+    CHECK_INT(index, 0);
+    CHECK_OK(embra_shape_match_add(s.w, deflt, solid, 5, 1e-6, &index));
+    CHECK_INT(index, 1);
+    CHECK_OK(embra_group_get_shape_match_count(s.w, deflt, &count));
+    CHECK_INT(count, 2);
+    CHECK_OK(embra_shape_match_remove(s.w, deflt, 0));
+    CHECK_OK(embra_group_get_shape_match_count(s.w, deflt, &count));
+    CHECK_INT(count, 1);
+    embra_world_destroy(s.w);
+  }
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_shape_match_add(NULL, deflt, cloth, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_shape_match_add(W, deflt, NULL, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, 2, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, -1, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("shape match compliance %s", bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_shape_match_add(W, deflt, cloth, 9, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("shape match");
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_shape_match_add(W, deflt, cloth, 9, -1.0, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_shape_match_add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
+  cloth[7] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = c + 2;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
+  bad[0] = g_ref.fixture + F0, bad[1] = g_ref.fixture + F2, bad[2] = g_ref.fixture + F5; /* on one line */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_shape_match_add(W, deflt, bad, 3, 0.0, NULL));
+  bad[1] = g_ref.fixture + F1; /* F0 and F1 at one place: with F5, two places, a line */
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_shape_match_add(W, deflt, bad, 3, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "shape match", embra_shape_match_remove(W, deflt, 0));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "shape match", embra_shape_match_remove(W, deflt, -1));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_shape_match_remove(W, g_ref.g_dead, 0));
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_shape_match_remove(NULL, deflt, 0));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "out_count", embra_group_get_shape_match_count(W, deflt, NULL));
+}
+
 static void test_constraints_add(void) {
   embra_constraint_batch_def d;
   int32_t ids[8];
@@ -2494,6 +2546,7 @@ int main(void) {
   RUN(test_constraints_add);
   RUN(test_polygon_planarity_add);
   RUN(test_rigid_set_add);
+  RUN(test_shape_match_add);
   RUN(test_pins);
   RUN(test_colliders);
   RUN(test_id_lists);

@@ -227,6 +227,9 @@ std::map<std::string, std::vector<json>> code_defaults() {
   c[d + "constraint_batch/properties/rest"] = {k.rest_from_current == 1 ? json("current") : json(k.rest)};
   c[d + "constraint_batch/properties/compliance"] = {k.compliance};
 
+  // A shape match's group left out is embra_shape_match_add's {0,0}: the default group.
+  c[d + "shape_match/properties/group"] = {group_name(embra_group_id{0, 0})};
+
   const embra_pin_def pin = embra_default_pin_def();
   c[d + "pin/properties/compliance"] = {pin.compliance, saved["pins"][0]["compliance"]};
   c[d + "pin/properties/group"] = {group_name(pin.group)};

@@ -4,8 +4,8 @@
  * tests/scenes/valid/) and for a world built through the C ABI (a cloth grid and a tet block,
  * constraints of every kind added after the second body and one between the bodies, groups with
  * orders and weights, hard and soft pins, plane, line, polyline, axes and mesh supports, a plane and a sphere,
- * non-default solver settings, a rest scale, initial velocities, point, area and line loads, and a destroyed group, pin
- * and collider whose slots are reused):
+ * non-default solver settings, a rest scale, initial velocities, point, area and line loads, shape matches, and a
+ * destroyed group, pin and collider whose slots are reused):
  *
  *   - load -> save -> load -> save is byte-identical (and a third round changes nothing);
  *   - the original world and the reloaded one, stepped 100 frames, have bit-identical positions,
@@ -524,6 +524,16 @@ static embra_world* build_api_world(void) {
     }
     CHECK_OK(embra_world_set_area_loads(w, area, 3));
     CHECK_OK(embra_world_set_line_loads(w, line, 2));
+    /* Shape matches: a soft one over a patch of the cloth in a group, a hard one over the block. */
+    {
+      const int32_t patch[5] = {c0 + 2 * NX + 1, c0 + 2 * NX + 2, c0 + 3 * NX + 1, c0 + 3 * NX + 2, c0 + 4 * NX + 3};
+      const int32_t corners[4] = {b0 + 0, b0 + 1, b0 + 2, b0 + 5};
+      int32_t index = -1;
+      CHECK_OK(embra_shape_match_add(w, g_bend, patch, 5, 3e-4 / 7.0, &index));
+      CHECK_INT(index, 0);
+      CHECK_OK(embra_shape_match_add(w, (embra_group_id){0, 0}, corners, 4, 0.0, &index));
+      CHECK_INT(index, 0);
+    }
   }
   if (capi_test_failed != failed_before) {
     embra_world_destroy(w);

@@ -590,6 +590,38 @@ EMBRA_API embra_status embra_polygon_planarity_add(embra_world* world, embra_gro
 EMBRA_API embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const int32_t* particles,
                                            int32_t count, double compliance, int32_t* out_added);
 
+/* Shape matching (Kangaroo2's RigidPointSet, ShapeOp's Rigid goal, Vellum's Shape Match): the
+ * points `particles`, `count` >= 3, pulled every projection toward the best-fit rigid placement of
+ * their rest shape, their positions now. The fit: with the particles' masses m_i (an immovable
+ * particle counts as the heaviest of the others), the mass-weighted centroids c of the points x_i
+ * and r_c of the rest points r_i, and A = sum m_i (x_i - c)(r_i - r_c)^T, R is the proper rotation
+ * (det +1) nearest to A (its polar factor, from a 3x3 Jacobi SVD); the goals are g_i = c + R (r_i -
+ * r_c). Each projection makes the fit once and moves each point, the goals held fixed, by the XPBD
+ * step of C_i = x_i - g_i with compliance `compliance` m_bar / m_i (m/N; m_bar the mean of the
+ * m_i): the set's energy is E = 1 / (2 compliance) sum (m_i / m_bar) |x_i - g_i|^2 (J), whose
+ * gradient is (m_i / (m_bar compliance)) (x_i - g_i). 0 = hard: one projection puts every movable
+ * point on its goal, so a free set moves as one rigid body (the projection moves no centre of mass
+ * and has no net torque about it, to rounding); a compliant set gives way under load in proportion
+ * to `compliance`, each point as a soft pin of that compliance would for equal masses. Hard-pinned
+ * and immovable points take part in the fit but are not moved. Projected in `group` ({0,0} =
+ * default) after its constraints, one set at a time in the order added (the same bits at any thread
+ * count); not part of the global solve's Newton system (embra_solver_def.global_solve: the
+ * iterations after it project it) nor of the residual reports. *out_index (may be NULL) is its
+ * index among the group's shape matches. All or none: refused for NULL particles, count < 3, a
+ * particle outside the world or given twice, a compliance negative or not finite, a stale group,
+ * and rest points all at one place or on one line (within 1e-6 of their reach: no rotation about
+ * that line to fit). Saved in scenes ("shape_matches"); destroying the group removes them. Which to
+ * use: embra_rigid_set_add braces a set with 4 n - 9 constraints of existing kinds (forces per
+ * member, the global solve, the residual reports); a shape match is one goal of n points, cheaper
+ * for large sets, exactly rigid in one projection when hard, and soft with one compliance. */
+EMBRA_API embra_status embra_shape_match_add(embra_world* world, embra_group_id group, const int32_t* particles,
+                                             int32_t count, double compliance, int32_t* out_index);
+/* Removes shape match `index` of `group` ({0,0} = default); those after it move down by one. */
+EMBRA_API embra_status embra_shape_match_remove(embra_world* world, embra_group_id group, int32_t index);
+/* The number of shape matches `group` ({0,0} = default) holds. */
+EMBRA_API embra_status embra_group_get_shape_match_count(const embra_world* world, embra_group_id group,
+                                                         int32_t* out_count);
+
 /* Edits without a rebuild. A constraint is named by its group ({0,0}: the default group), kind and
  * index among the group's constraints of that kind: those bodies generated first (in body order),
  * then the added ones in the order added, the numbering of embra_constraint_residual.index and

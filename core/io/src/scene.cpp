@@ -1075,6 +1075,16 @@ class Builder {
       w.set_line_loads(line_loads);
       return 0;
     });
+    section("shape_matches", [&](const json& m, const std::string& at) {
+      std::vector<int32_t> ids;
+      for (size_t k = 0; k < m["particles"].size(); ++k)
+        ids.push_back(particle(w, m["particles"][k], at + "/particles/" + std::to_string(k)));
+      std::vector<Vec3> rest;
+      if (m.contains("rest"))
+        for (const json& r : m["rest"]) rest.push_back(vec3(r));
+      const Id g = group(m, "group", at);
+      guard(at, [&] { return w.add_shape_match(g, ids, rest, m["compliance"].get<double>()); });
+    });
     section("colliders", [&](const json& c, const std::string& at) {
       ColliderDesc d;
       d.shape = collider_shape(c["shape"].get<std::string>());
@@ -1752,6 +1762,17 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
   for (const LineLoad& l : w.line_loads())
     line_loads.push_back({{"particles", {l.particles[0], l.particles[1]}}, {"load", vec_json(l.load)}});
   if (!line_loads.empty()) doc["line_loads"] = line_loads;
+
+  // Each group's shape matches in the order it projects them, groups in creation order.
+  json shape_matches = json::array();
+  for (uint32_t slot : slots)
+    for (const ShapeMatch& m : w.groups()[slot].shapes) {
+      json rest = json::array();
+      for (const Vec3& r : m.rest) rest.push_back(vec_json(r));
+      shape_matches.push_back(
+          {{"group", gname[slot]}, {"particles", m.particles}, {"rest", rest}, {"compliance", m.compliance}});
+    }
+  if (!shape_matches.empty()) doc["shape_matches"] = shape_matches;
 
   json colliders = json::array();
   std::set<std::string> used_colliders = given_names(meta.collider_names);

@@ -444,6 +444,65 @@ void World::remove_constraint(Id group_id, Kind kind, int64_t index) {
   solver_dirty_ = true;
 }
 
+int64_t World::add_shape_match(Id group_id, std::span<const int32_t> particles, std::span<const Vec3> rest,
+                               double compliance) {
+  const Id gid = resolve_group(group_id);
+  const size_t n = particles.size();
+  if (n < 3)
+    invalid("a shape match takes at least 3 particles (fewer have no rotation to fit), not " + std::to_string(n));
+  if (n > static_cast<size_t>(limits::kMaxParticles))
+    invalid("a shape match takes at most " + std::to_string(limits::kMaxParticles) + " particles");
+  if (!rest.empty() && rest.size() != n)
+    invalid("a shape match takes one rest point per particle: " + std::to_string(rest.size()) + " for " +
+            std::to_string(n));
+  check_non_negative(compliance, "shape match compliance");
+  for (size_t i = 0; i < n; ++i) check_particle(particles[i], ("shape match particle " + std::to_string(i)).c_str());
+  std::vector<int32_t> sorted(particles.begin(), particles.end());
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t i = 1; i < n; ++i)
+    if (sorted[i] == sorted[i - 1]) invalid("shape match particle " + std::to_string(sorted[i]) + " appears twice");
+  std::vector<Vec3> r(n);
+  for (size_t i = 0; i < n; ++i) {
+    r[i] = rest.empty() ? x_[particles[i]] : rest[i];
+    for (int k = 0; k < 3; ++k) check_finite(r[i][k], "shape match rest point " + std::to_string(i));
+  }
+  // A rotation to fit needs the rest shape off one line: its farthest point from the first, then the
+  // farthest from their line, at least 1e-6 of that reach from it.
+  size_t far = 0;
+  for (size_t i = 1; i < n; ++i)
+    if ((r[i] - r[0]).squaredNorm() > (r[far] - r[0]).squaredNorm()) far = i;
+  const double reach = (r[far] - r[0]).norm();
+  if (!(reach > 0.0)) invalid("the shape match's rest points are all at one place: no rotation to fit");
+  const Vec3 axis = (r[far] - r[0]) / reach;
+  double off = 0.0;
+  for (size_t i = 0; i < n; ++i) off = std::max(off, (r[i] - r[0]).cross(axis).norm());
+  if (!(off > 1e-6 * reach))
+    invalid(
+        "the shape match's rest points are on one line (within 1e-6 of their reach): no rotation about it to "
+        "fit");
+  // Everything is valid: append.
+  ShapeMatch s;
+  s.particles.assign(particles.begin(), particles.end());
+  s.rest = std::move(r);
+  s.compliance = compliance;
+  s.lambda.assign(n, Vec3::Zero());
+  std::vector<ShapeMatch>& list = group_mut(gid).shapes;
+  list.push_back(std::move(s));
+  return static_cast<int64_t>(list.size()) - 1;
+}
+
+void World::remove_shape_match(Id group_id, int64_t index) {
+  std::vector<ShapeMatch>& list = group_mut(resolve_group(group_id)).shapes;
+  if (index < 0 || index >= static_cast<int64_t>(list.size()))
+    invalid("shape match " + std::to_string(index) + " is outside the group's [0, " + std::to_string(list.size()) +
+            ")");
+  list.erase(list.begin() + index);
+}
+
+const std::vector<ShapeMatch>& World::shape_matches(Id group_id) const {
+  return group(resolve_group(group_id)).shapes;
+}
+
 void World::set_group_enabled(Id id, bool enabled) {
   Group& g = group_mut(id);
   if (id == settings_.contact_group && !enabled)

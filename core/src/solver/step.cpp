@@ -158,6 +158,7 @@ void World::reset_multipliers() {
     for (SolverArray& a : g.solve) std::fill(a.lambda.begin(), a.lambda.end(), 0.0);
     std::fill(g.tethers.lambda.begin(), g.tethers.lambda.end(), 0.0);
     for (int32_t pi : g.soft_pins) pins_[pi].lambda.setZero();
+    for (ShapeMatch& sm : g.shapes) std::fill(sm.lambda.begin(), sm.lambda.end(), Vec3::Zero());
   }
 }
 
@@ -191,6 +192,8 @@ void World::realign(const std::vector<Vec3>& predicted) {
       corr[weld.ids[2 * i + 1]] -= w_[weld.ids[2 * i + 1]] * l;
     }
     for (int32_t pi : g.soft_pins) corr[pins_[pi].particle] += w_[pins_[pi].particle] * pins_[pi].lambda;
+    for (const ShapeMatch& sm : g.shapes)
+      for (size_t i = 0; i < sm.particles.size(); ++i) corr[sm.particles[i]] += w_[sm.particles[i]] * sm.lambda[i];
     for (const Contact& ct : g.contacts) {
       if (ct.lambda == 0.0) continue;
       Vec3 n;
@@ -293,6 +296,8 @@ void World::project_group(Group& g, double h, bool first) {
   project_generic<Kind::cospherical>(*pool_, g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_);
   project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
   project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
+  // Shape matches, one set at a time in the order added (serial: the same bits at any thread count).
+  for (ShapeMatch& sm : g.shapes) project_shape_match(sm, inv_h2, inv_mass_, w_, x_, shape_weights_);
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
   if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
     self_collision::project(self_contacts_, x_, w_);

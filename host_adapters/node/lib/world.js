@@ -750,6 +750,36 @@ class World {
     return added[0];
   }
 
+  /**
+   * Shape matching (embra_shape_match_add): three or more points (particle indices), not on one line,
+   * pulled every projection toward the best-fit rigid placement (mass-weighted, proper rotation) of their
+   * current shape. options {compliance (m/N, default 0 = hard), group}; returns its index among the
+   * group's shape matches.
+   */
+  addShapeMatch(particles, opts) {
+    const o = options(opts, 'addShapeMatch options');
+    const p = buf.intsIn(particles, 'particles');
+    if (p === null) throw new TypeError('particles: required');
+    const compliance = o.has('compliance') ? buf.number(take(o, 'compliance'), 'compliance') : 0;
+    const group = toId(o.has('group') ? take(o, 'group') : null, GroupId, 'group');
+    if (o.size) throw new TypeError(`addShapeMatch: unknown option '${o.keys().next().value}'`);
+    const index = [0];
+    this.#call('embra_shape_match_add', group, p, buf.int32(p.length, 'count'), compliance, index);
+    return index[0];
+  }
+
+  /** Removes shape match `index` of `group` (null: the default group); later ones move down. */
+  removeShapeMatch(index, group = null) {
+    this.#call('embra_shape_match_remove', toId(group, GroupId, 'group'), buf.int32(index, 'index'));
+  }
+
+  /** How many shape matches `group` (null: the default group) holds. */
+  shapeMatchCount(group = null) {
+    const count = [0];
+    this.#call('embra_group_get_shape_match_count', toId(group, GroupId, 'group'), count);
+    return count[0];
+  }
+
   // Edits of one constraint, named as the diagnostics name it: group (null: the default group), kind and
   // index among the group's constraints of that kind (those bodies generated first, then the added ones in
   // the order added). Only added constraints are edited; a body's follow its material (setMaterial).

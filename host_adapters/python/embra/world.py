@@ -611,6 +611,27 @@ class World:
                    byref(added))
         return added.value
 
+    def add_shape_match(self, particles, compliance=0.0, group=None):
+        """Shape matching (embra_shape_match_add): three or more points (particle indices), not on one
+        line, pulled every projection toward the best-fit rigid placement (mass-weighted, proper
+        rotation) of their current shape. compliance in m/N (0 = hard). Returns its index among the
+        group's shape matches."""
+        p, n, keep = buf.ints_in(particles, "particles")
+        index = c_int32(0)
+        self._call("embra_shape_match_add", _id(group, GroupId, "group"), p, buf.int32(n, "count"), float(compliance),
+                   byref(index))
+        return index.value
+
+    def remove_shape_match(self, index, group=None):
+        """Removes shape match `index` of the group (embra_shape_match_remove); later ones move down."""
+        self._call("embra_shape_match_remove", _id(group, GroupId, "group"), buf.int32(index, "index"))
+
+    def shape_match_count(self, group=None):
+        """How many shape matches the group holds (embra_group_get_shape_match_count)."""
+        count = c_int32(0)
+        self._call("embra_group_get_shape_match_count", _id(group, GroupId, "group"), byref(count))
+        return count.value
+
     def add_polygon_planarity(self, particles, compliance=0.0, group=None):
         """Holds a polygon of four or more corners (particle indices in order round it) in one plane
         (embra_polygon_planarity_add): planarity constraints of rest 0 on its windows of four

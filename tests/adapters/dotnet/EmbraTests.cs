@@ -515,6 +515,37 @@ namespace Embra.Tests
             }
         }
 
+        /// <summary>Six points under one hard shape match, one pinned, swing under gravity with every
+        /// pairwise distance kept to 1e-6 m; removed; a point given twice is refused.</summary>
+        [Test]
+        public void ShapeMatchKeepsItsShape()
+        {
+            var solver = Library.DefaultSolverDef();
+            solver.Substeps = 4;
+            solver.Iterations = 40;
+            solver.Tethers = 0;
+            var xyz = new double[] { 0, 0, 1, 0.4, 0, 1, 0, 0.4, 1, 0, 0, 1.4, 0.3, 0.3, 1.3, -0.2, 0.1, 1.2 };
+            using (var w = new World(solver))
+            {
+                var def = Library.DefaultBodyDef();
+                def.Generate = 0;
+                w.CreateBody(xyz, masses: new[] { 1.0, 2.0, 1.0, 1.0, 0.5, 1.0 }, def: def);
+                Assert.AreEqual(0, w.AddShapeMatch(new[] { 0, 1, 2, 3, 4, 5 }));
+                w.CreatePin(0, new[] { 0.0, 0.0, 1.0 });
+                w.Step(60);
+                var p = w.GetPositions();
+                Func<double[], int, int, double> d = (x, i, j) =>
+                    Math.Sqrt(Math.Pow(x[3 * i] - x[3 * j], 2) + Math.Pow(x[3 * i + 1] - x[3 * j + 1], 2) +
+                              Math.Pow(x[3 * i + 2] - x[3 * j + 2], 2));
+                for (int i = 0; i < 6; ++i)
+                    for (int j = i + 1; j < 6; ++j) Assert.AreEqual(d(xyz, i, j), d(p, i, j), 1e-6, i + "-" + j);
+                Assert.AreEqual(1, w.ShapeMatchCount());
+                w.RemoveShapeMatch(0);
+                Assert.AreEqual(0, w.ShapeMatchCount());
+                Assert.Throws<EmbraArgumentException>(() => w.AddShapeMatch(new[] { 0, 1, 1 }));
+            }
+        }
+
         /// <summary>Six points braced rigid (4 n - 9 = 15 constraints), one pinned, fall and turn under
         /// gravity with every pairwise distance kept to 1e-6 m; a point given twice is refused.</summary>
         [Test]

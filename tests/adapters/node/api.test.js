@@ -126,6 +126,25 @@ test('polygon planarity: a hexagon with its corners up and down in turn ends on 
   w.close();
 });
 
+test('shape match: six points, one pinned, hard, swing with every distance kept; remove; refusals', () => {
+  const xyz = [[0, 0, 1], [0.4, 0, 1], [0, 0.4, 1], [0, 0, 1.4], [0.3, 0.3, 1.3], [-0.2, 0.1, 1.2]];
+  const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 40, tethers: 0 });
+  w.createBody(xyz, { generate: 0, masses: [1, 2, 1, 1, 0.5, 1] });
+  assert.equal(w.addShapeMatch([0, 1, 2, 3, 4, 5]), 0);
+  w.createPin(0, xyz[0]);
+  w.step(60);
+  const p = w.positions();
+  const d0 = (i, j) => Math.hypot(...[0, 1, 2].map((k) => xyz[i][k] - xyz[j][k]));
+  for (let i = 0; i < 6; i++) {
+    for (let j = i + 1; j < 6; j++) assert.ok(Math.abs(dist(p, i, j) - d0(i, j)) < 1e-6, `${i}-${j}`);
+  }
+  assert.equal(w.shapeMatchCount(), 1);
+  w.removeShapeMatch(0);
+  assert.equal(w.shapeMatchCount(), 0);
+  assert.throws(() => w.addShapeMatch([0, 1, 1]), /twice/);
+  w.close();
+});
+
 test('rigid set: six points braced (4 n - 9 constraints) fall and turn with every distance kept', () => {
   const xyz = [[0, 0, 1], [0.4, 0, 1], [0, 0.4, 1], [0, 0, 1.4], [0.3, 0.3, 1.3], [-0.2, 0.1, 1.2]];
   const w = new embra.World({ gravity: [0, 0, -9.81], substeps: 4, iterations: 40, tethers: 0 });

@@ -134,6 +134,37 @@ def test_rigid_set_keeps_its_shape_while_it_falls_and_turns():
             w.add_rigid_set([0, 1, 2])
 
 
+def test_shape_match_keeps_a_falling_spinning_set_rigid():
+    """Six points under one hard shape match, thrown spinning: after 60 frames every pairwise
+    distance as it was to 1e-9 m, and their mass-weighted centre where a loose particle thrown with
+    it is (1e-9 m); points on one line are refused; remove takes it away."""
+    xyz = [(0, 0, 1), (0.4, 0, 1), (0, 0.4, 1), (0, 0, 1.4), (0.3, 0.3, 1.3), (-0.2, 0.1, 1.2)]
+    masses = [1.0, 2.0, 0.5, 1.5, 1.0, 0.8]
+    with embra.World(gravity=(0.0, 0.0, -9.81), tethers=0) as w:
+        w.create_body(xyz + [(0, 0, 0)], generate=0, masses=masses + [1.0])
+        assert w.add_shape_match(range(6)) == 0
+        c = [sum(m * p[k] for m, p in zip(masses, xyz)) / sum(masses) for k in range(3)]
+        v = []
+        for p in xyz:  # 1 m/s along x plus 4 rad/s about z through the centre
+            v += [1.0 - 4.0 * (p[1] - c[1]), 4.0 * (p[0] - c[0]), 2.0]
+        w.set_positions(c, first=6)
+        w.set_velocities(v + [1.0, 0.0, 2.0])
+        w.step(60)
+        p = [flat(w.positions())[3 * k:3 * k + 3] for k in range(7)]
+        for i in range(6):
+            for j in range(i + 1, 6):
+                assert abs(math.dist(p[i], p[j]) - math.dist(xyz[i], xyz[j])) < 1e-9
+        centre = [sum(m * q[k] for m, q in zip(masses, p)) / sum(masses) for k in range(3)]
+        assert math.dist(centre, p[6]) < 1e-9
+        assert w.shape_match_count() == 1
+        w.remove_shape_match(0)
+        assert w.shape_match_count() == 0
+    with embra.World() as w:
+        w.create_body([(0, 0, 0), (1, 0, 0), (2, 0, 0)], generate=0, masses=[1.0] * 3)
+        with pytest.raises(embra.EmbraError, match="line"):
+            w.add_shape_match([0, 1, 2])
+
+
 def test_statics_two_bar_truss_forces_and_reactions():
     """A load hung from two pins by two hard bars at 45 degrees: each bar carries the load over
     2 sin 45 (tension, N), and the pins' reactions sum to minus every weight and point load."""

@@ -12,6 +12,7 @@
 #include "embra/core/fields.hpp"
 #include "embra/core/kinds.hpp"
 #include "embra/core/loads.hpp"
+#include "embra/core/shape_match.hpp"
 
 #include <array>
 #include <atomic>
@@ -453,6 +454,7 @@ struct Group {
   SolverArray solve[kKindCount];   // the arrays in colour order, as the solver projects them
   SolverArray tethers;             // automatic long-range attachments (Settings::tethers)
   std::vector<int32_t> soft_pins;  // indices into World::pins_
+  std::vector<ShapeMatch> shapes;  // World::add_shape_match, projected after the constraint kinds
   std::vector<Contact> contacts;   // only in the contact group
   GroupReport report;
 };
@@ -632,6 +634,17 @@ class World {
   /// (> 0) the constraint is removed (later ones move down by one) and reported by take_broken.
   /// 0 turns either off; each finite, >= 0 (a distance of rest 0 has no strain: refused).
   void set_constraint_plasticity(Id group, Kind kind, int64_t index, double yield, double rupture);
+  /// Shape matching (shape_match.hpp): the points `particles` (at least 3, distinct) pulled each
+  /// substep toward the best-fit rigid placement of `rest` (one point per particle, m; empty: the
+  /// current positions), with `compliance` (m/N, >= 0; 0 = hard), in `group` (null = the default
+  /// group), projected after the group's constraints. Returns its index among the group's shape
+  /// matches. Refused, changing nothing: a particle out of range or given twice, a rest point not
+  /// finite, a rest shape on one line or at one point (no rotation to fit), a bad compliance.
+  int64_t add_shape_match(Id group, std::span<const int32_t> particles, std::span<const Vec3> rest, double compliance);
+  /// Removes a group's shape match; the ones after it move down by one.
+  void remove_shape_match(Id group, int64_t index);
+  /// A group's shape matches (null = the default group), in the order added.
+  const std::vector<ShapeMatch>& shape_matches(Id group) const;
   /// The constraints broken since the last call, in the order they broke; the list is emptied.
   std::vector<BrokenConstraint> take_broken();
   const std::vector<BrokenConstraint>& broken() const { return broken_; }
@@ -872,6 +885,7 @@ class World {
   std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
+  std::vector<double> shape_weights_;                 // project_shape_match's scratch
   StepReport report_;
   Warning warning_;
   std::vector<Field> fields_;
