@@ -778,11 +778,13 @@ class World {
   /// with a force on a live collider, each in the order the readers sum them.
   StaticsState statics_state() const;
   /// Replaces it (a saved scene's state.forces, loaded): the solver arrays are brought up to date
-  /// first (as the next step would), then every multiplier and contact force is set from `state`
-  /// and those it does not list to 0. Refused, changing no multiplier or contact: a stale group, pin
-  /// or collider, a kind listed twice for a group (or a group's tethers twice, a pin twice), a count
-  /// that is not multipliers(kind) per constraint of the group's kind (one per automatic tether), a
-  /// hard pin (it keeps no multiplier), a particle out of range, a value not finite within +-1e300.
+  /// first, as the next step would (a world edited since its last step has them rebuilt, its
+  /// multipliers 0, whether or not `state` is then accepted), then every multiplier and contact
+  /// force is set from `state` and those it does not list to 0. Refused, changing no multiplier or
+  /// contact beyond that rebuild: a stale group, pin or collider, a kind listed twice for a group
+  /// (or a group's tethers twice, a pin twice), a count that is not multipliers(kind) per constraint
+  /// of the group's kind (one per automatic tether), a hard pin (it keeps no multiplier), a particle
+  /// out of range, a value not finite within +-1e300.
   void set_statics_state(const StaticsState& state);
   const Warning& warning() const { return warning_; }
 
