@@ -201,5 +201,12 @@ for key, v in (("force", c[0]["force"]), ("collider_sum", f["collider_sum"]), ("
 assert f["units"]["moment"] == "N m" and f["reactions"] == []
 PY
 
+# The forces survive final.json (its state.forces): run again from it without stepping (--frames 0),
+# the floor scene writes the same forces.json, byte for byte (every number printed to 17 digits).
+"$embra" run "$tmp/floor/final.json" --frames 0 --out "$tmp/floor_again" >"$tmp/log" 2>&1 && ok ||
+  bad "final.json must run: $(cat "$tmp/log")"
+grep -q '"forces": {' "$tmp/floor/final.json" && cmp -s "$tmp/floor/forces.json" "$tmp/floor_again/forces.json" && ok ||
+  bad "forces.json from final.json, not stepped, differs from the run's"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

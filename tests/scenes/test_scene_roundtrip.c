@@ -87,6 +87,115 @@ static int step(embra_world* w, int frames) {
   return 1;
 }
 
+/* The forces a world's readers give, in a form two worlds built alike compare by: per live group,
+ * embra_group_get_forces of every kind but the weld (one buffer per group, groups in slot order);
+ * the pins' reactions as (particle, force) records sorted by particle then bytes; the colliders'
+ * force, moment and contacts in slot order. */
+typedef struct forces {
+  double** group;   /* per group */
+  int64_t* group_n; /* doubles per group */
+  int32_t groups;
+  double* pins; /* 4 per pin: particle, force xyz */
+  int32_t pin_count;
+  double* colliders; /* 7 per collider */
+  int32_t collider_count;
+  int ok;
+} forces;
+
+static int compare_pin_record(const void* a, const void* b) {
+  return memcmp(a, b, 4 * sizeof(double));
+}
+
+static forces forces_of(const embra_world* w) {
+  forces f;
+  embra_group_id ids[256];
+  embra_reaction* r = NULL;
+  embra_collider_reaction* c = NULL;
+  int32_t g, k, i;
+  memset(&f, 0, sizeof f);
+  if (embra_world_get_groups(w, ids, 256, &f.groups) != EMBRA_OK ||
+      embra_world_get_reactions(w, NULL, 0, &f.pin_count) != EMBRA_OK ||
+      embra_world_get_collider_reactions(w, NULL, 0, &f.collider_count) != EMBRA_OK)
+    return f;
+  f.group = (double**)calloc((size_t)f.groups + 1, sizeof(double*));
+  f.group_n = (int64_t*)calloc((size_t)f.groups + 1, sizeof(int64_t));
+  f.pins = (double*)calloc(4 * (size_t)f.pin_count + 1, sizeof(double));
+  f.colliders = (double*)calloc(7 * (size_t)f.collider_count + 1, sizeof(double));
+  r = (embra_reaction*)calloc((size_t)f.pin_count + 1, sizeof(embra_reaction));
+  c = (embra_collider_reaction*)calloc((size_t)f.collider_count + 1, sizeof(embra_collider_reaction));
+  if (f.group == NULL || f.group_n == NULL || f.pins == NULL || f.colliders == NULL || r == NULL || c == NULL ||
+      embra_world_get_reactions(w, r, f.pin_count, &f.pin_count) != EMBRA_OK ||
+      embra_world_get_collider_reactions(w, c, f.collider_count, &f.collider_count) != EMBRA_OK) {
+    free(r);
+    free(c);
+    return f;
+  }
+  for (g = 0; g < f.groups; ++g) {
+    int64_t total = 0, n = 0;
+    for (k = 0; embra_residual_name(k) != NULL; ++k) {
+      if (k == EMBRA_CONSTRAINT_WELD || embra_group_get_forces(w, ids[g], k, NULL, 0, &n) != EMBRA_OK) continue;
+      total += n;
+    }
+    f.group[g] = (double*)calloc((size_t)total + 1, sizeof(double));
+    for (k = 0; f.group[g] != NULL && embra_residual_name(k) != NULL; ++k) {
+      if (k == EMBRA_CONSTRAINT_WELD || embra_group_get_forces(w, ids[g], k, NULL, 0, &n) != EMBRA_OK) continue;
+      if (embra_group_get_forces(w, ids[g], k, f.group[g] + f.group_n[g], n, &n) != EMBRA_OK) break;
+      f.group_n[g] += n;
+    }
+    if (f.group[g] == NULL || f.group_n[g] != total) {
+      free(r);
+      free(c);
+      return f;
+    }
+  }
+  for (i = 0; i < f.pin_count; ++i) {
+    f.pins[4 * i] = (double)r[i].particle;
+    memcpy(f.pins + 4 * i + 1, r[i].force, 3 * sizeof(double));
+  }
+  qsort(f.pins, (size_t)f.pin_count, 4 * sizeof(double), compare_pin_record);
+  for (i = 0; i < f.collider_count; ++i) {
+    memcpy(f.colliders + 7 * i, c[i].force, 3 * sizeof(double));
+    memcpy(f.colliders + 7 * i + 3, c[i].moment, 3 * sizeof(double));
+    f.colliders[7 * i + 6] = (double)c[i].contacts;
+  }
+  free(r);
+  free(c);
+  f.ok = 1;
+  return f;
+}
+
+static void forces_free(forces* f) {
+  int32_t g;
+  for (g = 0; f->group != NULL && g < f->groups; ++g) free(f->group[g]);
+  free(f->group);
+  free(f->group_n);
+  free(f->pins);
+  free(f->colliders);
+}
+
+/* 1 when both read the same forces, bit for bit (groups matched one to one by their forces, as the
+ * slots of a loaded world's groups need not be the saved world's). */
+static int same_forces(const forces* a, const forces* b) {
+  int32_t g, h;
+  char used[256];
+  if (!a->ok || !b->ok || a->groups != b->groups || a->pin_count != b->pin_count ||
+      a->collider_count != b->collider_count)
+    return 0;
+  if (memcmp(a->pins, b->pins, 4 * sizeof(double) * (size_t)a->pin_count) != 0 ||
+      memcmp(a->colliders, b->colliders, 7 * sizeof(double) * (size_t)a->collider_count) != 0)
+    return 0;
+  memset(used, 0, sizeof used);
+  for (g = 0; g < a->groups; ++g) {
+    for (h = 0; h < b->groups; ++h)
+      if (!used[h] && a->group_n[g] == b->group_n[h] &&
+          memcmp(a->group[g], b->group[h], sizeof(double) * (size_t)a->group_n[g]) == 0)
+        break;
+    if (h == b->groups) return 0;
+    used[h] = 1;
+  }
+  return 1;
+}
+
 /* All the round-trip checks on `original` (at frame 0, never stepped); `base_dir` resolves the
  * scene's relative paths. Destroys `original`. */
 static void check_round_trip(const char* label, embra_world* original, const char* base_dir) {
@@ -94,9 +203,11 @@ static void check_round_trip(const char* label, embra_world* original, const cha
   char *s1, *s2 = NULL, *s3 = NULL, *mid = NULL;
   char *end_original = NULL, *end_reloaded = NULL, *end_resumed = NULL;
   embra_world *reloaded = NULL, *third = NULL, *resumed = NULL;
+  forces at_half;
   int64_t frames_a = -1, frames_b = -2;
   int f, diverged = 0;
 
+  memset(&at_half, 0, sizeof at_half);
   CAPI_CONTEXT("%s", label);
   s1 = scene_save(original, &n1);
   if (!CHECK(s1 != NULL)) goto done;
@@ -131,6 +242,8 @@ static void check_round_trip(const char* label, embra_world* original, const cha
     if (f == HALF) {
       mid = scene_save(original, &nmid);
       CHECK(mid != NULL);
+      at_half = forces_of(original);
+      CHECK(at_half.ok);
     }
   }
   if (f <= FRAMES) goto done;
@@ -148,12 +261,20 @@ static void check_round_trip(const char* label, embra_world* original, const cha
     CHECK_OK(embra_world_get_report(resumed, &r));
     CHECK_INT(r.frame, HALF);
   }
+  /* Before its first step it reads the forces the world saved read (state.forces). */
+  {
+    forces loaded = forces_of(resumed);
+    CHECK_MSG(same_forces(&at_half, &loaded), "%s: the scene saved at frame %d reads other forces once loaded", label,
+              HALF);
+    forces_free(&loaded);
+  }
   if (!step(resumed, FRAMES - HALF)) goto done;
   CHECK_MSG(same_state(original, resumed), "%s: the run resumed from frame %d ends elsewhere", label, HALF);
   end_resumed = scene_save(resumed, NULL);
   CHECK(end_resumed != NULL && end_original != NULL && strcmp(end_original, end_resumed) == 0);
 
 done:
+  forces_free(&at_half);
   free(s1);
   free(s2);
   free(s3);

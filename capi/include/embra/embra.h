@@ -1000,6 +1000,11 @@ EMBRA_API embra_status embra_group_get_residuals(const embra_world* world, embra
  * load: exactly (to rounding) with realign_passes >= 1, which evaluates them at the substep's end;
  * textbook XPBD (realign_passes 0) leaves an imbalance of the order of h^2 g / member length of the
  * forces. Read them after embra_world_step or embra_world_solve; constraints added since read 0.
+ * A saved scene keeps them (its state.forces: the last substep's multipliers and contact forces,
+ * docs/scene-format.md): a world loaded from a scene saved after a step (embra_world_save_json or
+ * _file, `embra run`'s final.json) reads the same forces and reactions, bit for bit, before its first
+ * step; a scene without them reads 0 until a step. Stepping does not read them (every substep starts
+ * its multipliers at 0), so a loaded world steps on the same either way.
  * ------------------------------------------------------------------------------------------- */
 
 /* The force of every constraint of `kind` in `group`, -lambda / h^2 of the last substep, in the order

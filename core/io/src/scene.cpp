@@ -1116,6 +1116,9 @@ class Builder {
     section("fields", [&](const json& f, const std::string& at) { field(w, f, at); });
     section("actions", [&](const json& a, const std::string& at) { action(a, at); });
     if (doc_.contains("tolerances")) meta_.tolerances = doc_["tolerances"].dump();
+    // Last: the forces name groups, pins and colliders, and count the constraints and tethers of
+    // the world as built.
+    if (doc_.contains("state") && doc_["state"].contains("forces")) forces(w, doc_["state"]["forces"]);
     return world;
   }
 
@@ -1332,6 +1335,59 @@ class Builder {
       w.set_positions(0, xs);
       w.set_velocities(0, vs);
       w.set_clock(s["frame"].get<int64_t>(), value_or(s, "time", 0.0));
+      return 0;
+    });
+  }
+
+  /// /state/forces: the multipliers and contact forces the force readers read (World::set_statics_state).
+  void forces(World& w, const json& f) {
+    const std::string at = "/state/forces";
+    StaticsState s;
+    const auto each = [&](const char* key, const auto& per_item) {
+      if (!f.contains(key)) return;
+      for (size_t i = 0; i < f[key].size(); ++i) per_item(f[key][i], at + "/" + key + "/" + std::to_string(i));
+    };
+    const auto numbers = [](const json& list) {
+      std::vector<double> out;
+      out.reserve(list.size());
+      for (const json& v : list) out.push_back(v.get<double>());
+      return out;
+    };
+    each("constraints", [&](const json& c, const std::string& where) {
+      StaticsState::Multipliers m;
+      m.group = group(c, "group", where);
+      m.kind = *kind_from_name(c["kind"].get<std::string>());  // the schema has checked it names a kind
+      m.lambda = numbers(c["multipliers"]);
+      const int64_t count = w.constraint_count(m.group, m.kind).first;
+      const int64_t per = multipliers(m.kind);
+      if (static_cast<int64_t>(m.lambda.size()) != per * count)
+        fail(where + "/multipliers", "has " + std::to_string(m.lambda.size()) + " multipliers for the " +
+                                         std::to_string(count) + " " + kind_name(m.kind) + " constraints of group '" +
+                                         c["group"].get<std::string>() + "' (" + std::to_string(per) + " each)");
+      s.constraints.push_back(std::move(m));
+    });
+    each("tethers", [&](const json& t, const std::string& where) {
+      s.tethers.push_back({group(t, "group", where), numbers(t["multipliers"])});
+    });
+    each("pins", [&](const json& p, const std::string& where) {
+      s.pins.push_back({named(pins_, p, "pin", where), vec3(p["multiplier"])});
+    });
+    each("contacts", [&](const json& c, const std::string& where) {
+      Contact ct{};
+      ct.particle = particle(w, c["particle"], where + "/particle");
+      ct.collider = static_cast<int32_t>(named(colliders_, c, "collider", where).index);
+      ct.force_h2 = vec3(c["force_h2"]);
+      s.contacts.push_back(ct);
+    });
+    each("face_contacts", [&](const json& c, const std::string& where) {
+      FaceContact fc{};
+      for (int k = 0; k < 3; ++k) fc.ids[k] = particle(w, c["particles"][k], where + "/particles/" + std::to_string(k));
+      fc.collider = static_cast<int32_t>(named(colliders_, c, "collider", where).index);
+      fc.force_h2 = vec3(c["force_h2"]);
+      s.face_contacts.push_back(fc);
+    });
+    guard(at, [&] {
+      w.set_statics_state(s);
       return 0;
     });
   }
@@ -1856,6 +1912,52 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                      {"rotation", {q.w(), q.x(), q.y(), q.z()}}});
   }
   if (!moved.empty()) doc["state"]["colliders"] = moved;
+  // The forces the readers read (a world stepped at least once): groups in creation order, pins in
+  // the order listed, contacts in the order found (the order the reaction sums them in).
+  const StaticsState st = w.statics_state();
+  const auto in_range = [](double v) { return std::abs(v) <= limits::kMaxAbsValue; };
+  bool savable = true;  // a multiplier beyond +-1e300 (no scene at rest holds one) keeps it out
+  for (const auto& m : st.constraints)
+    for (double v : m.lambda) savable = savable && in_range(v);
+  for (const auto& t : st.tethers)
+    for (double v : t.lambda) savable = savable && in_range(v);
+  for (const auto& p : st.pins)
+    for (int k = 0; k < 3; ++k) savable = savable && in_range(p.lambda[k]);
+  for (const Contact& ct : st.contacts)
+    for (int k = 0; k < 3; ++k) savable = savable && in_range(ct.force_h2[k]);
+  for (const FaceContact& fc : st.face_contacts)
+    for (int k = 0; k < 3; ++k) savable = savable && in_range(fc.force_h2[k]);
+  if (!st.empty() && savable) {
+    json forces = json::object();
+    json list = json::array(), tethers = json::array();
+    for (uint32_t slot : slots) {
+      for (const auto& m : st.constraints)
+        if (m.group.index == slot)
+          list.push_back({{"group", gname.at(slot)}, {"kind", kind_name(m.kind)}, {"multipliers", m.lambda}});
+      for (const auto& t : st.tethers)
+        if (t.group.index == slot) tethers.push_back({{"group", gname.at(slot)}, {"multipliers", t.lambda}});
+    }
+    if (!list.empty()) forces["constraints"] = list;
+    if (!tethers.empty()) forces["tethers"] = tethers;
+    std::map<uint32_t, Vec3> pin_lambda;
+    for (const auto& p : st.pins) pin_lambda[p.pin.index] = p.lambda;
+    json pin_list = json::array();
+    for (uint32_t i : pin_order)
+      if (pin_lambda.count(i)) pin_list.push_back({{"pin", pin_name.at(i)}, {"multiplier", vec_json(pin_lambda[i])}});
+    if (!pin_list.empty()) forces["pins"] = pin_list;
+    json contacts = json::array(), face_contacts = json::array();
+    for (const Contact& ct : st.contacts)
+      contacts.push_back({{"particle", ct.particle},
+                          {"collider", collider_name.at(static_cast<uint32_t>(ct.collider))},
+                          {"force_h2", vec_json(ct.force_h2)}});
+    for (const FaceContact& fc : st.face_contacts)
+      face_contacts.push_back({{"particles", {fc.ids[0], fc.ids[1], fc.ids[2]}},
+                               {"collider", collider_name.at(static_cast<uint32_t>(fc.collider))},
+                               {"force_h2", vec_json(fc.force_h2)}});
+    if (!contacts.empty()) forces["contacts"] = contacts;
+    if (!face_contacts.empty()) forces["face_contacts"] = face_contacts;
+    doc["state"]["forces"] = forces;
+  }
   return doc.dump(1) + "\n";
 }
 

@@ -11,9 +11,13 @@
 // (Settings::realign_passes) make so; textbook XPBD leaves an imbalance of O(h^2 g / length) of
 // the forces (World::realign, docs/design.md "Statics").
 #include "collision/collider_shapes.hpp"
+#include "common/check.hpp"
 #include "embra/core/world.hpp"
 #include "model/kind_traits.hpp"
 #include "solver/forces.hpp"
+
+#include <bit>
+#include <set>
 
 namespace embra {
 
@@ -110,6 +114,164 @@ std::vector<ColliderReaction> World::collider_reactions() const {
     add(fc.collider, bary[0] * x_[fc.ids[0]] + bary[1] * x_[fc.ids[1]] + bary[2] * x_[fc.ids[2]], inv_h2 * fc.force_h2);
   }
   return out;
+}
+
+namespace {
+
+/// A multiplier as a reset leaves it: +0 (a -0 is kept, so that a force read after a load has the
+/// same sign bit).
+bool is_reset(double v) {
+  return std::bit_cast<uint64_t>(v) == 0;
+}
+
+bool all_reset(const std::vector<double>& v) {
+  for (double x : v)
+    if (!is_reset(x)) return false;
+  return true;
+}
+
+}  // namespace
+
+StaticsState World::statics_state() const {
+  StaticsState s;
+  for (uint32_t slot = 0; slot < groups_.size(); ++slot) {
+    const Group& g = groups_[slot];
+    if (!g.alive) continue;
+    const Id id{slot, g.generation};
+    for (int k = 0; k < kKindCount; ++k) {
+      // What constraint_forces reads: the solver arrays' multipliers, back in ConstraintArray order.
+      const SolverArray& a = g.solve[k];
+      const size_t per = static_cast<size_t>(multipliers(static_cast<Kind>(k)));
+      std::vector<double> lambda(per * g.arrays[k].size(), 0.0);
+      for (size_t i = 0; i < a.size(); ++i)
+        if (a.source[i] >= 0 && static_cast<size_t>(a.source[i]) < g.arrays[k].size())
+          for (size_t c = 0; c < per; ++c) lambda[per * static_cast<size_t>(a.source[i]) + c] = a.lambda[per * i + c];
+      if (!all_reset(lambda)) s.constraints.push_back({id, static_cast<Kind>(k), std::move(lambda)});
+    }
+    if (!all_reset(g.tethers.lambda)) s.tethers.push_back({id, g.tethers.lambda});
+  }
+  for (uint32_t i = 0; i < pins_.size(); ++i) {
+    const Pin& p = pins_[i];
+    if (p.alive && !(is_reset(p.lambda.x()) && is_reset(p.lambda.y()) && is_reset(p.lambda.z())))
+      s.pins.push_back({Id{i, p.generation}, p.lambda});
+  }
+  const auto live = [&](int32_t c) {
+    return c >= 0 && static_cast<size_t>(c) < colliders_.size() && colliders_[c].alive;
+  };
+  if (settings_.contact_group.index < groups_.size())
+    for (const Contact& ct : groups_[settings_.contact_group.index].contacts)
+      if (ct.force_h2 != Vec3::Zero() && live(ct.collider)) s.contacts.push_back(ct);
+  for (const FaceContact& fc : face_contacts_)
+    if (fc.force_h2 != Vec3::Zero() && live(fc.collider)) s.face_contacts.push_back(fc);
+  return s;
+}
+
+void World::set_statics_state(const StaticsState& s) {
+  // The solver arrays as the next step would build them: the multipliers live there.
+  if (solver_dirty_)
+    rebuild_solver();
+  else if (rest_dirty_)
+    refresh_rest();
+  const auto finite = [](const std::vector<double>& v, const std::string& what) {
+    for (double x : v) check_finite(x, what);
+  };
+  const auto finite3 = [](const Vec3& v, const std::string& what) {
+    for (int k = 0; k < 3; ++k) check_finite(v[k], what);
+  };
+  const auto live_collider = [&](int32_t c, const std::string& what) {
+    if (c < 0 || static_cast<size_t>(c) >= colliders_.size() || !colliders_[c].alive)
+      throw Error(ErrorCode::stale_id, what + ": collider " + std::to_string(c) + " is no live collider of this world");
+  };
+  std::set<std::pair<uint32_t, int>> kinds_seen;
+  for (size_t i = 0; i < s.constraints.size(); ++i) {
+    const StaticsState::Multipliers& m = s.constraints[i];
+    const std::string what = "multipliers " + std::to_string(i);
+    const Group& g = group(m.group);
+    const int k = static_cast<int>(m.kind);
+    if (k < 0 || k >= kKindCount) invalid(what + ": no constraint kind " + std::to_string(k));
+    if (!kinds_seen.insert({m.group.index, k}).second)
+      invalid(what + ": the group's " + kind_name(m.kind) + " multipliers are given twice");
+    const size_t per = static_cast<size_t>(multipliers(m.kind));
+    if (m.lambda.size() != per * g.arrays[k].size())
+      invalid(what + ": " + std::to_string(m.lambda.size()) + " multipliers for the group's " +
+              std::to_string(g.arrays[k].size()) + " " + kind_name(m.kind) + " constraints (" + std::to_string(per) +
+              " each)");
+    finite(m.lambda, what);
+  }
+  std::set<uint32_t> tethers_seen;
+  for (size_t i = 0; i < s.tethers.size(); ++i) {
+    const StaticsState::Tethers& t = s.tethers[i];
+    const std::string what = "tether multipliers " + std::to_string(i);
+    const Group& g = group(t.group);
+    if (!tethers_seen.insert(t.group.index).second) invalid(what + ": the group's tethers are given twice");
+    if (t.lambda.size() != g.tethers.size())
+      invalid(what + ": " + std::to_string(t.lambda.size()) + " multipliers for the group's " +
+              std::to_string(g.tethers.size()) + " automatic tethers");
+    finite(t.lambda, what);
+  }
+  std::set<uint32_t> pins_seen;
+  for (size_t i = 0; i < s.pins.size(); ++i) {
+    const std::string what = "pin multiplier " + std::to_string(i);
+    const Pin& p = pin(s.pins[i].pin);
+    if (!pins_seen.insert(s.pins[i].pin.index).second) invalid(what + ": the pin is given twice");
+    if (p.kinematic()) invalid(what + ": a hard pin keeps no multiplier (its reaction is what holds the rest)");
+    finite3(s.pins[i].lambda, what);
+  }
+  for (size_t i = 0; i < s.contacts.size(); ++i) {
+    const Contact& ct = s.contacts[i];
+    const std::string what = "contact " + std::to_string(i);
+    check_particle(ct.particle, what.c_str());
+    live_collider(ct.collider, what);
+    finite3(ct.force_h2, what);
+  }
+  for (size_t i = 0; i < s.face_contacts.size(); ++i) {
+    const FaceContact& fc = s.face_contacts[i];
+    const std::string what = "face contact " + std::to_string(i);
+    for (int k = 0; k < 3; ++k) check_particle(fc.ids[k], what.c_str());
+    live_collider(fc.collider, what);
+    finite3(fc.force_h2, what);
+  }
+  // Every check passed: set them all, the rest to 0. The constraint arrays keep the same copy
+  // (end_frame's), which a step that fails restores.
+  for (Group& g : groups_) {
+    if (!g.alive) continue;
+    for (int k = 0; k < kKindCount; ++k) {
+      std::fill(g.arrays[k].lambda.begin(), g.arrays[k].lambda.end(), 0.0);
+      std::fill(g.solve[k].lambda.begin(), g.solve[k].lambda.end(), 0.0);
+    }
+    std::fill(g.tethers.lambda.begin(), g.tethers.lambda.end(), 0.0);
+  }
+  for (const StaticsState::Multipliers& m : s.constraints) {
+    Group& g = groups_[m.group.index];
+    const int k = static_cast<int>(m.kind);
+    const size_t per = static_cast<size_t>(multipliers(m.kind));
+    g.arrays[k].lambda = m.lambda;
+    SolverArray& a = g.solve[k];
+    for (size_t i = 0; i < a.size(); ++i)
+      for (size_t c = 0; c < per; ++c) a.lambda[per * i + c] = m.lambda[per * static_cast<size_t>(a.source[i]) + c];
+  }
+  for (const StaticsState::Tethers& t : s.tethers) groups_[t.group.index].tethers.lambda = t.lambda;
+  for (Pin& p : pins_) p.lambda.setZero();
+  for (const StaticsState::PinMultiplier& p : s.pins) pins_[p.pin.index].lambda = p.lambda;
+  std::vector<Contact>& contacts = groups_[settings_.contact_group.index].contacts;
+  contacts.clear();
+  for (const Contact& given : s.contacts) {
+    Contact ct{};
+    ct.particle = given.particle;
+    ct.collider = given.collider;
+    ct.lambda = 0.0;
+    ct.force_h2 = given.force_h2;
+    contacts.push_back(ct);
+  }
+  face_contacts_.clear();
+  for (const FaceContact& given : s.face_contacts) {
+    FaceContact fc{};
+    for (int k = 0; k < 3; ++k) fc.ids[k] = fc.partner[k] = given.ids[k];
+    fc.collider = given.collider;
+    fc.lambda = 0.0;
+    fc.force_h2 = given.force_h2;
+    face_contacts_.push_back(fc);
+  }
 }
 
 }  // namespace embra

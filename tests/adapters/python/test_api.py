@@ -218,6 +218,11 @@ def test_collider_reactions_carry_what_rests_on_a_ground_plane():
         assert max(abs(r[0]["force"][k] + total[k]) for k in range(3)) < 1e-9 * scale
         assert max(abs(r[0]["moment"][k] + moment[k]) for k in range(3)) < 1e-9 * math.hypot(*moment)
         assert w.reactions() == []
+        # Saved and loaded (the scene's state.forces), the plane reads the same force before a step.
+        with embra.World.load_json(w.save_json()) as loaded:
+            again = loaded.collider_reactions()
+            assert [(c["force"], c["moment"], c["contacts"]) for c in again] == \
+                [(c["force"], c["moment"], c["contacts"]) for c in r]
 
 
 def test_area_and_line_loads_accelerate_free_particles_and_read_back():

@@ -445,6 +445,36 @@ struct FaceContact {
   Vec3 force_h2 = Vec3::Zero();
 };
 
+/// What the force readers (World::constraint_forces, reactions, collider_reactions, and the
+/// diagnostics' forces) read of the last step beyond the positions and the model: the multipliers of
+/// its last substep and its contacts' forces. A saved scene keeps it (state.forces,
+/// docs/scene-format.md) so that a loaded world reads the forces the saved one read before its first
+/// step. Stepping never reads it: each substep sets every multiplier to 0 and finds its contacts
+/// afresh before projecting.
+struct StaticsState {
+  struct Multipliers {
+    Id group;
+    Kind kind = Kind::distance;
+    std::vector<double> lambda;  // multipliers(kind) per constraint, in ConstraintArray order
+  };
+  struct Tethers {
+    Id group;
+    std::vector<double> lambda;  // one per automatic tether, in the solver's (colour) order
+  };
+  struct PinMultiplier {
+    Id pin;
+    Vec3 lambda = Vec3::Zero();
+  };
+  std::vector<Multipliers> constraints;    // a (group, kind) not listed: all 0
+  std::vector<Tethers> tethers;            // a group not listed: all 0
+  std::vector<PinMultiplier> pins;         // a pin not listed: 0 (a hard pin keeps none)
+  std::vector<Contact> contacts;           // particle, collider (slot) and force_h2 are what is read
+  std::vector<FaceContact> face_contacts;  // ids, collider (slot) and force_h2 are what is read
+  bool empty() const {
+    return constraints.empty() && tethers.empty() && pins.empty() && contacts.empty() && face_contacts.empty();
+  }
+};
+
 struct Group {
   GroupDesc desc;
   uint32_t generation = 0;
@@ -761,6 +791,19 @@ class World {
   /// about the collider's position, each force acting at its particle (a face contact: its contact
   /// point).
   std::vector<ColliderReaction> collider_reactions() const;
+  /// What those readers read (StaticsState), for saving: every (group, kind) and group's automatic
+  /// tethers with a multiplier that is not +0, every pin whose multiplier is not +0, and the contacts
+  /// with a force on a live collider, each in the order the readers sum them.
+  StaticsState statics_state() const;
+  /// Replaces it (a saved scene's state.forces, loaded): the solver arrays are brought up to date
+  /// first, as the next step would (a world edited since its last step has them rebuilt, its
+  /// multipliers 0, whether or not `state` is then accepted), then every multiplier and contact
+  /// force is set from `state` and those it does not list to 0. Refused, changing no multiplier or
+  /// contact beyond that rebuild: a stale group, pin or collider, a kind listed twice for a group
+  /// (or a group's tethers twice, a pin twice), a count that is not multipliers(kind) per constraint
+  /// of the group's kind (one per automatic tether), a hard pin (it keeps no multiplier), a particle
+  /// out of range, a value not finite within +-1e300.
+  void set_statics_state(const StaticsState& state);
   const Warning& warning() const { return warning_; }
 
  private:
