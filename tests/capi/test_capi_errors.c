@@ -1149,6 +1149,36 @@ static void test_polygon_planarity_add(void) {
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "degenerate", embra_polygon_planarity_add(W, deflt, line, 4, 0.0, NULL));
 }
 
+/* The refusals embra_rigid_set_add and embra_shape_match_add share (one signature): no world, no
+ * particles, a count below 3, negative or past the array, a compliance non-finite or negative, a
+ * stale group, a point outside the world or given twice. */
+typedef embra_status (*point_set_add_fn)(embra_world*, embra_group_id, const int32_t*, int32_t, double, int32_t*);
+static void refuse_point_set_arguments(point_set_add_fn add, const char* what) {
+  const int32_t c = g_ref.cloth;
+  int32_t cloth[9], i;
+  const embra_group_id deflt = {0, 0};
+  for (i = 0; i < 9; ++i) cloth[i] = c + i;
+  CAPI_CONTEXT("%s", what);
+  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", add(NULL, deflt, cloth, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", add(W, deflt, NULL, 9, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", add(W, deflt, cloth, 2, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", add(W, deflt, cloth, -1, 0.0, NULL));
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
+  for (i = 0; i < 3; ++i) {
+    CAPI_CONTEXT("%s compliance %s", what, bad_name(i));
+    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", add(W, deflt, cloth, 9, bad_value(i), NULL));
+  }
+  CAPI_CONTEXT("%s", what);
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", add(W, deflt, cloth, 9, -1.0, NULL));
+  REFUSED(EMBRA_ERROR_STALE_ID, "group", add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
+  cloth[7] = g_ref.n;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = -1;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", add(W, deflt, cloth, 9, 0.0, NULL));
+  cloth[7] = c + 2;
+  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", add(W, deflt, cloth, 9, 0.0, NULL));
+}
+
 /* embra_rigid_set_add: the flat cloth (nine points) and the tetrahedron with the free point (solid)
  * are good, 4 n - 9 constraints each; a point outside the world or given twice, fewer than three, a
  * bad compliance, a stale group, two points at one place and a set on one line are refused. */
@@ -1168,23 +1198,7 @@ static void test_rigid_set_add(void) {
     CHECK_INT(added, 11);
     embra_world_destroy(s.w);
   }
-  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_rigid_set_add(NULL, deflt, cloth, 9, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_rigid_set_add(W, deflt, NULL, 9, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, 2, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_rigid_set_add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
-  for (i = 0; i < 3; ++i) {
-    CAPI_CONTEXT("rigid set compliance %s", bad_name(i));
-    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, bad_value(i), NULL));
-  }
-  CAPI_CONTEXT("rigid set");
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_rigid_set_add(W, deflt, cloth, 9, -1.0, NULL));
-  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_rigid_set_add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
-  cloth[7] = g_ref.n;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
-  cloth[7] = -1;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
-  cloth[7] = c + 2;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_rigid_set_add(W, deflt, cloth, 9, 0.0, NULL));
+  refuse_point_set_arguments(embra_rigid_set_add, "rigid set");
   bad[0] = g_ref.fixture + F0, bad[1] = g_ref.fixture + F2, bad[2] = g_ref.fixture + F5; /* on one line */
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_rigid_set_add(W, deflt, bad, 3, 0.0, NULL));
   bad[1] = g_ref.fixture + F1, bad[2] = g_ref.fixture + F3; /* F0 and F1 at one place */
@@ -1214,24 +1228,7 @@ static void test_shape_match_add(void) {
     CHECK_INT(count, 1);
     embra_world_destroy(s.w);
   }
-  REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_shape_match_add(NULL, deflt, cloth, 9, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "particles", embra_shape_match_add(W, deflt, NULL, 9, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, 2, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, -1, 0.0, NULL));
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "count", embra_shape_match_add(W, deflt, cloth, INT32_MAX, 0.0, NULL));
-  for (i = 0; i < 3; ++i) {
-    CAPI_CONTEXT("shape match compliance %s", bad_name(i));
-    REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_shape_match_add(W, deflt, cloth, 9, bad_value(i), NULL));
-  }
-  CAPI_CONTEXT("shape match");
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "compliance", embra_shape_match_add(W, deflt, cloth, 9, -1.0, NULL));
-  REFUSED(EMBRA_ERROR_STALE_ID, "group", embra_shape_match_add(W, g_ref.g_dead, cloth, 9, 0.0, NULL));
-  cloth[7] = g_ref.n;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
-  cloth[7] = -1;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "outside", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
-  cloth[7] = c + 2;
-  REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "twice", embra_shape_match_add(W, deflt, cloth, 9, 0.0, NULL));
+  refuse_point_set_arguments(embra_shape_match_add, "shape match");
   bad[0] = g_ref.fixture + F0, bad[1] = g_ref.fixture + F2, bad[2] = g_ref.fixture + F5; /* on one line */
   REFUSED(EMBRA_ERROR_INVALID_ARGUMENT, "line", embra_shape_match_add(W, deflt, bad, 3, 0.0, NULL));
   bad[1] = g_ref.fixture + F1; /* F0 and F1 at one place: with F5, two places, a line */
