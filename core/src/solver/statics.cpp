@@ -139,14 +139,10 @@ StaticsState World::statics_state() const {
     if (!g.alive) continue;
     const Id id{slot, g.generation};
     for (int k = 0; k < kKindCount; ++k) {
-      // What constraint_forces reads: the solver arrays' multipliers, back in ConstraintArray order.
-      const SolverArray& a = g.solve[k];
-      const size_t per = static_cast<size_t>(multipliers(static_cast<Kind>(k)));
-      std::vector<double> lambda(per * g.arrays[k].size(), 0.0);
-      for (size_t i = 0; i < a.size(); ++i)
-        if (a.source[i] >= 0 && static_cast<size_t>(a.source[i]) < g.arrays[k].size())
-          for (size_t c = 0; c < per; ++c) lambda[per * static_cast<size_t>(a.source[i]) + c] = a.lambda[per * i + c];
-      if (!all_reset(lambda)) s.constraints.push_back({id, static_cast<Kind>(k), std::move(lambda)});
+      // What constraint_forces reads, in ConstraintArray order: end_frame's copy of the solver
+      // arrays' multipliers, kept in step with the constraints by every edit.
+      const std::vector<double>& lambda = g.arrays[k].lambda;
+      if (!all_reset(lambda)) s.constraints.push_back({id, static_cast<Kind>(k), lambda});
     }
     if (!all_reset(g.tethers.lambda)) s.tethers.push_back({id, g.tethers.lambda});
   }
