@@ -2,6 +2,7 @@
 #include "guard.hpp"
 
 #include "embra/core/limits.hpp"
+#include "embra/core/point_set.hpp"
 
 #include <algorithm>
 #include <iterator>
@@ -87,12 +88,8 @@ embra_status embra_polygon_planarity_add(embra_world* world, embra_group_id grou
       if (corners[i] < 0 || corners[i] >= n)
         refuse(EMBRA_ERROR_INVALID_ARGUMENT, "particles[" + num(i) + "] = " + num(corners[i]) +
                                                  " is outside the world's particles [0, " + num(n) + ")");
-    std::vector<int32_t> sorted(corners.begin(), corners.end());
-    std::sort(sorted.begin(), sorted.end());
-    for (size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i] == sorted[i - 1])
-        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
-               "the polygon is degenerate: particle " + num(sorted[i]) + " appears twice");
+    if (const int32_t twice = embra::repeated_particle(corners); twice >= 0)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "the polygon is degenerate: particle " + num(twice) + " appears twice");
     // One window of four consecutive corners for a quad; every one of them, cyclically, for more.
     const int32_t windows = count == 4 ? 1 : count;
     std::vector<int32_t> ids(static_cast<size_t>(windows) * 4);
@@ -130,37 +127,21 @@ embra_status embra_rigid_set_add(embra_world* world, embra_group_id group, const
       if (pts[i] < 0 || pts[i] >= n)
         refuse(EMBRA_ERROR_INVALID_ARGUMENT,
                "particles[" + num(i) + "] = " + num(pts[i]) + " is outside the world's particles [0, " + num(n) + ")");
-    std::vector<int32_t> sorted(pts.begin(), pts.end());
-    std::sort(sorted.begin(), sorted.end());
-    for (size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i] == sorted[i - 1])
-        refuse(EMBRA_ERROR_INVALID_ARGUMENT,
-               "the point set is degenerate: particle " + num(sorted[i]) + " appears twice");
-    // The base: a the first point, b the farthest from it, c the farthest from the line ab, d the
-    // farthest from the plane abc (the first of equals, so the choice is the same on every machine).
+    if (const int32_t twice = embra::repeated_particle(pts); twice >= 0)
+      refuse(EMBRA_ERROR_INVALID_ARGUMENT, "the point set is degenerate: particle " + num(twice) + " appears twice");
+    // The base: the first point, the farthest from it, the farthest from their line, the farthest
+    // from the plane of those three (embra::point_set_base).
     const std::vector<embra::Vec3>& x = world->world.positions();
-    const auto farthest = [&](auto&& distance) {
-      int32_t best = 0;
-      double most = -1.0;
-      for (int32_t i = 0; i < count; ++i)
-        if (const double d = distance(x[pts[i]]); d > most) most = d, best = i;
-      return std::pair<int32_t, double>{best, most};
-    };
-    const embra::Vec3 xa = x[pts[0]];
-    const auto [ib, size] = farthest([&](const embra::Vec3& p) { return (p - xa).norm(); });
-    const embra::Vec3 u = (x[pts[ib]] - xa) / size;
-    const auto [ic, off_line] = farthest([&](const embra::Vec3& p) { return (p - xa).cross(u).norm(); });
-    if (!(off_line > 1e-6 * size))
+    const embra::PointSetBase set = embra::point_set_base(pts.size(), [&](size_t i) { return x[pts[i]]; });
+    if (!set.spans_plane())
       refuse(EMBRA_ERROR_INVALID_ARGUMENT,
              "the point set is degenerate: its points are on one line (or coincide), no rigid frame to hold");
-    const embra::Vec3 normal = u.cross(x[pts[ic]] - xa).normalized();
-    const auto [id, off_plane] = farthest([&](const embra::Vec3& p) { return std::abs((p - xa).dot(normal)); });
     // Solid when a point is 1e-3 of the set's size off the plane (its base tetrahedron then has a volume
     // the tet_volume kind measures: at least 1e-10 of the size cubed); else flat, each point held at
     // its offset from the base's plane.
-    const bool solid = off_plane > 1e-3 * size;
-    std::vector<int32_t> base{pts[0], pts[ib], pts[ic]};
-    if (solid) base.push_back(pts[id]);
+    const bool solid = set.plane_distance > 1e-3 * set.reach;
+    std::vector<int32_t> base{pts[0], pts[set.far], pts[set.off]};
+    if (solid) base.push_back(pts[set.off_plane]);
     // Distances among the base; every other point's distances to each base point; a solid base's
     // volume (its handedness), a flat set's points held on the base's plane.
     std::vector<int32_t> pairs, tet, offsets;

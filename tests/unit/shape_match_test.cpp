@@ -14,7 +14,10 @@
 //   - a soft set hung from one pinned point comes to rest with each free point alpha m_bar g below
 //     its goal (the static balance of its weight and the goal's pull): twice the compliance, twice
 //     the sag;
-//   - the same bits at 1 and 4 threads; bad input refused, changing nothing.
+//   - the same bits at 1 and 4 threads; bad input refused, changing nothing;
+//   - the point-set checks every adder shares (point_set.hpp): the base of a set with known
+//     distances, the one-line limit, a repeated particle.
+#include "embra/core/point_set.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -459,6 +462,31 @@ TEST(ShapeMatch, BadInputIsRefusedAndChangesNothing) {
   EXPECT_THROW(w.remove_shape_match(Id{}, 1), Error);
   w.remove_shape_match(Id{}, 0);
   EXPECT_TRUE(w.shape_matches(Id{}).empty());
+}
+
+TEST(PointSet, BaseHasTheKnownFarthestPoints) {
+  // From (0,0,0): (3,4,0) is 5 away, the farthest; (4,-3,0) is 5 from the line through those two
+  // (perpendicular to it), the farthest; (1,1,2) is 2 from their plane z = 0, the farthest.
+  const std::vector<Vec3> p{Vec3(0, 0, 0), Vec3(1, 1, 2), Vec3(3, 4, 0), Vec3(4, -3, 0), Vec3(1, 1, 0)};
+  const PointSetBase b = point_set_base(p.size(), [&](size_t i) { return p[i]; });
+  EXPECT_EQ(b.far, 2u);
+  EXPECT_DOUBLE_EQ(b.reach, 5.0);
+  EXPECT_EQ(b.off, 3u);
+  EXPECT_NEAR(b.off_line, 5.0, 1e-15);
+  EXPECT_EQ(b.off_plane, 1u);
+  EXPECT_NEAR(b.plane_distance, 2.0, 1e-15);
+  EXPECT_TRUE(b.spans_plane());
+  // A third point 1e-7 of the reach off the line does not span a plane; 1e-5 does.
+  for (const double off : {1e-7, 1e-5}) {
+    const std::vector<Vec3> q{Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(5, 10 * off, 0)};
+    EXPECT_EQ(point_set_base(q.size(), [&](size_t i) { return q[i]; }).spans_plane(), off > 1e-6) << off;
+  }
+  const std::vector<Vec3> one_place(3, Vec3(1, 2, 3));
+  const PointSetBase c = point_set_base(3, [&](size_t i) { return one_place[i]; });
+  EXPECT_EQ(c.reach, 0.0);
+  EXPECT_FALSE(c.spans_plane());
+  EXPECT_EQ(repeated_particle(std::vector<int32_t>{4, 2, 9, 2, 4}), 2);
+  EXPECT_EQ(repeated_particle(std::vector<int32_t>{4, 2, 9}), -1);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "common/pool.hpp"
 #include "common/slots.hpp"
 #include "embra/core/panels.hpp"
+#include "embra/core/point_set.hpp"
 #include "model/kind_traits.hpp"
 #include "solver/global_solve.hpp"
 
@@ -457,26 +458,17 @@ int64_t World::add_shape_match(Id group_id, std::span<const int32_t> particles, 
             std::to_string(n));
   check_non_negative(compliance, "shape match compliance");
   for (size_t i = 0; i < n; ++i) check_particle(particles[i], ("shape match particle " + std::to_string(i)).c_str());
-  std::vector<int32_t> sorted(particles.begin(), particles.end());
-  std::sort(sorted.begin(), sorted.end());
-  for (size_t i = 1; i < n; ++i)
-    if (sorted[i] == sorted[i - 1]) invalid("shape match particle " + std::to_string(sorted[i]) + " appears twice");
+  if (const int32_t twice = repeated_particle(particles); twice >= 0)
+    invalid("shape match particle " + std::to_string(twice) + " appears twice");
   std::vector<Vec3> r(n);
   for (size_t i = 0; i < n; ++i) {
     r[i] = rest.empty() ? x_[particles[i]] : rest[i];
     for (int k = 0; k < 3; ++k) check_finite(r[i][k], "shape match rest point " + std::to_string(i));
   }
-  // A rotation to fit needs the rest shape off one line: its farthest point from the first, then the
-  // farthest from their line, at least 1e-6 of that reach from it.
-  size_t far = 0;
-  for (size_t i = 1; i < n; ++i)
-    if ((r[i] - r[0]).squaredNorm() > (r[far] - r[0]).squaredNorm()) far = i;
-  const double reach = (r[far] - r[0]).norm();
-  if (!(reach > 0.0)) invalid("the shape match's rest points are all at one place: no rotation to fit");
-  const Vec3 axis = (r[far] - r[0]) / reach;
-  double off = 0.0;
-  for (size_t i = 0; i < n; ++i) off = std::max(off, (r[i] - r[0]).cross(axis).norm());
-  if (!(off > 1e-6 * reach))
+  // A rotation to fit needs the rest shape off one line (point_set_base).
+  const PointSetBase base = point_set_base(n, [&](size_t i) { return r[i]; });
+  if (!(base.reach > 0.0)) invalid("the shape match's rest points are all at one place: no rotation to fit");
+  if (!base.spans_plane())
     invalid(
         "the shape match's rest points are on one line (within 1e-6 of their reach): no rotation about it to "
         "fit");
