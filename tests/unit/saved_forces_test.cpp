@@ -249,7 +249,7 @@ TEST(SavedForces, AutomaticTethersAreSavedWithTheirGroup) {
 
 /// What does not match the world built from the scene is refused, and nothing is built: a wrong
 /// count of multipliers, a kind the group does not hold, tethers of the wrong count, a pin or
-/// collider that is not in the scene, a hard pin, a particle out of range, a number beyond 1e300.
+/// collider that is not in the scene, a pin given twice, a particle out of range, a number beyond 1e300.
 /// The core's own check refuses a wrong count and leaves every force as it was.
 TEST(SavedForces, StateThatDoesNotMatchTheWorldIsRefused) {
   Settings s = test::settings(4, 20, Vec3(0.0, 0.0, -kG), 4.0);
@@ -272,7 +272,7 @@ TEST(SavedForces, StateThatDoesNotMatchTheWorldIsRefused) {
   const json doc = json::parse(text);
   const json& forces = doc["state"]["forces"];
   ASSERT_TRUE(forces.contains("constraints") && forces.contains("pins") && forces.contains("contacts"));
-  EXPECT_EQ(forces["pins"].size(), 1u) << "the soft pin only: a hard pin keeps no multiplier";
+  EXPECT_EQ(forces["pins"].size(), 2u) << "the soft pin's multiplier and the hard pin's impulse";
 
   const auto refused = [&](const std::function<void(json&)>& edit, const std::string& where) {
     json d = doc;
@@ -300,7 +300,7 @@ TEST(SavedForces, StateThatDoesNotMatchTheWorldIsRefused) {
       },
       "automatic tethers");
   refused([](json& d) { d["state"]["forces"]["pins"][0]["pin"] = "nowhere"; }, "/state/forces/pins/0/pin");
-  refused([&](json& d) { d["state"]["forces"]["pins"][0]["pin"] = d["pins"][0]["name"]; }, "hard pin");
+  refused([](json& d) { d["state"]["forces"]["pins"].push_back(d["state"]["forces"]["pins"][0]); }, "given twice");
   refused([](json& d) { d["state"]["forces"]["contacts"][0]["collider"] = "nowhere"; },
           "/state/forces/contacts/0/collider");
   refused([](json& d) { d["state"]["forces"]["contacts"][0]["particle"] = 16; }, "/state/forces/contacts/0/particle");

@@ -14,6 +14,7 @@
 //   - a soft set hung from one pinned point comes to rest with each free point alpha m_bar g below
 //     its goal (the static balance of its weight and the goal's pull): twice the compliance, twice
 //     the sag;
+//   - hung from one hard-pinned point, then two, at rest: the pins' reactions sum to minus the weight;
 //   - the same bits at 1 and 4 threads; bad input refused, changing nothing;
 //   - the point-set checks every adder shares (point_set.hpp): the base of a set with known
 //     distances, the one-line limit, a repeated particle.
@@ -402,6 +403,30 @@ TEST(ShapeMatch, SoftSetHungFromAPinSagsByItsCompliance) {
   EXPECT_LT(worst, 1e-6);
   EXPECT_GT(sag2, sag1);
   EXPECT_NEAR(sag2 / sag1, 2.0, 1e-5);
+}
+
+/// The same set hung from one hard-pinned point, then from two: at rest the pins' reactions sum to
+/// minus the set's weight. A pinned point does not move, but it takes back what the free points
+/// took from the set's pull (the set's forces, over all its points, are momentum-neutral); between
+/// two pins the split is the least-norm one that balances force and moment.
+TEST(ShapeMatch, HardPinnedPointsCarryTheSetsWeight) {
+  for (const int pinned : {1, 2}) {
+    Settings s = test::settings(8, 30, Vec3(0.0, 0.0, -kG), 4.0);
+    World w(s);
+    const std::vector<Vec3> x = {Vec3(0.0, 0.0, 1.0),  Vec3(0.3, 0.0, 1.0),  Vec3(0.0, 0.3, 1.0),
+                                 Vec3(0.3, 0.3, 1.05), Vec3(0.15, 0.1, 0.8), Vec3(0.2, 0.25, 0.9)};
+    const int32_t first = test::add_particles(w, x, {1.0, 0.5, 0.8, 1.2, 0.7, 1.1});
+    for (int k = 0; k < pinned; ++k) test::hard_pin(w, first + k, x[static_cast<size_t>(k)]);
+    w.add_shape_match(Id{}, iota(first, 6), {}, 1e-4);
+    for (int frame = 0; frame < 1500; ++frame) w.step();
+    Vec3 sum = Vec3::Zero();
+    for (const Reaction& r : w.reactions()) sum += r.force;
+    const Vec3 weight = test::applied_load(w);
+    const double imbalance = (sum + weight).norm() / weight.norm();
+    ::testing::Test::RecordProperty("imbalance_" + std::to_string(pinned) + "_pins", sci(imbalance));
+    EXPECT_LT(w.report().max_speed, 1e-9) << pinned << " pins: at rest";
+    EXPECT_LT(imbalance, 1e-9) << pinned << " pins";
+  }
 }
 
 std::vector<Vec3> run_with_threads(int32_t threads) {

@@ -1005,6 +1005,12 @@ EMBRA_API embra_status embra_group_get_residuals(const embra_world* world, embra
  * _file, `embra run`'s final.json) reads the same forces and reactions, bit for bit, before its first
  * step; a scene without them reads 0 until a step. Stepping does not read them (every substep starts
  * its multipliers at 0), so a loaded world steps on the same either way.
+ * A hard pin's reaction is read from what its particle took, not from the end of the substep: each
+ * projection of a constraint holding it hands it grad C dlambda (the gradient where the projection
+ * starts), summed over the last substep. Whatever the constraints' multipliers (redundant hard
+ * constraints, as a panel mesh's, let them grow against each other), the pins then carry exactly
+ * what the free particles do not: at a static rest the reactions sum to minus the load to rounding,
+ * with or without realignment passes.
  * ------------------------------------------------------------------------------------------- */
 
 /* The force of every constraint of `kind` in `group`, -lambda / h^2 of the last substep, in the order
@@ -1025,10 +1031,13 @@ typedef struct embra_reaction {
                       (normal to its plane, across its line): its multiplier over
                       h^2. A hard point pin: minus the particle's weight (gravity / inverse mass; none
                       for an immovable particle), its point load, its share of the area and line
-                      loads (at the current positions) and the forces on it of every
-                      constraint and soft pin (and automatic tether, when realign_passes >= 1:
-                      without realignment they keep no multiplier). Fields (wind, pressure, surface
-                      tension, vortex) and contacts on the pinned particle are not counted */
+                      loads (at the current positions) and the impulse over h^2 the constraints
+                      handed it in the last substep (every constraint kind and weld, shape
+                      matches, and the automatic tethers when realign_passes >= 1: without
+                      realignment they keep no multiplier; the global solve's steps without
+                      realignment: read from the multipliers where the substep ends). Fields
+                      (wind, pressure, surface tension, vortex), self contacts and contacts on the
+                      pinned particle are not counted */
 } embra_reaction;
 
 /* The reaction at every live pin after the last step, pins in creation-slot order (as

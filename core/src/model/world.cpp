@@ -1373,6 +1373,7 @@ void World::rebuild_solver() {
     }
   }
   chain_scratch_.assign(kChainScratch * (longest + 1) * static_cast<size_t>(pool_->size()), 0.0);
+  find_pinned_slots();
   solver_dirty_ = false;
   refresh_rest();
 }

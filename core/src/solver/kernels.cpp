@@ -1,5 +1,6 @@
 // The projection kernels (kernels.hpp), for every lane width: scalar, vec2 and avx2.
 #include "solver/kernels.hpp"
+#include "solver/pin_track.hpp"
 
 #include "common/lanes.hpp"
 #include "embra/core/constraint_math.hpp"
@@ -757,13 +758,16 @@ void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double
 }
 
 void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, const double* w,
-                std::vector<double>& scratch) {
+                std::vector<double>& scratch, ChainTrack* track) {
   const Kernels& k = kernels();
   const size_t stride = scratch.size() / static_cast<size_t>(pool.size());
-  each_colour(pool, a.chain_colour_start, a.chain_shared_tail, kChainGrain,
-              [&](size_t b, size_t e, bool in_lanes, int part) {
-                k.chain(a, b, e, in_lanes, inv_h2, x, w, scratch.data() + stride * static_cast<size_t>(part));
-              });
+  const auto run = [&](size_t b, size_t e, bool in_lanes, int part) {
+    k.chain(a, b, e, in_lanes, inv_h2, x, w, scratch.data() + stride * static_cast<size_t>(part));
+  };
+  if (track != nullptr)
+    passes::each_colour_tracked(pool, a.chain_colour_start, a.chain_shared_tail, kChainGrain, run, *track);
+  else
+    each_colour(pool, a.chain_colour_start, a.chain_shared_tail, kChainGrain, run);
 }
 
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w) {

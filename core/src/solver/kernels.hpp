@@ -11,6 +11,8 @@
 
 namespace embra {
 
+class ChainTrack;  // solver/pin_track.hpp
+
 /// The coordinates of a position array as one array of doubles (x0 y0 z0 x1 ...); null when empty.
 inline double* coords(std::vector<Vec3>& x) {
   return x.empty() ? nullptr : x.front().data();
@@ -68,6 +70,38 @@ void each_colour(ThreadPool& pool, const std::vector<int32_t>& starts, bool shar
   }
 }
 
+/// each_colour with `track.before(begin, end)` and `track.after(begin, end)` around every run of
+/// items: each colour whole, a shared tail one tracked item at a time (`track.next(i)`: the first
+/// tracked item at or after i, or SIZE_MAX) with the runs between them whole. What `before` reads
+/// is then what each item's projection starts from: items of a colour share no movable particle.
+/// The items run in the same order and lanes as each_colour's, so the result has the same bits.
+template <class F, class Track>
+void each_colour_tracked(ThreadPool& pool, const std::vector<int32_t>& starts, bool shared_tail, size_t grain, F&& run,
+                         Track& track) {
+  const size_t colours = starts.empty() ? 0 : starts.size() - 1;
+  for (size_t c = 0; c < colours; ++c) {
+    const size_t begin = static_cast<size_t>(starts[c]), end = static_cast<size_t>(starts[c + 1]);
+    if (shared_tail && c + 1 == colours) {
+      for (size_t i = begin; i < end;) {
+        const size_t t = track.next(i);
+        if (t >= end) {
+          run(i, end, false, 0);
+          break;
+        }
+        if (t > i) run(i, t, false, 0);
+        track.before(t, t + 1);
+        run(t, t + 1, false, 0);
+        track.after(t, t + 1);
+        i = t + 1;
+      }
+    } else {
+      track.before(begin, end);
+      pool.run(begin, end, kAlign, grain, [&](size_t b, size_t e, int part) { run(b, e, true, part); });
+      track.after(begin, end);
+    }
+  }
+}
+
 /// Calls project(i) for every constraint i of `a`, colour by colour, each colour's constraints
 /// split over the pool's threads (a shared tail in order on the caller): for the kinds projected
 /// one constraint at a time. Constraints of one colour share no particle, so every split gives the
@@ -88,8 +122,9 @@ void each_constraint(ThreadPool& pool, const SolverArray& a, F&& project) {
 /// One pass of `kernel` over every constraint of `a`.
 void project_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, double* x, const double* w);
 /// The chain pass over every chain of `a`; `scratch` holds one equal share per thread of the pool.
+/// With `track`, the hard pins' shares are tracked around every run (ChainTrack, pin_track.hpp).
 void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, const double* w,
-                std::vector<double>& scratch);
+                std::vector<double>& scratch, ChainTrack* track = nullptr);
 /// Every automatic tether run of `t` (runs share no particle).
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
 /// The function values of every constraint of `a` into out[0 .. a.size()).

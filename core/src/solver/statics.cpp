@@ -10,6 +10,14 @@
 // projections' gradients are those of the end of the substep, which the realignment passes
 // (Settings::realign_passes) make so; textbook XPBD leaves an imbalance of O(h^2 g / length) of
 // the forces (World::realign, docs/design.md "Statics").
+//
+// Hard pins: a hard-pinned particle's reaction is what holds it against its weight, its load and
+// the impulse the constraints handed it in the last substep (Pin::lambda), summed projection by
+// projection as the projections gave it (solver/pin_track.hpp), not read from the multipliers at
+// the end. Every projection is momentum-neutral (its gradients sum to zero), so what the pins took
+// is exactly what the free particles' motion did not: at a static rest the reactions sum to minus
+// the load to rounding, even where redundant hard constraints (a panel mesh's) leave the
+// multipliers undetermined and growing against each other.
 #include "collision/collider_shapes.hpp"
 #include "common/check.hpp"
 #include "embra/core/world.hpp"
@@ -40,23 +48,9 @@ std::vector<double> World::constraint_forces(Id group_id, Kind kind) const {
 std::vector<Reaction> World::reactions() const {
   const double h = settings_.dt / settings_.substeps;
   const double inv_h2 = 1.0 / (h * h);
-  std::vector<Vec3> f(x_.size(), Vec3::Zero());
+  // The loads as the last substep applied them: at a static rest its start is where it ended.
   bool any_hard = false;
   for (const Pin& p : pins_) any_hard = any_hard || (p.alive && p.kinematic());
-  // Every constraint's force on every particle (only a hard-pinned particle's sum is read).
-  if (any_hard)
-    for (int32_t slot : order_) {
-      const Group& g = groups_[slot];
-      add_group_forces(g, pins_, x_, inv_h2, f);
-      const SolverArray& t = g.tethers;
-      for (size_t i = 0; i < t.size(); ++i) {
-        if (t.lambda.empty() || t.lambda[i] == 0.0) continue;
-        const auto e = KindTraits<Kind::tether>::evaluate(&t.ids[2 * i], x_);
-        if (!e.valid) continue;
-        for (int m = 0; m < 2; ++m) f[t.ids[2 * i + m]] += (t.lambda[i] * inv_h2) * e.grad[m];
-      }
-    }
-  // The loads as the last substep applied them: at a static rest its start is where it ended.
   const std::vector<Vec3> load = any_hard ? applied_loads() : std::vector<Vec3>();
   std::vector<Reaction> out;
   for (size_t i = 0; i < pins_.size(); ++i) {
@@ -68,9 +62,11 @@ std::vector<Reaction> World::reactions() const {
     if (!p.kinematic()) {
       r.force = inv_h2 * p.lambda;
     } else {
+      // What holds the particle against its weight, its load and the impulse the constraints handed
+      // it in the last substep (Pin::lambda, tracked by PinTrack).
       const double inv_mass = inv_mass_[p.particle];
       const Vec3 weight = inv_mass > 0.0 ? Vec3(settings_.gravity / inv_mass) : Vec3(Vec3::Zero());
-      r.force = -(weight + load[p.particle] + f[p.particle]);
+      r.force = -(weight + load[p.particle] + inv_h2 * p.lambda);
     }
     out.push_back(r);
   }
@@ -208,9 +204,8 @@ void World::set_statics_state(const StaticsState& s) {
   std::set<uint32_t> pins_seen;
   for (size_t i = 0; i < s.pins.size(); ++i) {
     const std::string what = "pin multiplier " + std::to_string(i);
-    const Pin& p = pin(s.pins[i].pin);
+    pin(s.pins[i].pin);  // a live pin (else stale_id)
     if (!pins_seen.insert(s.pins[i].pin.index).second) invalid(what + ": the pin is given twice");
-    if (p.kinematic()) invalid(what + ": a hard pin keeps no multiplier (its reaction is what holds the rest)");
     finite3(s.pins[i].lambda, what);
   }
   for (size_t i = 0; i < s.contacts.size(); ++i) {

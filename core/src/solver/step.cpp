@@ -27,6 +27,7 @@
 #include "model/kind_traits.hpp"
 #include "solver/contacts.hpp"
 #include "solver/kernels.hpp"
+#include "solver/pin_track.hpp"
 #include "solver/residuals.hpp"
 
 #include <algorithm>
@@ -50,9 +51,42 @@ void each_particle(ThreadPool& pool, size_t n, F&& f) {
   });
 }
 
+/// passes::each_constraint over the constraints of kind K in `a`; with `pins` (the last substep of a
+/// frame) the hard pins' impulses are tracked (PinTrack).
+template <Kind K, class F>
+void each_constraint(ThreadPool& pool, SolverArray& a, const std::vector<Vec3>& x, std::vector<Pin>* pins,
+                     F&& project) {
+  if (pins == nullptr || a.pinned.empty()) {
+    passes::each_constraint(pool, a, project);
+    return;
+  }
+  PinTrack<K> track(a, x, *pins);
+  passes::each_colour_tracked(
+      pool, a.colour_start, a.shared_tail, passes::kGrain,
+      [&](size_t b, size_t e, bool, int) {
+        for (size_t i = b; i < e; ++i) project(i);
+      },
+      track);
+}
+
+/// project_pass of a lane kernel of kind K, the hard pins' impulses tracked likewise.
+template <Kind K>
+void kernel_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double inv_h2, std::vector<Vec3>& x,
+                 const double* w, std::vector<Pin>* pins) {
+  if (pins == nullptr || a.pinned.empty()) {
+    project_pass(pool, kernel, a, inv_h2, coords(x), w);
+    return;
+  }
+  PinTrack<K> track(a, x, *pins);
+  passes::each_colour_tracked(
+      pool, a.colour_start, a.shared_tail, passes::kGrain,
+      [&](size_t b, size_t e, bool in_lanes, int) { kernel(a, b, e, in_lanes, inv_h2, coords(x), w); }, track);
+}
+
 /// Welds x0 = x1 (three multipliers each), colour by colour over the pool's threads.
-void project_weld(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w) {
-  passes::each_constraint(pool, a, [&](size_t i) {
+void project_weld(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w,
+                  std::vector<Pin>* pins) {
+  each_constraint<Kind::weld>(pool, a, x, pins, [&](size_t i) {
     const int32_t p0 = a.ids[2 * i], p1 = a.ids[2 * i + 1];
     const double alpha = a.compliance[i] * inv_h2;
     const double denom = w[p0] + w[p1] + alpha;
@@ -71,9 +105,9 @@ void project_weld(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<V
 /// kernel's clamp, kernels.cpp).
 template <Kind K>
 void project_generic(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x,
-                     const std::vector<double>& w) {
+                     const std::vector<double>& w, std::vector<Pin>* pins) {
   constexpr int N = arity(K);
-  passes::each_constraint(pool, a, [&](size_t i) {
+  each_constraint<K>(pool, a, x, pins, [&](size_t i) {
     const int32_t* p = &a.ids[i * N];
     auto e = KindTraits<K>::evaluate(p, x);
     if (!e.valid) return;
@@ -162,7 +196,40 @@ void World::reset_multipliers() {
   }
 }
 
+void World::find_pinned_slots() {
+  pinned_any_ = false;
+  const auto find = [&](SolverArray& a, int n) {
+    a.pinned.clear();
+    for (size_t i = 0; i < a.size(); ++i)
+      for (int k = 0; k < n; ++k)
+        if (const int32_t pin = hard_pin_of_[a.ids[i * n + k]]; pin >= 0)
+          a.pinned.insert(a.pinned.end(), {static_cast<int32_t>(i), k, pin});
+    pinned_any_ = pinned_any_ || !a.pinned.empty();
+  };
+  for (Group& g : groups_) {
+    if (!g.alive) continue;
+    for (const KindInfo& info : kKinds) find(g.solve[static_cast<int>(info.kind)], info.arity);
+    find(g.tethers, arity(Kind::tether));
+  }
+}
+
+void World::restart_pin_impulses() {
+  for (Pin& p : pins_)
+    if (p.alive && p.kinematic()) p.lambda.setZero();
+  for (int32_t slot : order_) {
+    const Group& g = groups_[slot];
+    for (const KindInfo& info : kKinds)
+      visit_kind(info.kind, [&](auto k) { PinTrack<k>(g.solve[static_cast<int>(info.kind)], x_, pins_).add_all(); });
+    PinTrack<Kind::tether>(g.tethers, x_, pins_).add_all();
+    for (const ShapeMatch& sm : g.shapes)
+      pin_shape_match(sm, std::vector<Vec3>(sm.lambda.size(), Vec3::Zero()), x_, hard_pin_of_, pins_);
+  }
+}
+
 void World::realign(const std::vector<Vec3>& predicted) {
+  // The hard pins take what the multipliers' pulls at x hand them, as the other particles are put
+  // where those pulls take them.
+  if (track_pins_) restart_pin_impulses();
   std::vector<Vec3>& corr = realign_;
   corr.assign(x_.size(), Vec3::Zero());
   // The corrections are summed in this order (floating-point sums: the order is part of the result).
@@ -257,7 +324,8 @@ void World::project_group(Group& g, double h, bool first) {
   }
   double* x = coords(x_);
   const double* w = w_.data();
-  project_weld(*pool_, g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_);
+  std::vector<Pin>* tracked = track_pins_ ? &pins_ : nullptr;  // the last substep: find_pinned_slots
+  project_weld(*pool_, g.solve[static_cast<int>(Kind::weld)], inv_h2, x_, w_, tracked);
   const Kernels& k = kernels();
   // Bending before stretching, so that stretch has the final word in a projection: a dihedral step
   // is linear in the positions and, when a fast fold turns a hinge by tenths of a radian in a substep
@@ -265,39 +333,52 @@ void World::project_group(Group& g, double h, bool first) {
   // their edges. Projected after the stretch it left that for the next substep: edges across such
   // a fold ended 14 % long (the 128 x 128 acceptance cloth, frame 81 at 20 substeps); projected
   // before it, 2.9 %.
-  project_generic<Kind::edge_angle>(*pool_, g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_);
-  project_pass(*pool_, k.dihedral, g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x, w);
+  project_generic<Kind::edge_angle>(*pool_, g.solve[static_cast<int>(Kind::edge_angle)], inv_h2, x_, w_, tracked);
+  kernel_pass<Kind::dihedral>(*pool_, k.dihedral, g.solve[static_cast<int>(Kind::dihedral)], inv_h2, x_, w, tracked);
   // Tethers before stretching too: a tether pulls each particle on its own toward its anchor, and
   // during a whip that squeezes the edges between neighbours it pulls unequally; the stretch pass
   // after it takes that back (the 64 x 64 cloth after 200 frames: 2.05 % -> 1.16 %, 32 x 32: 2.77 %
   // -> 1.03 %).
-  project_pass(*pool_, k.tether, g.solve[static_cast<int>(Kind::tether)], inv_h2, x, w);
+  kernel_pass<Kind::tether>(*pool_, k.tether, g.solve[static_cast<int>(Kind::tether)], inv_h2, x_, w, tracked);
   if (settings_.realign_passes > 0)
-    project_pass(*pool_, k.tether, g.tethers, inv_h2, x, w);  // one at a time: realignment needs multipliers
+    kernel_pass<Kind::tether>(*pool_, k.tether, g.tethers, inv_h2, x_, w, tracked);  // realignment needs multipliers
   else
     tether_runs_pass(*pool_, g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
-  if (distance.chain_start.empty() || !first)
-    project_pass(*pool_, k.distance, distance, inv_h2, x, w);
-  else
+  if (distance.chain_start.empty() || !first) {
+    kernel_pass<Kind::distance>(*pool_, k.distance, distance, inv_h2, x_, w, tracked);
+  } else if (tracked == nullptr || distance.pinned.empty()) {
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
-  project_generic<Kind::tet_volume>(*pool_, g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_);
-  project_generic<Kind::equal_length>(*pool_, g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_);
-  project_generic<Kind::conical>(*pool_, g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_);
+  } else {
+    ChainTrack track(distance, x_, w_, pins_);
+    chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_, &track);
+  }
+  project_generic<Kind::tet_volume>(*pool_, g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::equal_length>(*pool_, g.solve[static_cast<int>(Kind::equal_length)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::conical>(*pool_, g.solve[static_cast<int>(Kind::conical)], inv_h2, x_, w_, tracked);
   // The geometry goals: length and angle ranges, co-linear, direction, co-circular, co-spherical.
-  project_generic<Kind::length_min>(*pool_, g.solve[static_cast<int>(Kind::length_min)], inv_h2, x_, w_);
-  project_generic<Kind::angle_min>(*pool_, g.solve[static_cast<int>(Kind::angle_min)], inv_h2, x_, w_);
-  project_generic<Kind::angle_max>(*pool_, g.solve[static_cast<int>(Kind::angle_max)], inv_h2, x_, w_);
-  project_generic<Kind::colinear>(*pool_, g.solve[static_cast<int>(Kind::colinear)], inv_h2, x_, w_);
-  project_generic<Kind::direction>(*pool_, g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_);
-  project_generic<Kind::cocircular>(*pool_, g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_);
-  project_generic<Kind::cospherical>(*pool_, g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_);
-  project_pass(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x, w);
-  project_pass(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x, w);
+  project_generic<Kind::length_min>(*pool_, g.solve[static_cast<int>(Kind::length_min)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::angle_min>(*pool_, g.solve[static_cast<int>(Kind::angle_min)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::angle_max>(*pool_, g.solve[static_cast<int>(Kind::angle_max)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::colinear>(*pool_, g.solve[static_cast<int>(Kind::colinear)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::direction>(*pool_, g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::cocircular>(*pool_, g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_, tracked);
+  project_generic<Kind::cospherical>(*pool_, g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_, tracked);
+  kernel_pass<Kind::planarity>(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x_, w, tracked);
+  kernel_pass<Kind::plane_offset>(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x_, w,
+                                  tracked);
   // Shape matches, one set at a time in the order added (serial: the same bits at any thread count).
-  for (ShapeMatch& sm : g.shapes) project_shape_match(sm, inv_h2, inv_mass_, w_, x_, shape_weights_);
+  for (ShapeMatch& sm : g.shapes) {
+    if (tracked == nullptr) {
+      project_shape_match(sm, inv_h2, inv_mass_, w_, x_, shape_weights_);
+      continue;
+    }
+    const std::vector<Vec3> before = sm.lambda;
+    project_shape_match(sm, inv_h2, inv_mass_, w_, x_, shape_weights_);
+    pin_shape_match(sm, before, x_, hard_pin_of_, pins_);
+  }
   // Self contacts first, collider contacts last: a collider (kinematic) has the final word.
   if (!self_contacts_.empty() && &g == &groups_[settings_.contact_group.index])
     self_collision::project(self_contacts_, x_, w_);
@@ -317,8 +398,15 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
     each_particle(*pool_, x_.size(), [&](size_t i) {
       if (w_[i] != 0.0) x_[i] = omega * (x_[i] - chebyshev_prev_[i]) + chebyshev_prev_[i];
     });
+    // The hard pins' impulses likewise: the step is a weighted sum of two iterates (weights adding
+    // to 1), and what the pins took balances the other particles' motion in each.
+    if (track_pins_)
+      for (size_t i = 0; i < pins_.size(); ++i)
+        if (pins_[i].alive && pins_[i].kinematic())
+          pins_[i].lambda = omega * (pins_[i].lambda - pin_chebyshev_prev_[i]) + pin_chebyshev_prev_[i];
   }
   chebyshev_prev_.swap(chebyshev_now_);
+  if (track_pins_) pin_chebyshev_prev_.swap(pin_chebyshev_now_);
 }
 
 void World::update_velocities(double h) {
@@ -536,8 +624,21 @@ void World::step(const StepControl& control) {
       find_contacts();
       find_self_contacts();
       find_face_contacts();
+      // The reactions read the last substep: there the hard pins' impulses are tracked.
+      if (s + 1 == substeps) {
+        for (Pin& p : pins_)
+          if (p.alive && p.kinematic()) p.lambda.setZero();
+        track_pins_ = pinned_any_;
+        for (int32_t slot : order_)  // shape matches are added without rebuilding the solver arrays
+          for (const ShapeMatch& sm : groups_[slot].shapes)
+            for (int32_t p : sm.particles) track_pins_ = track_pins_ || hard_pin_of_[p] >= 0;
+      }
       reset_multipliers();
       solve(h, control);
+      // The global solve's Newton steps are not tracked: without a realignment after them, the
+      // impulses are read from the multipliers where the substep ends.
+      if (track_pins_ && settings_.global_solve && settings_.realign_passes == 0) restart_pin_impulses();
+      track_pins_ = false;
       catch_late_contacts();
       apply_friction();
       settle_contacts_on_surface();
@@ -545,6 +646,7 @@ void World::step(const StepControl& control) {
       check_state_in_range();
     }
   } catch (...) {
+    track_pins_ = false;
     restore(start);
     throw;
   }
@@ -578,7 +680,13 @@ void World::solve(double h, const StepControl& control) {
       if (control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed))
         throw Error(ErrorCode::cancelled, "the step was cancelled in frame " + std::to_string(report_.frame) +
                                               "; the world was restored to the start of the frame");
-      if (rho > 0.0) chebyshev_now_ = x_;
+      if (rho > 0.0) {
+        chebyshev_now_ = x_;
+        if (track_pins_) {
+          pin_chebyshev_now_.resize(pins_.size());
+          for (size_t i = 0; i < pins_.size(); ++i) pin_chebyshev_now_[i] = pins_[i].lambda;
+        }
+      }
       project_volumes(h);  // fields/fields.cpp
       for (int32_t slot : order_) {
         Group& g = groups_[slot];

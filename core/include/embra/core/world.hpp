@@ -384,6 +384,11 @@ struct SolverArray {
   std::vector<int32_t> run_start, run_entry;
   // The runs of exactly two tethers (projected side by side, a block of lanes at a time) and the others.
   std::vector<int32_t> pair_runs, other_runs;
+  // The constraints holding a hard-pinned particle (World::find_pinned_slots, for the reactions,
+  // which read the last substep of a frame): entry j is constraint pinned[3 j] (this array's
+  // order, ascending), its slot pinned[3 j + 1] (the particle's place among its ids) and the pin
+  // pinned[3 j + 2] (World::pins index).
+  std::vector<int32_t> pinned;
   size_t size() const { return rest.size(); }
   size_t colours() const { return colour_start.empty() ? 0 : colour_start.size() - 1; }
 };
@@ -467,7 +472,7 @@ struct StaticsState {
   };
   std::vector<Multipliers> constraints;    // a (group, kind) not listed: all 0
   std::vector<Tethers> tethers;            // a group not listed: all 0
-  std::vector<PinMultiplier> pins;         // a pin not listed: 0 (a hard pin keeps none)
+  std::vector<PinMultiplier> pins;         // a pin not listed: 0 (a hard pin: its impulse, Pin::lambda)
   std::vector<Contact> contacts;           // particle, collider (slot) and force_h2 are what is read
   std::vector<FaceContact> face_contacts;  // ids, collider (slot) and force_h2 are what is read
   bool empty() const {
@@ -500,6 +505,9 @@ struct Pin {
   std::vector<Vec3> curve;          // polyline: its points; mesh: its vertices (offsets from the target)
   bool closed = false;
   std::vector<std::array<int32_t, 3>> triangles;  // mesh: its triangles
+  // A projected pin: its accumulated multiplier (kg m). A hard pin: the impulse times h its particle
+  // took from the constraints in the last substep, sum grad C dlambda over every projection that
+  // held it (kg m; its force is lambda / h^2).
   Vec3 lambda = Vec3::Zero();
   uint32_t generation = 0;
   bool alive = false;
@@ -845,6 +853,16 @@ class World {
   void project_contact(Contact& ct);
   void reset_multipliers();
   void realign(const std::vector<Vec3>& predicted);
+  // The impulse each hard pin takes in the last substep of a frame (its Pin::lambda, solver/statics.cpp
+  // "Hard pins"): the constraints holding a hard-pinned particle, listed in SolverArray::pinned
+  // whenever the solver arrays are rebuilt (a hard pin's creation or removal rebuilds them), and
+  // whether there are any; whether they are tracked in this substep; the impulses set from the
+  // multipliers at a realignment; the impulses at iterations k - 1 and k (Chebyshev acceleration
+  // moves them as it moves positions).
+  void find_pinned_slots();
+  void restart_pin_impulses();
+  bool pinned_any_ = false, track_pins_ = false;
+  std::vector<Vec3> pin_chebyshev_prev_, pin_chebyshev_now_;
   /// Projects a group once; `first`: its first projection in the substep (the chain solve's turn).
   void project_group(Group& g, double h, bool first);
   void project_contacts(Group& g, double h);
