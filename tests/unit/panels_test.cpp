@@ -95,15 +95,7 @@ TEST(PanelMetrics, SummaryCountsAgainstTolerance) {
 // vertices; everything reads zero as built, the bottom layer 0.01 below the top.
 TEST(PanelMesh, GridBuildsFlatAndExact) {
   World w(test::settings(10, 1));
-  std::vector<double> pos;
-  std::vector<int32_t> quads;
-  panel_grid(3, 2, 0.8, Vec3(0, 0, 1), pos, quads);
-  PanelMeshDesc d;
-  d.positions = pos;
-  d.quads = quads;
-  d.thickness = 0.01;
-  d.pins = PanelPins::top_corners;
-  const Id body = build_panel_mesh(w, d);
+  const Id body = test::add_panel_grid(w, 3, 2, 0.8);
   const PanelLayout* l = w.panel_layout(body);
   ASSERT_NE(l, nullptr);
   EXPECT_EQ(l->panel_count(), 6);

@@ -241,15 +241,7 @@ TEST(Statics, PanelMeshReactionsSumToTheWeight) {
     Settings s = test::settings(4, 50, Vec3(0.0, 0.0, -kG), 4.0);
     s.realign_passes = realign;
     World w(s);
-    std::vector<double> positions;
-    std::vector<int32_t> quads;
-    panel_grid(3, 3, 0.8, Vec3(0.0, 0.0, 1.0), positions, quads);
-    PanelMeshDesc d;
-    d.positions = positions;
-    d.quads = quads;
-    d.thickness = 0.01;
-    d.pins = PanelPins::top_corners;
-    build_panel_mesh(w, d);
+    test::add_panel_grid(w, 3, 3, 0.8);
     for (int f = 0; f < 600; ++f) w.step();
     double largest = 0.0;
     for (const Reaction& r : w.reactions()) largest = std::max(largest, r.force.norm());

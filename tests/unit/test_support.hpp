@@ -120,6 +120,20 @@ inline int32_t add_net(World& w, int n, double dx, double z0, double mass, doubl
   return first;
 }
 
+/// An n x m grid of square panels of side `size` in the plane z = 1 (panel_grid), `thickness` thick,
+/// hard-pinned at the top corners of the mesh's corners; returns the body.
+inline Id add_panel_grid(World& w, int32_t n, int32_t m, double size, double thickness = 0.01) {
+  std::vector<double> positions;
+  std::vector<int32_t> quads;
+  panel_grid(n, m, size, Vec3(0.0, 0.0, 1.0), positions, quads);
+  PanelMeshDesc d;
+  d.positions = positions;
+  d.quads = quads;
+  d.thickness = thickness;
+  d.pins = PanelPins::top_corners;
+  return build_panel_mesh(w, d);
+}
+
 /// Sum of the applied loads (N): the weight m g of every movable particle and every point load,
 /// worked out from the masses, gravity and loads as set (not the solver's own sum).
 inline Vec3 applied_load(const World& w) {
