@@ -123,17 +123,12 @@ class PinTrack {
 class ChainTrack {
  public:
   /// `a`: the distance array with its pinned entries (find_pinned_slots); w: the solver's inverse
-  /// masses (0: hard-pinned or immovable).
-  ChainTrack(const SolverArray& a, const std::vector<Vec3>& x, const std::vector<double>& w, std::vector<Pin>& pins)
-      : a_(a), x_(x), w_(w), pins_(pins) {
+  /// masses (0: hard-pinned or immovable); hard_pin_of: each particle's hard pin, or -1.
+  ChainTrack(const SolverArray& a, const std::vector<Vec3>& x, const std::vector<double>& w,
+             const std::vector<int32_t>& hard_pin_of, std::vector<Pin>& pins)
+      : a_(a), x_(x), w_(w), hard_pin_of_(hard_pin_of), pins_(pins) {
     std::vector<uint8_t> held(a.size(), 0);
-    for (size_t j = 0; j < a.pinned.size() / 3; ++j) {
-      held[static_cast<size_t>(a.pinned[3 * j])] = 1;
-      const int32_t particle =
-          a.ids[2 * static_cast<size_t>(a.pinned[3 * j]) + static_cast<size_t>(a.pinned[3 * j + 1])];
-      pin_of_.push_back({particle, a.pinned[3 * j + 2]});
-    }
-    std::sort(pin_of_.begin(), pin_of_.end());
+    for (size_t j = 0; j < a.pinned.size() / 3; ++j) held[static_cast<size_t>(a.pinned[3 * j])] = 1;
     for (size_t c = 0; c + 1 < a.chain_start.size(); ++c)
       for (int32_t k = a.chain_start[c]; k < a.chain_start[c + 1]; ++k)
         if (held[static_cast<size_t>(a.chain_edge[static_cast<size_t>(k)])]) {
@@ -187,7 +182,7 @@ class ChainTrack {
           part += (x_[q] - start_[at]) / w_[q];
           continue;
         }
-        const int32_t pin = pin_at(q);
+        const int32_t pin = hard_pin_of_[q];
         if (j > 0 && pin >= 0) pins_[static_cast<size_t>(pin)].lambda -= part;  // the link before it
         part = Vec3::Zero();
         if (j < m) {
@@ -206,17 +201,12 @@ class ChainTrack {
     if (!g.valid) return Vec3::Zero();
     return a_.ids[2 * static_cast<size_t>(e)] == q ? Vec3(g.grad[0]) : Vec3(g.grad[1]);
   }
-  int32_t pin_at(int32_t particle) const {
-    const auto it = std::lower_bound(pin_of_.begin(), pin_of_.end(), std::pair<int32_t, int32_t>{particle, -1});
-    return it != pin_of_.end() && it->first == particle ? it->second : -1;
-  }
-
   const SolverArray& a_;
   const std::vector<Vec3>& x_;
   const std::vector<double>& w_;
+  const std::vector<int32_t>& hard_pin_of_;  // World::hard_pin_of_: pin slot or -1 per particle
   std::vector<Pin>& pins_;
-  std::vector<std::pair<int32_t, int32_t>> pin_of_;  // (particle, pin), sorted
-  std::vector<size_t> chains_;                       // the chains holding a hard-pinned particle, ascending
+  std::vector<size_t> chains_;  // the chains holding a hard-pinned particle, ascending
   size_t lo_ = 0, hi_ = 0;
   std::vector<Vec3> start_, grad_;
   std::vector<double> lambda_;

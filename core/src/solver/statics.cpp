@@ -22,7 +22,6 @@
 #include "common/check.hpp"
 #include "embra/core/world.hpp"
 #include "model/kind_traits.hpp"
-#include "solver/forces.hpp"
 
 #include <bit>
 #include <set>

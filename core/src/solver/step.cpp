@@ -352,7 +352,7 @@ void World::project_group(Group& g, double h, bool first) {
   } else if (tracked == nullptr || distance.pinned.empty()) {
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
   } else {
-    ChainTrack track(distance, x_, w_, pins_);
+    ChainTrack track(distance, x_, w_, hard_pin_of_, pins_);
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_, &track);
   }
   project_generic<Kind::tet_volume>(*pool_, g.solve[static_cast<int>(Kind::tet_volume)], inv_h2, x_, w_, tracked);
