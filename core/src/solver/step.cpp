@@ -391,22 +391,33 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
   // dynamics": x^(k+1) <- omega_(k+1) (x^(k+1) - x^(k-1)) + x^(k-1) with omega_2 = 2 / (2 - rho^2),
   // omega_(k+1) = 4 / (4 - rho^2 omega_k), the first two iterations left as they are, and the last
   // one too, so that a plain pass (contacts last) has the final word. Positions of movable particles
-  // only; the multipliers keep what the projections accumulated.
+  // only; the multipliers keep what the projections accumulated. chebyshev_now_ holds the positions
+  // this iteration started from (solve set it before the first) and chebyshev_prev_ those the one
+  // before started from: the two swap, and the pass over the particles that takes the step keeps its
+  // result as the positions the next iteration starts from.
   constexpr int kStart = 2;
-  if (iteration >= kStart && iteration + 1 < settings_.iterations) {
-    omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
-    each_particle(*pool_, x_.size(), [&](size_t i) {
-      if (w_[i] != 0.0) x_[i] = omega * (x_[i] - chebyshev_prev_[i]) + chebyshev_prev_[i];
-    });
-    // The hard pins' impulses likewise: the step is a weighted sum of two iterates (weights adding
-    // to 1), and what the pins took balances the other particles' motion in each.
-    if (track_pins_)
-      for (size_t i = 0; i < pins_.size(); ++i)
-        if (pins_[i].alive && pins_[i].kinematic())
-          pins_[i].lambda = omega * (pins_[i].lambda - pin_chebyshev_prev_[i]) + pin_chebyshev_prev_[i];
-  }
+  if (iteration + 1 >= settings_.iterations) return;  // the last iteration: nothing after it reads them
+  const bool extrapolate = iteration >= kStart;
+  if (extrapolate) omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
   chebyshev_prev_.swap(chebyshev_now_);
-  if (track_pins_) pin_chebyshev_prev_.swap(pin_chebyshev_now_);
+  chebyshev_now_.resize(x_.size());
+  each_particle(*pool_, x_.size(), [&](size_t i) {
+    const Vec3 before = chebyshev_now_[i];  // where the iteration before this one started
+    if (extrapolate && w_[i] != 0.0) x_[i] = omega * (x_[i] - before) + before;
+    chebyshev_now_[i] = x_[i];
+  });
+  // The hard pins' impulses likewise: the step is a weighted sum of two iterates (weights adding to
+  // 1), and what the pins took balances the other particles' motion in each.
+  if (track_pins_) {
+    pin_chebyshev_prev_.swap(pin_chebyshev_now_);
+    pin_chebyshev_now_.resize(pins_.size());
+    for (size_t i = 0; i < pins_.size(); ++i) {
+      const Vec3 before = pin_chebyshev_now_[i];
+      if (extrapolate && pins_[i].alive && pins_[i].kinematic())
+        pins_[i].lambda = omega * (pins_[i].lambda - before) + before;
+      pin_chebyshev_now_[i] = pins_[i].lambda;
+    }
+  }
 }
 
 void World::update_velocities(double h) {
@@ -676,17 +687,17 @@ void World::solve(double h, const StepControl& control) {
     // Chebyshev acceleration acts on iterations 2 .. iterations - 2 (chebyshev_step): none below 4.
     const double rho = settings_.iterations > 3 ? settings_.chebyshev_rho_milli / 1000.0 : 0.0;
     double omega = 1.0;
+    if (rho > 0.0) {  // the positions the first iteration starts from (chebyshev_step moves them on)
+      chebyshev_now_ = x_;
+      if (track_pins_) {
+        pin_chebyshev_now_.resize(pins_.size());
+        for (size_t i = 0; i < pins_.size(); ++i) pin_chebyshev_now_[i] = pins_[i].lambda;
+      }
+    }
     for (int it = 0; it < settings_.iterations; ++it) {
       if (control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed))
         throw Error(ErrorCode::cancelled, "the step was cancelled in frame " + std::to_string(report_.frame) +
                                               "; the world was restored to the start of the frame");
-      if (rho > 0.0) {
-        chebyshev_now_ = x_;
-        if (track_pins_) {
-          pin_chebyshev_now_.resize(pins_.size());
-          for (size_t i = 0; i < pins_.size(); ++i) pin_chebyshev_now_[i] = pins_[i].lambda;
-        }
-      }
       project_volumes(h);  // fields/fields.cpp
       for (int32_t slot : order_) {
         Group& g = groups_[slot];
