@@ -189,10 +189,11 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   const V3<T> n = cross(a, b);
   const T m = lanes::sqrt(dot(n, n));
   const auto valid = m > 1e-300;
-  const V3<T> u = {n.x / m, n.y / m, n.z / m};
+  const T inv_m = 1.0 / m;  // one division, not six: the block is bound by its divider
+  const V3<T> u = inv_m * n;
   const T value = dot(s, u);
   const V3<T> t = s - value * u;
-  const V3<T> q = {t.x / m, t.y / m, t.z / m};
+  const V3<T> q = inv_m * t;
   const V3<T> ga = cross(b, q), gb = cross(q, a);
   V3<T> g[4];
   if constexpr (kPlanarity) {
