@@ -55,6 +55,19 @@ class ThreadPool {
     dispatch(&Job<F>::call, &job, static_cast<int>(parts));
   }
 
+  /// run() over [begin, end) where each part appends what it finds to its own list
+  /// (find(part_begin, part_end, list)), the lists then appended to `out` part after part: `out`
+  /// gains the items in range order, as if found on one thread, at any thread count. `parts` is the
+  /// caller's scratch, kept from call to call so that its lists keep their storage.
+  template <class T, class F>
+  void collect(size_t begin, size_t end, size_t grain, std::vector<std::vector<T>>& parts, std::vector<T>& out,
+               F&& find) {
+    parts.resize(static_cast<size_t>(size()));
+    for (std::vector<T>& part : parts) part.clear();
+    run(begin, end, 1, grain, [&](size_t b, size_t e, int part) { find(b, e, parts[static_cast<size_t>(part)]); });
+    for (const std::vector<T>& part : parts) out.insert(out.end(), part.begin(), part.end());
+  }
+
  private:
   template <class F>
   struct Job {

@@ -69,14 +69,11 @@ void World::find_contacts() {
 }
 
 void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, std::vector<Contact>& out) {
-  // Each part looks at a contiguous run of the particles; appended part after part, the contacts
-  // stand in particle order as if found on one thread.
-  contact_parts_.resize(static_cast<size_t>(pool_->size()));
-  for (std::vector<Contact>& part : contact_parts_) part.clear();
-  pool_->run(0, only ? only->size() : x_.size(), 1, kContactGrain, [&](size_t begin, size_t end, int part) {
-    find_collider_contacts(index, only, begin, end, contact_parts_[static_cast<size_t>(part)]);
-  });
-  for (const std::vector<Contact>& part : contact_parts_) out.insert(out.end(), part.begin(), part.end());
+  // Each part looks at a contiguous run of the particles: the contacts stand in particle order.
+  pool_->collect(0, only ? only->size() : x_.size(), kContactGrain, contact_parts_, out,
+                 [&](size_t begin, size_t end, std::vector<Contact>& part) {
+                   find_collider_contacts(index, only, begin, end, part);
+                 });
 }
 
 void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* only, size_t begin, size_t end,
@@ -142,39 +139,37 @@ void World::catch_late_contacts() {
 void World::find_face_contacts() {
   face_contacts_.clear();
   if (panel_layouts_.empty()) return;
-  // Each part looks at a contiguous run of a mesh's panels; appended part after part, the contacts
-  // stand in panel order as if found on one thread.
-  std::vector<std::vector<FaceContact>> parts(static_cast<size_t>(pool_->size()));
+  // Each part looks at a contiguous run of a mesh's panels: the contacts stand in panel order.
   for (size_t c = 0; c < colliders_.size(); ++c) {
     const Collider& col = colliders_[c];
     if (!col.alive || col.desc.shape != ColliderShape::sphere) continue;
     const double r = col.desc.radius + col.desc.thickness;
     const double move = (col.position - col.position_prev).norm();
-    for (const PanelLayout& l : panel_layouts_) {
-      for (std::vector<FaceContact>& part : parts) part.clear();
-      pool_->run(0, static_cast<size_t>(l.panel_count()), 1, kFaceGrain, [&](size_t begin, size_t end, int part) {
-        for (size_t p = begin; p < end; ++p)
-          for (int layer = 0; layer < 2; ++layer)
-            for (int half = 0; half < 2; ++half) {
-              const int32_t o = l.first_particle + 8 * static_cast<int32_t>(p) + 4 * layer;
-              const int32_t across = layer == 0 ? 4 : -4;
-              const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
-              const int32_t partner[3] = {ids[0] + across, ids[1] + across, ids[2] + across};
-              if (slab_weight(ids[0], partner[0]) == 0.0 && slab_weight(ids[1], partner[1]) == 0.0 &&
-                  slab_weight(ids[2], partner[2]) == 0.0)
-                continue;
-              double moved = 0.0;
-              for (int32_t i : ids) moved = std::max(moved, (x_[i] - x_prev_[i]).norm());
-              const Vec3 b = closest_barycentric(col.position, x_[ids[0]], x_[ids[1]], x_[ids[2]]);
-              const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
-              if ((q - col.position).norm() - r < moved + move)
-                parts[static_cast<size_t>(part)].push_back(FaceContact{
-                    {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), 0.0});
-            }
-      });
-      for (const std::vector<FaceContact>& part : parts)
-        face_contacts_.insert(face_contacts_.end(), part.begin(), part.end());
-    }
+    // A panel's four triangles (two a layer) that come within reach of the sphere.
+    auto look_at = [&](int32_t first_particle, size_t p, std::vector<FaceContact>& found) {
+      for (int layer = 0; layer < 2; ++layer)
+        for (int half = 0; half < 2; ++half) {
+          const int32_t o = first_particle + 8 * static_cast<int32_t>(p) + 4 * layer;
+          const int32_t across = layer == 0 ? 4 : -4;
+          const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
+          const int32_t partner[3] = {ids[0] + across, ids[1] + across, ids[2] + across};
+          if (slab_weight(ids[0], partner[0]) == 0.0 && slab_weight(ids[1], partner[1]) == 0.0 &&
+              slab_weight(ids[2], partner[2]) == 0.0)
+            continue;
+          double moved = 0.0;
+          for (int32_t i : ids) moved = std::max(moved, (x_[i] - x_prev_[i]).norm());
+          const Vec3 b = closest_barycentric(col.position, x_[ids[0]], x_[ids[1]], x_[ids[2]]);
+          const Vec3 q = b[0] * x_[ids[0]] + b[1] * x_[ids[1]] + b[2] * x_[ids[2]];
+          if ((q - col.position).norm() - r < moved + move)
+            found.push_back(FaceContact{
+                {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), 0.0});
+        }
+    };
+    for (const PanelLayout& l : panel_layouts_)
+      pool_->collect(0, static_cast<size_t>(l.panel_count()), kFaceGrain, face_parts_, face_contacts_,
+                     [&](size_t begin, size_t end, std::vector<FaceContact>& found) {
+                       for (size_t p = begin; p < end; ++p) look_at(l.first_particle, p, found);
+                     });
   }
 }
 

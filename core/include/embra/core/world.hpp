@@ -371,7 +371,8 @@ struct SolverArray {
   // Distance arrays under Settings::chain_solve: the constraints as chains, straight runs end to end.
   // Chain c is the constraints chain_edge[chain_start[c] .. chain_start[c + 1]) in order, joining the
   // particles chain_part[chain_start[c] + c .. chain_start[c + 1] + c] (one more than constraints);
-  // no particle appears twice in a chain. Every constraint is in exactly one chain.
+  // no particle appears twice in a chain. Every constraint is in exactly one chain, or, where each
+  // chain would be a single constraint, there are none (the plain pass projects them the same way).
   std::vector<int32_t> chain_start, chain_edge, chain_part;
   // The chains by colour: colour c is chains [chain_colour_start[c], chain_colour_start[c + 1]), which
   // share no particle (so they can be solved side by side), longest first; the last colour may share
@@ -944,6 +945,7 @@ class World {
   std::unique_ptr<ThreadPool> pool_;                  // Settings::threads
   std::unique_ptr<GlobalSolve> global_;               // Settings::global_solve: pattern, factorisation, scratch
   std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
+  std::vector<std::vector<FaceContact>> face_parts_;  // find_face_contacts: one list per thread
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
   std::vector<double> shape_weights_;                 // project_shape_match's scratch
