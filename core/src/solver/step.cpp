@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace embra {
@@ -401,10 +402,18 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
   if (extrapolate) omega = iteration == kStart ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
   chebyshev_prev_.swap(chebyshev_now_);
   chebyshev_now_.resize(x_.size());
-  each_particle(*pool_, x_.size(), [&](size_t i) {
-    const Vec3 before = chebyshev_now_[i];  // where the iteration before this one started
-    if (extrapolate && w_[i] != 0.0) x_[i] = omega * (x_[i] - before) + before;
-    chebyshev_now_[i] = x_[i];
+  // Over the raw coordinates, the step written out per coordinate as Vec3's would compute it (the
+  // same bits), then the range copied whole: the Vec3 form spilled each point through the stack.
+  double* x = coords(x_);
+  double* start = coords(chebyshev_now_);  // where the iteration before this one started
+  const double* w = w_.data();
+  pool_->run(0, x_.size(), 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+    if (extrapolate)
+      for (size_t i = begin; i < end; ++i) {
+        if (w[i] == 0.0) continue;
+        for (size_t k = 3 * i; k < 3 * i + 3; ++k) x[k] = omega * (x[k] - start[k]) + start[k];
+      }
+    std::memcpy(start + 3 * begin, x + 3 * begin, 3 * (end - begin) * sizeof(double));
   });
   // The hard pins' impulses likewise: the step is a weighted sum of two iterates (weights adding to
   // 1), and what the pins took balances the other particles' motion in each.
