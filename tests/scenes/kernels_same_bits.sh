@@ -2,7 +2,8 @@
 # The solver's kernel sets (scalar, 2-wide SSE2, 4-wide AVX2; chosen at run time, EMBRA_KERNELS
 # forces one) compute the same bits: a draped cloth (distance and dihedral kernels), a pinned cloth
 # (chain, dihedral and automatic tether kernels) and a panel mesh (distance, planarity and
-# plane-offset kernels) stepped with each set end in byte-identical final.json files.
+# plane-offset kernels, island by island) stepped with each set end in byte-identical final.json
+# files; so does the panel mesh with its rows in their passes instead (EMBRA_ISLANDS=off).
 #
 # usage: kernels_same_bits.sh EMBRA_CLI SOURCE_DIR WORK_DIR
 set -u
@@ -12,11 +13,13 @@ fail=0
 for scene in examples/cloth_drape.json:60 tests/scenes/kernels/pinned_cloth.json:90 examples/large/poq_drape_16.json:40; do
   path=$source/${scene%%:*} frames=${scene##*:} name=$(basename "${scene%%:*}" .json)
   first=""
-  for set in scalar vec2 avx2; do
+  for set in scalar vec2 avx2 passes; do
     if [ "$set" = avx2 ] && ! grep -q avx2 /proc/cpuinfo; then continue; fi
+    kernels=$set islands=on
+    if [ "$set" = passes ]; then kernels="" islands=off; fi
     out=$work/$name.$set
     rm -rf "$out"  # the work folder stays between runs; `embra run` refuses a non-empty --out
-    if ! EMBRA_KERNELS=$set "$cli" run "$path" --frames "$frames" --out "$out" --every 100000 >"$out.log" 2>&1; then
+    if ! EMBRA_KERNELS=$kernels EMBRA_ISLANDS=$islands "$cli" run "$path" --frames "$frames" --out "$out" --every 100000 >"$out.log" 2>&1; then
       echo "FAIL $name with $set kernels: embra run exited non-zero"; cat "$out.log"; fail=1; continue
     fi
     sum=$(sha256sum "$out/final.json" | cut -d' ' -f1)

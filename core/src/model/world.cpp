@@ -1086,6 +1086,112 @@ class RestSurface {
   std::vector<int32_t> nbr_start_, nbr_, tri_, vt_start_, vt_, across_;
 };
 
+/// The group's distance, planarity and plane-offset rows as islands (IslandPlan), or none when they
+/// do not form small islands, when another kind is projected between them, or when the distances
+/// are chained (their first pass is the chain pass).
+void build_islands(Group& g, size_t particle_count) {
+  g.islands = IslandPlan{};
+  constexpr Kind kRowKinds[IslandPlan::kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
+  for (int k = 0; k < kKindCount; ++k) {
+    const Kind kind = static_cast<Kind>(k);
+    const bool before =
+        kind == Kind::weld || kind == Kind::edge_angle || kind == Kind::dihedral || kind == Kind::tether;
+    const bool row = kind == Kind::distance || kind == Kind::planarity || kind == Kind::plane_offset;
+    if (!before && !row && g.solve[k].size() > 0) return;
+  }
+  if (!g.solve[static_cast<int>(Kind::distance)].chain_start.empty()) return;
+  // Union-find over the particles the rows join.
+  std::vector<int32_t> parent(particle_count, -1);
+  auto find = [&](int32_t p) {
+    int32_t r = p;
+    while (parent[r] >= 0) r = parent[r];
+    while (parent[p] >= 0) {
+      const int32_t next = parent[p];
+      parent[p] = r;
+      p = next;
+    }
+    return r;
+  };
+  size_t rows = 0;
+  for (Kind kind : kRowKinds) {
+    const SolverArray& a = g.solve[static_cast<int>(kind)];
+    const int n = arity(kind);
+    rows += a.size();
+    for (size_t i = 0; i < a.size(); ++i)
+      for (int j = 1; j < n; ++j) {
+        const int32_t r0 = find(a.ids[n * i]), r1 = find(a.ids[n * i + j]);
+        if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
+      }
+  }
+  if (rows == 0) return;
+  // Each island's rows in the passes' order, islands in the order of their first row.
+  std::vector<int32_t> island_of(particle_count, -1);
+  std::vector<std::vector<std::pair<int8_t, int32_t>>> island_rows;
+  for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
+    const SolverArray& a = g.solve[static_cast<int>(kRowKinds[kr])];
+    const int n = arity(kRowKinds[kr]);
+    for (size_t i = 0; i < a.size(); ++i) {
+      int32_t& island = island_of[find(a.ids[n * i])];
+      if (island < 0) {
+        island = static_cast<int32_t>(island_rows.size());
+        island_rows.emplace_back();
+      }
+      island_rows[island].emplace_back(static_cast<int8_t>(kr), static_cast<int32_t>(i));
+      if (island_rows[island].size() > static_cast<size_t>(IslandPlan::kSteps)) return;
+    }
+  }
+  // Shapes: the rows' kinds and local particles (numbered by first use), islands grouped by shape.
+  std::map<std::vector<int8_t>, int32_t> shape_of;
+  std::vector<int32_t> local(particle_count, -1);
+  for (const auto& list : island_rows) {
+    std::vector<int8_t> key, slots;
+    std::vector<int32_t> particles, row;
+    for (const auto& [kr, i] : list) {
+      const SolverArray& a = g.solve[static_cast<int>(kRowKinds[kr])];
+      const int n = arity(kRowKinds[kr]);
+      key.push_back(kr);
+      for (int j = 0; j < 4; ++j) {
+        int8_t slot = 0;
+        if (j < n) {
+          const int32_t p = a.ids[n * static_cast<size_t>(i) + j];
+          if (local[p] < 0) {
+            if (particles.size() == static_cast<size_t>(IslandPlan::kSlots)) {
+              for (int32_t q : particles) local[q] = -1;
+              g.islands = IslandPlan{};
+              return;
+            }
+            local[p] = static_cast<int32_t>(particles.size());
+            particles.push_back(p);
+          }
+          slot = static_cast<int8_t>(local[p]);
+        }
+        slots.push_back(slot);
+        key.push_back(slot);
+      }
+      row.push_back(i);
+    }
+    for (int32_t q : particles) local[q] = -1;
+    key.push_back(static_cast<int8_t>(particles.size()));
+    const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(g.islands.shapes.size()));
+    if (fresh) {
+      IslandPlan::Shape shape;
+      shape.slots = static_cast<int32_t>(particles.size());
+      shape.steps = static_cast<int32_t>(list.size());
+      for (const auto& [kr, i] : list) shape.kind.push_back(kr);
+      shape.slot = slots;
+      g.islands.shapes.push_back(std::move(shape));
+    }
+    IslandPlan::Shape& shape = g.islands.shapes[it->second];
+    shape.particle.insert(shape.particle.end(), particles.begin(), particles.end());
+    shape.row.insert(shape.row.end(), row.begin(), row.end());
+  }
+  for (size_t sh = 0; sh < g.islands.shapes.size(); ++sh) {
+    const int32_t count = static_cast<int32_t>(g.islands.shapes[sh].islands());
+    for (int32_t first = 0; first < count; first += IslandPlan::kItemIslands)
+      g.islands.items.push_back({static_cast<int32_t>(sh), first, std::min(IslandPlan::kItemIslands, count - first)});
+  }
+}
+
 }  // namespace
 
 std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors, int32_t k) {
@@ -1324,6 +1430,7 @@ void World::rebuild_solver() {
       }
     }
     g.tethers = SolverArray{};
+    build_islands(g, x_.size());
   }
   // Automatic long-range attachments: every particle of an inextensible body to its nearest
   // anchors (hard-pinned or immovable particles of the body), in the body's stretch group.

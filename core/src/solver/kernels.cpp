@@ -40,17 +40,14 @@ EMBRA_ALWAYS_INLINE bool all_within_pi(T v) {
 // Each kernel handles one block of Lanes<T>::count constraints of one colour (they share no
 // particle), reading every operand first and writing every result last.
 
-/// Distance |x0 - x1| = rest; a tether is the unilateral |x0 - x1| <= rest (it only pulls).
+/// One distance row's projection from its operands: d = x0 - x1, the moves x0 += s0 d and
+/// x1 -= s1 d, the new multiplier; returns the lanes where it applies. Shared by the passes and the
+/// islands, so both compute the same bits.
 template <class T, bool kTether>
-EMBRA_ALWAYS_INLINE void distance_block(const int32_t* ids, const double* rest, const double* compliance,
-                                        double* lambda, double inv_h2, double* x, const double* w) {
+EMBRA_ALWAYS_INLINE auto distance_step(const lanes::V3<T>& p0, const lanes::V3<T>& p1, T w0, T w1, T r, T lam, T alpha,
+                                       lanes::V3<T>& d, T& s0, T& s1, T& lam_new) {
   using namespace lanes;
-  using L = Lanes<T>;
-  const V3<T> p0 = load_point<T>(x, ids, 2), p1 = load_point<T>(x, ids + 1, 2);
-  const T w0 = load_value<T>(w, ids, 2), w1 = load_value<T>(w, ids + 1, 2);
-  const T r = gather<T>(rest), lam = gather<T>(lambda);
-  const T alpha = gather<T>(compliance) * inv_h2;
-  const V3<T> d = p0 - p1;
+  d = p0 - p1;
   const T len = lanes::sqrt(dot(d, d));
   const T c = len - r;
   const T denom = w0 + w1 + alpha;
@@ -62,8 +59,25 @@ EMBRA_ALWAYS_INLINE void distance_block(const int32_t* ids, const double* rest, 
     dl = select(0.0 < sum, splat<T>(0.0), sum) - lam;  // std::min(lambda + dl, 0) - lambda: pull only
   }
   const T s = dl / len;  // grad C = +-(x0 - x1) / len
-  const T s0 = w0 * s, s1 = w1 * s;
-  const T lam_new = lam + dl;
+  s0 = w0 * s;
+  s1 = w1 * s;
+  lam_new = lam + dl;
+  return ok;
+}
+
+/// Distance |x0 - x1| = rest; a tether is the unilateral |x0 - x1| <= rest (it only pulls).
+template <class T, bool kTether>
+EMBRA_ALWAYS_INLINE void distance_block(const int32_t* ids, const double* rest, const double* compliance,
+                                        double* lambda, double inv_h2, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  const V3<T> p0 = load_point<T>(x, ids, 2), p1 = load_point<T>(x, ids + 1, 2);
+  const T w0 = load_value<T>(w, ids, 2), w1 = load_value<T>(w, ids + 1, 2);
+  const T r = gather<T>(rest), lam = gather<T>(lambda);
+  const T alpha = gather<T>(compliance) * inv_h2;
+  V3<T> d;
+  T s0, s1, lam_new;
+  const auto ok = distance_step<T, kTether>(p0, p1, w0, w1, r, lam, alpha, d, s0, s1, lam_new);
   for (int l = 0; l < L::count; ++l) {
     if (!L::on(ok, l)) continue;
     lambda[l] = L::get(lam_new, l);
@@ -170,19 +184,17 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
   scatter4<T>(ids, ok, lam + dl, p, wk, dl, g, lambda, x);
 }
 
-/// Quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2, x3)) or plane
-/// offset (signed distance of x0 from the plane of (x1, x2, x3)) = rest: the function and gradients
-/// of eval_quad_planarity / eval_plane_offset (constraint_math.hpp), written out flat. Both are
-/// C = s . u with u = n / |n|, n = a x b; with q = (s - C u) / |n| the gradient along a is b x q and
-/// along b is q x a.
+/// One row of quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2,
+/// x3)) or plane offset (signed distance of x0 from the plane of (x1, x2, x3)) = rest, from its
+/// operands: the function and gradients of eval_quad_planarity / eval_plane_offset
+/// (constraint_math.hpp), written out flat, giving the gradients g and the multiplier's change dl;
+/// returns the lanes where it applies. Shared by the passes and the islands (the same bits). Both
+/// are C = s . u with u = n / |n|, n = a x b; with q = (s - C u) / |n| the gradient along a is b x q
+/// and along b is q x a.
 template <class T, bool kPlanarity>
-EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, const double* compliance, double* lambda,
-                                      double inv_h2, double* x, const double* w) {
+EMBRA_ALWAYS_INLINE auto offset_step(const lanes::V3<T> p[4], const T wk[4], T r, T lam, T alpha, lanes::V3<T> g[4],
+                                     T& dl) {
   using namespace lanes;
-  const QuadOperands<T> o(ids, rest, compliance, lambda, inv_h2, x, w);
-  const V3<T>* p = o.p;
-  const T* wk = o.wk;
-  const T r = o.r, lam = o.lam, alpha = o.alpha;
   const V3<T> a = kPlanarity ? p[2] - p[0] : p[2] - p[1];
   const V3<T> b = kPlanarity ? p[3] - p[1] : p[3] - p[1];
   const V3<T> s = kPlanarity ? p[1] - p[0] : p[0] - p[1];
@@ -195,7 +207,6 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   const V3<T> t = s - value * u;
   const V3<T> q = inv_m * t;
   const V3<T> ga = cross(b, q), gb = cross(q, a);
-  V3<T> g[4];
   if constexpr (kPlanarity) {
     g[0] = -u - ga;
     g[1] = u - gb;
@@ -207,9 +218,91 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   g[3] = gb;
   T denom = alpha;
   for (int k = 0; k < 4; ++k) denom = denom + wk[k] * dot(g[k], g[k]);
-  const auto ok = valid & (denom > 0.0);
-  const T dl = (-(value - r) - alpha * lam) / denom;
-  scatter4<T>(ids, ok, lam + dl, p, wk, dl, g, lambda, x);
+  dl = (-(value - r) - alpha * lam) / denom;
+  return valid & (denom > 0.0);
+}
+
+/// Quad planarity or plane offset (offset_step) of a block of constraints.
+template <class T, bool kPlanarity>
+EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, const double* compliance, double* lambda,
+                                      double inv_h2, double* x, const double* w) {
+  const QuadOperands<T> o(ids, rest, compliance, lambda, inv_h2, x, w);
+  lanes::V3<T> g[4];
+  T dl;
+  const auto ok = offset_step<T, kPlanarity>(o.p, o.wk, o.r, o.lam, o.alpha, g, dl);
+  scatter4<T>(ids, ok, o.lam + dl, o.p, o.wk, dl, g, lambda, x);
+}
+
+/// Islands (IslandPlan) first .. first + lanes - 1 of one shape, one per lane: their particles
+/// loaded once, every row projected in turn on the particles in registers (distance_step and
+/// offset_step, as the passes project them), each row's new multiplier stored, the movable particles
+/// stored once at the end.
+template <class T>
+EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t first, SolverArray* const* rows,
+                                      double inv_h2, double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  const int slots = shape.slots, steps = shape.steps;
+  V3<T> p[IslandPlan::kSlots];
+  T wp[IslandPlan::kSlots];
+  const int32_t* ids = &shape.particle[first * static_cast<size_t>(slots)];
+  for (int k = 0; k < slots; ++k) {
+    p[k] = load_point<T>(x, ids + k, slots);
+    wp[k] = load_value<T>(w, ids + k, slots);
+  }
+  const int32_t* row = &shape.row[first * static_cast<size_t>(steps)];
+  for (int step = 0; step < steps; ++step) {
+    SolverArray& a = *rows[shape.kind[step]];
+    const int32_t* at = row + step;  // lane l's row: at[l * steps]
+    const T r = load_value<T>(a.rest.data(), at, steps), lam = load_value<T>(a.lambda.data(), at, steps);
+    const T alpha = load_value<T>(a.compliance.data(), at, steps) * inv_h2;
+    const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
+    T lam_new;
+    if (shape.kind[step] == 0) {
+      V3<T> d;
+      T s0, s1;
+      const auto ok =
+          distance_step<T, false>(p[sl[0]], p[sl[1]], wp[sl[0]], wp[sl[1]], r, lam, alpha, d, s0, s1, lam_new);
+      p[sl[0]] = select3(ok & (wp[sl[0]] != 0.0), p[sl[0]] + s0 * d, p[sl[0]]);
+      p[sl[1]] = select3(ok & (wp[sl[1]] != 0.0), p[sl[1]] - s1 * d, p[sl[1]]);
+      for (int l = 0; l < L::count; ++l)
+        if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
+      continue;
+    }
+    const V3<T> q[4] = {p[sl[0]], p[sl[1]], p[sl[2]], p[sl[3]]};
+    const T wk[4] = {wp[sl[0]], wp[sl[1]], wp[sl[2]], wp[sl[3]]};
+    V3<T> g[4];
+    T dl;
+    const auto ok = shape.kind[step] == 1 ? offset_step<T, true>(q, wk, r, lam, alpha, g, dl)
+                                          : offset_step<T, false>(q, wk, r, lam, alpha, g, dl);
+    for (int k = 0; k < 4; ++k) p[sl[k]] = select3(ok & (wk[k] != 0.0), q[k] + (wk[k] * dl) * g[k], q[k]);
+    lam_new = lam + dl;
+    for (int l = 0; l < L::count; ++l)
+      if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
+  }
+  for (int k = 0; k < slots; ++k) {
+    alignas(32) double to[L::count][4];
+    transpose(p[k], to);
+    for (int l = 0; l < L::count; ++l)  // an immovable particle is not written
+      if (L::get(wp[k], l) != 0.0)
+        std::memcpy(x + 3 * static_cast<int64_t>(ids[l * slots + k]), to[l], 3 * sizeof(double));
+  }
+}
+
+/// The islands of items [begin, end) (IslandPlan::items): in lanes of T while an item has that many
+/// left, then one at a time.
+template <class T>
+EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows,
+                                      double inv_h2, double* x, const double* w) {
+  constexpr int lanes_n = lanes::Lanes<T>::count;
+  for (size_t i = begin; i < end; ++i) {
+    const IslandPlan::Item& item = plan.items[i];
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    int k = 0;
+    for (; k + lanes_n <= item.count; k += lanes_n)
+      island_block<T>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
+    for (; k < item.count; ++k) island_block<double>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
+  }
 }
 
 /// Whether p lies inside the ball of radius r about c, to rounding (a tether's reach is a sum of
@@ -687,25 +780,29 @@ EMBRA_ALWAYS_INLINE void values(const SolverArray& a, size_t i, size_t end, cons
                         const double* w) {                                                                 \
     pass<T, Op::OP>(a, begin, end, in_lanes, inv_h2, x, w);                                                \
   }
-#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                                         \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, distance)                                                                       \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, tether)                                                                         \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                                       \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                                      \
-  EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                                   \
-  ATTR void NAME##_tether_runs(const SolverArray& t, size_t begin, size_t end, bool others, double* x,             \
-                               const double* w) {                                                                  \
-    tether_runs<T>(t, begin, end, others, x, w);                                                                   \
-  }                                                                                                                \
-  ATTR void NAME##_chain(SolverArray& a, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x,        \
-                         const double* w, double* scratch) {                                                       \
-    chain_pass<T>(a, begin, end, in_lanes, inv_h2, x, w, scratch);                                                 \
-  }                                                                                                                \
-  ATTR void NAME##_distance_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) { \
-    values<T, Op::distance>(a, begin, end, x, out);                                                                \
-  }                                                                                                                \
-  ATTR void NAME##_dihedral_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) { \
-    values<T, Op::dihedral>(a, begin, end, x, out);                                                                \
+#define EMBRA_DEFINE_PASSES(NAME, T, ATTR)                                                                            \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, distance)                                                                          \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, tether)                                                                            \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, dihedral)                                                                          \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, planarity)                                                                         \
+  EMBRA_DEFINE_PASS(NAME, T, ATTR, plane_offset)                                                                      \
+  ATTR void NAME##_tether_runs(const SolverArray& t, size_t begin, size_t end, bool others, double* x,                \
+                               const double* w) {                                                                     \
+    tether_runs<T>(t, begin, end, others, x, w);                                                                      \
+  }                                                                                                                   \
+  ATTR void NAME##_islands(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2, \
+                           double* x, const double* w) {                                                              \
+    island_items<T>(plan, begin, end, rows, inv_h2, x, w);                                                            \
+  }                                                                                                                   \
+  ATTR void NAME##_chain(SolverArray& a, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x,           \
+                         const double* w, double* scratch) {                                                          \
+    chain_pass<T>(a, begin, end, in_lanes, inv_h2, x, w, scratch);                                                    \
+  }                                                                                                                   \
+  ATTR void NAME##_distance_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) {    \
+    values<T, Op::distance>(a, begin, end, x, out);                                                                   \
+  }                                                                                                                   \
+  ATTR void NAME##_dihedral_values(const SolverArray& a, size_t begin, size_t end, const double* x, double* out) {    \
+    values<T, Op::dihedral>(a, begin, end, x, out);                                                                   \
   }
 
 EMBRA_DEFINE_PASSES(scalar, double, )
@@ -719,30 +816,51 @@ EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
 
 }  // namespace
 
+namespace {
+Kernels pick_kernels();  // the kernel set for this machine (or EMBRA_KERNELS)
+}  // namespace
+
 const Kernels& kernels() {
   static const Kernels chosen = [] {
-    const Kernels scalar{scalar_distance,     scalar_tether, scalar_dihedral,        scalar_planarity,
-                         scalar_plane_offset, scalar_chain,  scalar_distance_values, scalar_dihedral_values,
-                         scalar_tether_runs,  "scalar"};
+    Kernels k = pick_kernels();
+    // EMBRA_ISLANDS=off: the rows of islands in their passes instead (the same bits, to check that).
+    const char* islands = std::getenv("EMBRA_ISLANDS");
+    if (islands != nullptr && std::string(islands) == "off") k.islands = nullptr;
+    return k;
+  }();
+  return chosen;
+}
+
+namespace {
+
+Kernels pick_kernels() {
+  {
+    const Kernels scalar{
+        scalar_distance, scalar_tether,          scalar_dihedral,        scalar_planarity,   scalar_plane_offset,
+        scalar_chain,    scalar_distance_values, scalar_dihedral_values, scalar_tether_runs, scalar_islands,
+        "scalar"};
     const char* forced = std::getenv("EMBRA_KERNELS");
     const std::string want = forced ? forced : "";
     if (want == "scalar") return scalar;
 #if EMBRA_LANES_VECTOR
     const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,   vec2_plane_offset,
-                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_runs, "vec2"};
+                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_runs, vec2_islands,
+                       "vec2"};
     if (want == "vec2") return vec2;
 #if defined(EMBRA_HAVE_AVX2_KERNELS)
     if (__builtin_cpu_supports("avx2"))
       return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,   avx2_plane_offset,
-                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_runs, "avx2"};
+                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_runs, avx2_islands,
+                     "avx2"};
 #endif
     return vec2;
 #else
     return scalar;
 #endif
-  }();
-  return chosen;
+  }
 }
+
+}  // namespace
 
 namespace {
 
@@ -750,6 +868,9 @@ using passes::each_colour;
 using passes::kAlign;
 using passes::kChainGrain;
 using passes::kGrain;
+
+/// Island items (of four panels' rows, about 70 rows) per thread below which the loop is not split.
+constexpr size_t kIslandGrain = 8;
 
 }  // namespace
 
@@ -777,6 +898,13 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
   pool.run(0, t.pair_runs.size(), kAlign, kGrain,
            [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, false, x, w); });
   pool.run(0, t.other_runs.size(), 1, kGrain, [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, true, x, w); });
+}
+
+void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
+                  const double* w) {
+  const Kernels& k = kernels();
+  pool.run(0, plan.items.size(), 1, kIslandGrain,
+           [&](size_t b, size_t e, int) { k.islands(plan, b, e, rows, inv_h2, x, w); });
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

@@ -40,6 +40,10 @@ struct Kernels {
   Values distance_values, dihedral_values;
   /// The automatic tethers' runs pair_runs[begin .. end), or other_runs[begin .. end) with `others`.
   void (*tether_runs)(const SolverArray&, size_t begin, size_t end, bool others, double* x, const double* w);
+  /// The island items [begin, end) of `plan`; rows: the group's distance, planarity and plane-offset
+  /// arrays.
+  void (*islands)(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2, double* x,
+                  const double* w);
   const char* name;
 };
 
@@ -127,6 +131,10 @@ void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, cons
                 std::vector<double>& scratch, ChainTrack* track = nullptr);
 /// Every automatic tether run of `t` (runs share no particle).
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
+/// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), the
+/// items split over the pool's threads (islands share no particle).
+void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
+                  const double* w);
 /// The function values of every constraint of `a` into out[0 .. a.size()).
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out);
 

@@ -346,9 +346,18 @@ void World::project_group(Group& g, double h, bool first) {
   else
     tether_runs_pass(*pool_, g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
+  SolverArray* rows[IslandPlan::kRowKinds] = {&distance, &g.solve[static_cast<int>(Kind::planarity)],
+                                              &g.solve[static_cast<int>(Kind::plane_offset)]};
+  // Islands (a panel mesh's panels): the three kinds' rows island by island, with the same bits, except
+  // where the hard pins' impulses are tracked (colour by colour).
+  const bool islands =
+      g.islands.active() && k.islands != nullptr &&
+      (tracked == nullptr || (rows[0]->pinned.empty() && rows[1]->pinned.empty() && rows[2]->pinned.empty()));
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
-  if (distance.chain_start.empty() || !first) {
+  if (islands) {
+    islands_pass(*pool_, g.islands, rows, inv_h2, x, w);
+  } else if (distance.chain_start.empty() || !first) {
     kernel_pass<Kind::distance>(*pool_, k.distance, distance, inv_h2, x_, w, tracked);
   } else if (tracked == nullptr || distance.pinned.empty()) {
     chain_pass(*pool_, distance, inv_h2, x, w, chain_scratch_);
@@ -367,9 +376,10 @@ void World::project_group(Group& g, double h, bool first) {
   project_generic<Kind::direction>(*pool_, g.solve[static_cast<int>(Kind::direction)], inv_h2, x_, w_, tracked);
   project_generic<Kind::cocircular>(*pool_, g.solve[static_cast<int>(Kind::cocircular)], inv_h2, x_, w_, tracked);
   project_generic<Kind::cospherical>(*pool_, g.solve[static_cast<int>(Kind::cospherical)], inv_h2, x_, w_, tracked);
-  kernel_pass<Kind::planarity>(*pool_, k.planarity, g.solve[static_cast<int>(Kind::planarity)], inv_h2, x_, w, tracked);
-  kernel_pass<Kind::plane_offset>(*pool_, k.plane_offset, g.solve[static_cast<int>(Kind::plane_offset)], inv_h2, x_, w,
-                                  tracked);
+  if (!islands) {
+    kernel_pass<Kind::planarity>(*pool_, k.planarity, *rows[1], inv_h2, x_, w, tracked);
+    kernel_pass<Kind::plane_offset>(*pool_, k.plane_offset, *rows[2], inv_h2, x_, w, tracked);
+  }
   // Shape matches, one set at a time in the order added (serial: the same bits at any thread count).
   for (ShapeMatch& sm : g.shapes) {
     if (tracked == nullptr) {

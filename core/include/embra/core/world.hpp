@@ -481,6 +481,36 @@ struct StaticsState {
   }
 };
 
+/// A group's distance, planarity and plane-offset rows as islands (World::rebuild_solver): the
+/// rows joined by shared particles, no island sharing a particle with another, each of at most
+/// kSlots particles and kSteps rows, in a group that projects no other kind between those three (a
+/// panel mesh's panels: the welds, which join them, are projected before). An island's rows are
+/// projected in the passes' order (distances, then planarity, then plane offsets, each in colour
+/// order) with its particles held in registers, islands of the same shape side by side in lanes:
+/// every particle sees the projections of the three passes in their order, so the bits are the
+/// passes' (tests/scenes/kernels_same_bits.sh, EMBRA_ISLANDS=off), loaded and stored once per
+/// island instead of once per row, and the three passes' colours are one parallel loop.
+struct IslandPlan {
+  static constexpr int kSlots = 8;     // particles of an island, at most
+  static constexpr int kSteps = 32;    // rows of an island, at most
+  static constexpr int kRowKinds = 3;  // the kinds of its rows: distance, planarity, plane offset
+  struct Shape {                       // islands with the same rows on the same local particles
+    int32_t slots = 0, steps = 0;
+    std::vector<int8_t> kind;       // per step: 0 distance, 1 planarity, 2 plane offset
+    std::vector<int8_t> slot;       // per step: 4 local particles (a distance uses 2)
+    std::vector<int32_t> particle;  // per island: its `slots` particles
+    std::vector<int32_t> row;       // per island: its `steps` rows (indices into that kind's array)
+    size_t islands() const { return slots == 0 ? 0 : particle.size() / static_cast<size_t>(slots); }
+  };
+  struct Item {  // up to kItemIslands consecutive islands of one shape
+    int32_t shape = 0, first = 0, count = 0;
+  };
+  static constexpr int kItemIslands = 4;
+  std::vector<Shape> shapes;
+  std::vector<Item> items;
+  bool active() const { return !items.empty(); }
+};
+
 struct Group {
   GroupDesc desc;
   uint32_t generation = 0;
@@ -489,6 +519,7 @@ struct Group {
   ConstraintArray arrays[kKindCount];
   SolverArray solve[kKindCount];   // the arrays in colour order, as the solver projects them
   SolverArray tethers;             // automatic long-range attachments (Settings::tethers)
+  IslandPlan islands;              // the distance, planarity and plane-offset rows, when they form islands
   std::vector<int32_t> soft_pins;  // indices into World::pins_
   std::vector<ShapeMatch> shapes;  // World::add_shape_match, projected after the constraint kinds
   std::vector<Contact> contacts;   // only in the contact group
