@@ -1088,18 +1088,18 @@ class RestSurface {
 
 /// The group's distance, planarity and plane-offset rows as islands (IslandPlan), or none when they
 /// do not form small islands, when another kind is projected between them, or when the distances
-/// are chained (their first pass is the chain pass).
-void build_islands(Group& g, size_t particle_count) {
-  g.islands = IslandPlan{};
+/// are chained (their first pass is the chain pass). The kinds World::project_group projects before
+/// the distances are listed here: any other kind with rows keeps the passes.
+IslandPlan build_islands(const Group& g, size_t particle_count) {
   constexpr Kind kRowKinds[IslandPlan::kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
   for (int k = 0; k < kKindCount; ++k) {
     const Kind kind = static_cast<Kind>(k);
     const bool before =
         kind == Kind::weld || kind == Kind::edge_angle || kind == Kind::dihedral || kind == Kind::tether;
     const bool row = kind == Kind::distance || kind == Kind::planarity || kind == Kind::plane_offset;
-    if (!before && !row && g.solve[k].size() > 0) return;
+    if (!before && !row && g.solve[k].size() > 0) return {};
   }
-  if (!g.solve[static_cast<int>(Kind::distance)].chain_start.empty()) return;
+  if (!g.solve[static_cast<int>(Kind::distance)].chain_start.empty()) return {};
   // Union-find over the particles the rows join.
   std::vector<int32_t> parent(particle_count, -1);
   auto find = [&](int32_t p) {
@@ -1123,7 +1123,7 @@ void build_islands(Group& g, size_t particle_count) {
         if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
       }
   }
-  if (rows == 0) return;
+  if (rows == 0) return {};
   // Each island's rows in the passes' order, islands in the order of their first row.
   std::vector<int32_t> island_of(particle_count, -1);
   std::vector<std::vector<std::pair<int8_t, int32_t>>> island_rows;
@@ -1137,9 +1137,10 @@ void build_islands(Group& g, size_t particle_count) {
         island_rows.emplace_back();
       }
       island_rows[island].emplace_back(static_cast<int8_t>(kr), static_cast<int32_t>(i));
-      if (island_rows[island].size() > static_cast<size_t>(IslandPlan::kSteps)) return;
+      if (island_rows[island].size() > static_cast<size_t>(IslandPlan::kSteps)) return {};
     }
   }
+  IslandPlan plan;
   // Shapes: the rows' kinds and local particles (numbered by first use), islands grouped by shape.
   std::map<std::vector<int8_t>, int32_t> shape_of;
   std::vector<int32_t> local(particle_count, -1);
@@ -1155,11 +1156,7 @@ void build_islands(Group& g, size_t particle_count) {
         if (j < n) {
           const int32_t p = a.ids[n * static_cast<size_t>(i) + j];
           if (local[p] < 0) {
-            if (particles.size() == static_cast<size_t>(IslandPlan::kSlots)) {
-              for (int32_t q : particles) local[q] = -1;
-              g.islands = IslandPlan{};
-              return;
-            }
+            if (particles.size() == static_cast<size_t>(IslandPlan::kSlots)) return {};
             local[p] = static_cast<int32_t>(particles.size());
             particles.push_back(p);
           }
@@ -1172,24 +1169,25 @@ void build_islands(Group& g, size_t particle_count) {
     }
     for (int32_t q : particles) local[q] = -1;
     key.push_back(static_cast<int8_t>(particles.size()));
-    const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(g.islands.shapes.size()));
+    const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(plan.shapes.size()));
     if (fresh) {
       IslandPlan::Shape shape;
       shape.slots = static_cast<int32_t>(particles.size());
       shape.steps = static_cast<int32_t>(list.size());
       for (const auto& [kr, i] : list) shape.kind.push_back(kr);
       shape.slot = slots;
-      g.islands.shapes.push_back(std::move(shape));
+      plan.shapes.push_back(std::move(shape));
     }
-    IslandPlan::Shape& shape = g.islands.shapes[it->second];
+    IslandPlan::Shape& shape = plan.shapes[it->second];
     shape.particle.insert(shape.particle.end(), particles.begin(), particles.end());
     shape.row.insert(shape.row.end(), row.begin(), row.end());
   }
-  for (size_t sh = 0; sh < g.islands.shapes.size(); ++sh) {
-    const int32_t count = static_cast<int32_t>(g.islands.shapes[sh].islands());
+  for (size_t sh = 0; sh < plan.shapes.size(); ++sh) {
+    const int32_t count = static_cast<int32_t>(plan.shapes[sh].islands());
     for (int32_t first = 0; first < count; first += IslandPlan::kItemIslands)
-      g.islands.items.push_back({static_cast<int32_t>(sh), first, std::min(IslandPlan::kItemIslands, count - first)});
+      plan.items.push_back({static_cast<int32_t>(sh), first, std::min(IslandPlan::kItemIslands, count - first)});
   }
+  return plan;
 }
 
 }  // namespace
@@ -1430,7 +1428,7 @@ void World::rebuild_solver() {
       }
     }
     g.tethers = SolverArray{};
-    build_islands(g, x_.size());
+    g.islands = build_islands(g, x_.size());
   }
   // Automatic long-range attachments: every particle of an inextensible body to its nearest
   // anchors (hard-pinned or immovable particles of the body), in the body's stretch group.

@@ -258,25 +258,23 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
     const T alpha = load_value<T>(a.compliance.data(), at, steps) * inv_h2;
     const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
     T lam_new;
+    decltype(T{} > 0.0) ok;  // the lanes where the row applies
     if (shape.kind[step] == 0) {
       V3<T> d;
       T s0, s1;
-      const auto ok =
-          distance_step<T, false>(p[sl[0]], p[sl[1]], wp[sl[0]], wp[sl[1]], r, lam, alpha, d, s0, s1, lam_new);
+      ok = distance_step<T, false>(p[sl[0]], p[sl[1]], wp[sl[0]], wp[sl[1]], r, lam, alpha, d, s0, s1, lam_new);
       p[sl[0]] = select3(ok & (wp[sl[0]] != 0.0), p[sl[0]] + s0 * d, p[sl[0]]);
       p[sl[1]] = select3(ok & (wp[sl[1]] != 0.0), p[sl[1]] - s1 * d, p[sl[1]]);
-      for (int l = 0; l < L::count; ++l)
-        if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
-      continue;
+    } else {
+      const V3<T> q[4] = {p[sl[0]], p[sl[1]], p[sl[2]], p[sl[3]]};
+      const T wk[4] = {wp[sl[0]], wp[sl[1]], wp[sl[2]], wp[sl[3]]};
+      V3<T> g[4];
+      T dl;
+      ok = shape.kind[step] == 1 ? offset_step<T, true>(q, wk, r, lam, alpha, g, dl)
+                                 : offset_step<T, false>(q, wk, r, lam, alpha, g, dl);
+      for (int k = 0; k < 4; ++k) p[sl[k]] = select3(ok & (wk[k] != 0.0), q[k] + (wk[k] * dl) * g[k], q[k]);
+      lam_new = lam + dl;
     }
-    const V3<T> q[4] = {p[sl[0]], p[sl[1]], p[sl[2]], p[sl[3]]};
-    const T wk[4] = {wp[sl[0]], wp[sl[1]], wp[sl[2]], wp[sl[3]]};
-    V3<T> g[4];
-    T dl;
-    const auto ok = shape.kind[step] == 1 ? offset_step<T, true>(q, wk, r, lam, alpha, g, dl)
-                                          : offset_step<T, false>(q, wk, r, lam, alpha, g, dl);
-    for (int k = 0; k < 4; ++k) p[sl[k]] = select3(ok & (wk[k] != 0.0), q[k] + (wk[k] * dl) * g[k], q[k]);
-    lam_new = lam + dl;
     for (int l = 0; l < L::count; ++l)
       if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
   }
@@ -814,10 +812,32 @@ EMBRA_DEFINE_PASSES(avx2, lanes::D4, __attribute__((target("avx2"))))
 #endif
 #endif
 
-}  // namespace
+/// The kernel set for this machine, or the one EMBRA_KERNELS names.
+Kernels pick_kernels() {
+  const Kernels scalar{
+      scalar_distance, scalar_tether,          scalar_dihedral,        scalar_planarity,   scalar_plane_offset,
+      scalar_chain,    scalar_distance_values, scalar_dihedral_values, scalar_tether_runs, scalar_islands,
+      "scalar"};
+  const char* forced = std::getenv("EMBRA_KERNELS");
+  const std::string want = forced ? forced : "";
+  if (want == "scalar") return scalar;
+#if EMBRA_LANES_VECTOR
+  const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,   vec2_plane_offset,
+                     vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_runs, vec2_islands,
+                     "vec2"};
+  if (want == "vec2") return vec2;
+#if defined(EMBRA_HAVE_AVX2_KERNELS)
+  if (__builtin_cpu_supports("avx2"))
+    return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,   avx2_plane_offset,
+                   avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_runs, avx2_islands,
+                   "avx2"};
+#endif
+  return vec2;
+#else
+  return scalar;
+#endif
+}
 
-namespace {
-Kernels pick_kernels();  // the kernel set for this machine (or EMBRA_KERNELS)
 }  // namespace
 
 const Kernels& kernels() {
@@ -830,37 +850,6 @@ const Kernels& kernels() {
   }();
   return chosen;
 }
-
-namespace {
-
-Kernels pick_kernels() {
-  {
-    const Kernels scalar{
-        scalar_distance, scalar_tether,          scalar_dihedral,        scalar_planarity,   scalar_plane_offset,
-        scalar_chain,    scalar_distance_values, scalar_dihedral_values, scalar_tether_runs, scalar_islands,
-        "scalar"};
-    const char* forced = std::getenv("EMBRA_KERNELS");
-    const std::string want = forced ? forced : "";
-    if (want == "scalar") return scalar;
-#if EMBRA_LANES_VECTOR
-    const Kernels vec2{vec2_distance, vec2_tether,          vec2_dihedral,        vec2_planarity,   vec2_plane_offset,
-                       vec2_chain,    vec2_distance_values, vec2_dihedral_values, vec2_tether_runs, vec2_islands,
-                       "vec2"};
-    if (want == "vec2") return vec2;
-#if defined(EMBRA_HAVE_AVX2_KERNELS)
-    if (__builtin_cpu_supports("avx2"))
-      return Kernels{avx2_distance, avx2_tether,          avx2_dihedral,        avx2_planarity,   avx2_plane_offset,
-                     avx2_chain,    avx2_distance_values, avx2_dihedral_values, avx2_tether_runs, avx2_islands,
-                     "avx2"};
-#endif
-    return vec2;
-#else
-    return scalar;
-#endif
-  }
-}
-
-}  // namespace
 
 namespace {
 

@@ -349,7 +349,8 @@ void World::project_group(Group& g, double h, bool first) {
   SolverArray* rows[IslandPlan::kRowKinds] = {&distance, &g.solve[static_cast<int>(Kind::planarity)],
                                               &g.solve[static_cast<int>(Kind::plane_offset)]};
   // Islands (a panel mesh's panels): the three kinds' rows island by island, with the same bits, except
-  // where the hard pins' impulses are tracked (colour by colour).
+  // where the hard pins' impulses are tracked (colour by colour). build_islands lists the kinds
+  // projected above: a group with rows of any other kind keeps the passes, as those come in between.
   const bool islands =
       g.islands.active() && k.islands != nullptr &&
       (tracked == nullptr || (rows[0]->pinned.empty() && rows[1]->pinned.empty() && rows[2]->pinned.empty()));
