@@ -210,8 +210,10 @@ typedef struct embra_solver_def {
                                   against edge, kept the sum of the two sides' half thicknesses apart
                                   (embra_material.thickness), found in space-time over each substep so
                                   fast folds never pass through, resolved as hard contacts in the contact
-                                  group with the materials' friction. The broad phase is a spatial hash
-                                  rebuilt every substep (cost linear in the particle count). */
+                                  group with the materials' friction. The broad phase keeps its candidate
+                                  pairs while the particles stay in regions around their motion and
+                                  finds those of the particles that leave in a bounding-volume
+                                  hierarchy (cost linear in the particle count). */
   int32_t chain_solve;         /* 0 or 1; default 1. 1: distance constraints that lie end to end in
                                   straight runs over the bodies' rest shapes (a cloth grid's rows,
                                   columns and diagonals; any mesh's straight edge runs, within about

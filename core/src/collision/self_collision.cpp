@@ -30,9 +30,8 @@ constexpr double kMinGap = 1e-6;
 constexpr double kRegionAhead = 8.0;
 constexpr double kRegionMotion = 0.5;
 constexpr double kRegionThickness = 0.5;
-/// The broad phase's grids are built again when more than one primitive in kRegrid has moved since
-/// they were built (8 measured as fast as 16 and faster than 2 and 4).
-constexpr size_t kRegrid = 8;
+/// Items per leaf of the broad phase's hierarchy.
+constexpr int32_t kLeafItems = 4;
 
 struct Box {
   Vec3 lo, hi;
@@ -396,17 +395,24 @@ int exact_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 namespace embra {
 
 /// What the broad phase keeps from substep to substep besides the pairs (SelfCollisionCache):
-/// each primitive's region box, each particle's reach, the grids of the last full rebuild and the
-/// primitives moved since with grids of their own.
+/// each primitive's region box, each particle's reach, and a bounding-volume hierarchy over the
+/// region boxes, built once for the primitives' topology and refitted when regions change. Its
+/// leaves hold items: a triangle with the particles and edges it owns (each particle and edge owned
+/// by the first triangle holding it), or, for a particle or edge in no triangle, an item of its own.
+/// Items are stored in leaf order.
 struct SelfCollisionIndex {
   std::vector<self_collision::Box> tri_boxes, edge_boxes, point_boxes;  // point_boxes in points order
   std::vector<double> reach;                                            // per particle: its region's diagonal
-  double cell = 1.0;
-  self_collision::Grid tri_grid, edge_grid, point_grid;
-  std::vector<uint8_t> tri_moved, edge_moved, point_moved;
-  std::vector<int32_t> moved_tris, moved_edges, moved_points;
-  std::vector<self_collision::Box> moved_tri_boxes, moved_edge_boxes, moved_point_boxes;
-  self_collision::Grid moved_tri_grid, moved_edge_grid, moved_point_grid;
+  struct Node {
+    self_collision::Box box;
+    int32_t first = 0, count = 0;  // a leaf's items [first, first + count); count 0: internal
+    int32_t right = 0;             // internal: the right child (the left is the next node)
+  };
+  std::vector<Node> nodes;                         // pre-order: a child after its parent
+  std::vector<int32_t> item_tri;                   // per item: its triangle, or -1
+  std::vector<int32_t> point_begin, owned_points;  // per item: the particles it owns (points order)
+  std::vector<int32_t> edge_begin, owned_edges;    // per item: the edges it owns
+  std::vector<self_collision::Box> item_box;       // per item: its primitives' region boxes
 };
 
 }  // namespace embra
@@ -617,16 +623,6 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
   for (const std::vector<T>& list : parts) out.insert(out.end(), list.begin(), list.end());
 }
 
-/// Builds each grid of its boxes, the grids at once on the pool's threads (each built by one thread,
-/// so the same at any thread count; on 2 threads the first two on one, the third on the other).
-void build_grids(ThreadPool& pool, std::initializer_list<std::pair<Grid*, const std::vector<Box>*>> grids,
-                 double cell) {
-  const auto* g = grids.begin();
-  pool.run(0, grids.size(), 1, 1, [&](size_t begin, size_t end, int) {
-    for (size_t k = begin; k < end; ++k) g[k].first->build(*g[k].second, cell);
-  });
-}
-
 // Items per thread below which a detection loop is not split.
 constexpr size_t kPairGrain = 256;     // primitives queried against a grid
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
@@ -683,6 +679,149 @@ const Vec3& rest_of(const BodyInfo& b, int32_t i) {
   return b.rest_positions[static_cast<size_t>(i - b.first_particle)];
 }
 
+/// Builds the hierarchy's items and nodes for the primitives of `s`, split at the positions `x`
+/// (median splits of the items' centres along the widest axis, kLeafItems items a leaf). Any split
+/// finds the same pairs; a good one finds them sooner.
+void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const Vec3> x) {
+  const size_t nt = s.tris.size() / 3, ne = s.edges.size() / 2, np = s.points.size();
+  // The owners: the first triangle holding a particle or an edge, else an item of its own.
+  std::vector<int32_t> point_owner(x.size(), -1), edge_owner(ne, -1);
+  std::vector<std::array<int32_t, 3>> by_ends(ne);  // (lower end, higher end, edge)
+  for (size_t e = 0; e < ne; ++e) {
+    const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
+    by_ends[e] = {std::min(a, b), std::max(a, b), static_cast<int32_t>(e)};
+  }
+  std::sort(by_ends.begin(), by_ends.end());
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = s.tris[3 * t + k], b = s.tris[3 * t + (k + 1) % 3];
+      if (point_owner[a] < 0) point_owner[a] = static_cast<int32_t>(t);
+      const std::array<int32_t, 3> key = {std::min(a, b), std::max(a, b), std::numeric_limits<int32_t>::min()};
+      const auto it = std::lower_bound(by_ends.begin(), by_ends.end(), key);
+      if (it != by_ends.end() && (*it)[0] == key[0] && (*it)[1] == key[1] && edge_owner[(*it)[2]] < 0)
+        edge_owner[(*it)[2]] = static_cast<int32_t>(t);
+    }
+  std::vector<int32_t> tri_of(nt);  // per item in creation order: its triangle or -1
+  std::iota(tri_of.begin(), tri_of.end(), 0);
+  for (size_t e = 0; e < ne; ++e)
+    if (edge_owner[e] < 0) edge_owner[e] = static_cast<int32_t>(tri_of.size()), tri_of.push_back(-1);
+  for (int32_t p : s.points)
+    if (point_owner[p] < 0) point_owner[p] = static_cast<int32_t>(tri_of.size()), tri_of.push_back(-1);
+  const size_t items = tri_of.size();
+  std::vector<std::vector<int32_t>> pts(items), eds(items);
+  for (size_t k = 0; k < np; ++k) pts[static_cast<size_t>(point_owner[s.points[k]])].push_back(static_cast<int32_t>(k));
+  for (size_t e = 0; e < ne; ++e) eds[static_cast<size_t>(edge_owner[e])].push_back(static_cast<int32_t>(e));
+  // Each item's centre (a non-finite coordinate taken as 0, so the split's order stays strict).
+  std::vector<Vec3> centre(items, Vec3::Zero());
+  for (size_t k = 0; k < items; ++k) {
+    Vec3 sum = Vec3::Zero();
+    int count = 0;
+    if (tri_of[k] >= 0)
+      for (int j = 0; j < 3; ++j) sum += x[s.tris[3 * static_cast<size_t>(tri_of[k]) + j]], ++count;
+    for (int32_t q : pts[k]) sum += x[s.points[static_cast<size_t>(q)]], ++count;
+    for (int32_t e : eds[k])
+      sum += x[s.edges[2 * static_cast<size_t>(e)]] + x[s.edges[2 * static_cast<size_t>(e) + 1]], count += 2;
+    for (int a = 0; a < 3; ++a) centre[k][a] = std::isfinite(sum[a]) ? sum[a] / count : 0.0;
+  }
+  std::vector<int32_t> order(items);
+  std::iota(order.begin(), order.end(), 0);
+  ix.nodes.clear();
+  ix.nodes.reserve(2 * items / kLeafItems + 2);
+  auto build = [&](auto&& self, int32_t lo, int32_t hi) -> int32_t {
+    const int32_t at = static_cast<int32_t>(ix.nodes.size());
+    ix.nodes.emplace_back();
+    if (hi - lo <= kLeafItems) {
+      ix.nodes[static_cast<size_t>(at)].first = lo;
+      ix.nodes[static_cast<size_t>(at)].count = hi - lo;
+      return at;
+    }
+    auto c = [&](int32_t k) -> const Vec3& { return centre[static_cast<size_t>(order[static_cast<size_t>(k)])]; };
+    Vec3 lo_c = c(lo), hi_c = lo_c;
+    for (int32_t k = lo; k < hi; ++k) lo_c = lo_c.cwiseMin(c(k)), hi_c = hi_c.cwiseMax(c(k));
+    int axis = 0;
+    (hi_c - lo_c).maxCoeff(&axis);
+    const int32_t mid = lo + (hi - lo) / 2;
+    std::nth_element(order.begin() + lo, order.begin() + mid, order.begin() + hi, [&](int32_t a, int32_t b) {
+      const double ca = centre[static_cast<size_t>(a)][axis], cb = centre[static_cast<size_t>(b)][axis];
+      return ca < cb || (ca == cb && a < b);
+    });
+    self(self, lo, mid);
+    const int32_t right = self(self, mid, hi);
+    ix.nodes[static_cast<size_t>(at)].right = right;
+    return at;
+  };
+  build(build, 0, static_cast<int32_t>(items));
+  ix.item_tri.resize(items);
+  ix.point_begin.assign(1, 0);
+  ix.edge_begin.assign(1, 0);
+  ix.owned_points.clear();
+  ix.owned_edges.clear();
+  for (size_t k = 0; k < items; ++k) {  // in leaf order
+    const size_t item = static_cast<size_t>(order[k]);
+    ix.item_tri[k] = tri_of[item];
+    ix.owned_points.insert(ix.owned_points.end(), pts[item].begin(), pts[item].end());
+    ix.owned_edges.insert(ix.owned_edges.end(), eds[item].begin(), eds[item].end());
+    ix.point_begin.push_back(static_cast<int32_t>(ix.owned_points.size()));
+    ix.edge_begin.push_back(static_cast<int32_t>(ix.owned_edges.size()));
+  }
+  ix.item_box.resize(items);
+}
+
+/// The hierarchy refitted to the primitives' region boxes: an item's box holds its triangle's (which
+/// holds its vertices' and edges') or those of what it owns, a node's its children's.
+void refit_hierarchy(SelfCollisionIndex& ix, ThreadPool& pool, size_t grain) {
+  const auto unite = [](Box& b, const Box& o) {
+    b.lo = b.lo.cwiseMin(o.lo);
+    b.hi = b.hi.cwiseMax(o.hi);
+  };
+  pool.run(0, ix.item_tri.size(), 1, grain, [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) {
+      Box& b = ix.item_box[k];
+      if (ix.item_tri[k] >= 0) {
+        b = ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])];
+        continue;
+      }
+      b = Box{Vec3::Constant(std::numeric_limits<double>::infinity()),
+              Vec3::Constant(-std::numeric_limits<double>::infinity())};
+      for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j) unite(b, ix.point_boxes[ix.owned_points[j]]);
+      for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) unite(b, ix.edge_boxes[ix.owned_edges[j]]);
+    }
+  });
+  for (size_t k = ix.nodes.size(); k-- > 0;) {
+    SelfCollisionIndex::Node& node = ix.nodes[k];
+    if (node.count > 0) {
+      node.box = ix.item_box[static_cast<size_t>(node.first)];
+      for (int32_t j = node.first + 1; j < node.first + node.count; ++j) unite(node.box, ix.item_box[j]);
+    } else {
+      node.box = ix.nodes[k + 1].box;
+      unite(node.box, ix.nodes[static_cast<size_t>(node.right)].box);
+    }
+  }
+}
+
+/// Calls visit(item) for every item whose box overlaps q, depth first. The stack is on the calling
+/// thread's own stack (a shared vector's end, written at every step, would bounce between the
+/// threads' caches): the median splits halve every node, so the hierarchy is at most 31 deep below
+/// its root and the walk holds at most one pending right child a level.
+template <class F>
+void query_hierarchy(const SelfCollisionIndex& ix, const Box& q, F&& visit) {
+  std::array<int32_t, 64> stack;
+  size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const int32_t at = stack[--top];
+    const SelfCollisionIndex::Node& node = ix.nodes[static_cast<size_t>(at)];
+    if (!node.box.overlaps(q)) continue;
+    if (node.count == 0) {
+      stack[top++] = node.right;
+      stack[top++] = at + 1;
+      continue;
+    }
+    for (int32_t k = node.first; k < node.first + node.count; ++k)
+      if (ix.item_box[static_cast<size_t>(k)].overlaps(q)) visit(k);
+  }
+}
+
 }  // namespace
 
 void find_contacts(const Input& in, std::vector<SelfContact>& out) {
@@ -724,14 +863,12 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // contacts are the same as with a broad phase rebuilt every substep.
   // A pair's regions are those of its particles, so only the pairs with a particle that left its
   // region need finding again: that particle gets a new region and the primitives holding it are
-  // queried again; the other pairs are kept. The grids are those of the last full rebuild, with the
-  // primitives whose regions changed since then in small grids of their own; when more than one
-  // primitive in kFullRebuild has changed, the grids are built again and every pair found again.
+  // queried again (against the hierarchy of region boxes, refitted); the other pairs are kept.
   if (!cache.index) cache.index = std::make_shared<SelfCollisionIndex>();
   SelfCollisionIndex& ix = *cache.index;
   const size_t np = s.points.size();
-  const bool cached =
-      cache.lo.size() == x1.size() && cache.triangles == nt && cache.edges == ne && ix.point_boxes.size() == np;
+  const bool cached = cache.lo.size() == x1.size() && cache.triangles == s.tris && cache.edges == s.edges &&
+                      ix.point_boxes.size() == np;
   auto inside = [&](const Vec3& p, int32_t i) {
     return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
   };
@@ -754,9 +891,10 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     if (!cached) {
       cache.lo.assign(x1.size(), Vec3::Zero());
       cache.hi.assign(x1.size(), Vec3::Zero());
-      cache.triangles = nt;
-      cache.edges = ne;
+      cache.triangles = s.tris;
+      cache.edges = s.edges;
       ix = SelfCollisionIndex{};
+      build_hierarchy(ix, s, x1);
       ix.reach.assign(x1.size(), 0.0);
       ix.tri_boxes.resize(nt);
       ix.edge_boxes.resize(ne);
@@ -791,14 +929,11 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       for (int32_t i : ids) d = std::max(d, ix.reach[i]);
       return d;
     };
-    // The primitives holding them: new boxes, and marked as moved since the last full rebuild.
+    // The primitives holding them: new boxes.
     s.changed_tris.clear();
     s.changed_edges.clear();
     s.tri_changed.assign(nt, 0);
     s.edge_changed.assign(ne, 0);
-    ix.tri_moved.resize(nt, 0);
-    ix.edge_moved.resize(ne, 0);
-    ix.point_moved.resize(np, 0);
     // (boxes and marks split over the threads, then the lists in index order)
     in.pool->run(0, nt, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
       for (size_t t = begin; t < end; ++t) {
@@ -816,49 +951,12 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
         s.edge_changed[e] = 1;
       }
     });
-    for (size_t t = 0; t < nt; ++t) {
-      if (!s.tri_changed[t]) continue;
-      s.changed_tris.push_back(static_cast<int32_t>(t));
-      if (!ix.tri_moved[t]) ix.tri_moved[t] = 1, ix.moved_tris.push_back(static_cast<int32_t>(t));
-    }
-    for (size_t e = 0; e < ne; ++e) {
-      if (!s.edge_changed[e]) continue;
-      s.changed_edges.push_back(static_cast<int32_t>(e));
-      if (!ix.edge_moved[e]) ix.edge_moved[e] = 1, ix.moved_edges.push_back(static_cast<int32_t>(e));
-    }
-    for (int32_t k : s.left) {
-      ix.point_boxes[k] = region({s.points[k]});
-      if (!ix.point_moved[k]) ix.point_moved[k] = 1, ix.moved_points.push_back(k);
-    }
-    // The grids are built again when too many primitives have moved since they were built (the
-    // pairs are kept); else the moved primitives get small grids of their own.
-    const bool regrid = !cached || ix.moved_tris.size() * kRegrid > nt || ix.moved_edges.size() * kRegrid > ne ||
-                        ix.moved_points.size() * kRegrid > np;
-    if (regrid) {
-      // The mean triangle extent (measured fastest on the folded-cloth benchmark, against 0.7 and 2
-      // times it): a triangle covers 1 to 8 cells and a bucket holds a bounded number of triangles.
-      ix.cell = mean_extent(ix.tri_boxes);
-      build_grids(*in.pool,
-                  {{&ix.tri_grid, &ix.tri_boxes}, {&ix.point_grid, &ix.point_boxes}, {&ix.edge_grid, &ix.edge_boxes}},
-                  ix.cell);
-      for (int32_t t : ix.moved_tris) ix.tri_moved[t] = 0;
-      for (int32_t e : ix.moved_edges) ix.edge_moved[e] = 0;
-      for (int32_t k : ix.moved_points) ix.point_moved[k] = 0;
-      ix.moved_tris.clear(), ix.moved_edges.clear(), ix.moved_points.clear();
-    } else {
-      auto moved_boxes = [](const std::vector<int32_t>& ids, const std::vector<Box>& boxes, std::vector<Box>& into) {
-        into.resize(ids.size());
-        for (size_t k = 0; k < ids.size(); ++k) into[k] = boxes[ids[k]];
-      };
-      moved_boxes(ix.moved_tris, ix.tri_boxes, ix.moved_tri_boxes);
-      moved_boxes(ix.moved_edges, ix.edge_boxes, ix.moved_edge_boxes);
-      moved_boxes(ix.moved_points, ix.point_boxes, ix.moved_point_boxes);
-      build_grids(*in.pool,
-                  {{&ix.moved_tri_grid, &ix.moved_tri_boxes},
-                   {&ix.moved_point_grid, &ix.moved_point_boxes},
-                   {&ix.moved_edge_grid, &ix.moved_edge_boxes}},
-                  ix.cell);
-    }
+    for (size_t t = 0; t < nt; ++t)
+      if (s.tri_changed[t]) s.changed_tris.push_back(static_cast<int32_t>(t));
+    for (size_t e = 0; e < ne; ++e)
+      if (s.edge_changed[e]) s.changed_edges.push_back(static_cast<int32_t>(e));
+    for (int32_t k : s.left) ix.point_boxes[k] = region({s.points[k]});
+    refit_hierarchy(ix, *in.pool, kBoxGrain);
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
@@ -885,20 +983,6 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     };
     keep(cache.point_triangle, [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
     keep(cache.edge_edge, [&](int32_t a, int32_t b) { return !s.edge_changed[a] && !s.edge_changed[b]; });
-    // The primitives whose regions overlap q: the full rebuild's grid, less those that moved since,
-    // and the grid of those.
-    auto query = [&](const Grid& grid, const std::vector<uint8_t>& moved, const Grid& moved_grid,
-                     const std::vector<int32_t>& moved_ids, const Box& q, std::vector<int32_t>& cand) {
-      cand.clear();
-      grid.query(q, cand);
-      if (moved_ids.empty()) return;
-      size_t kept = 0;
-      for (int32_t c : cand)
-        if (!moved[c]) cand[kept++] = c;
-      cand.resize(kept);
-      moved_grid.query(q, cand);
-      for (size_t k = kept; k < cand.size(); ++k) cand[k] = moved_ids[cand[k]];
-    };
     // A pair is kept when the two can come within their thickness while their particles stay in
     // their regions (see above), and they are not neighbours on the surface at rest.
     auto point_triangle_pair = [&](int32_t p, int32_t t, std::vector<int32_t>& pairs) {
@@ -940,33 +1024,47 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       pairs.insert(pairs.end(), {ea, eb});
     };
     // Point against triangle: each particle with a new region against every triangle, then each
-    // triangle with a new region against the particles that kept theirs.
+    // triangle with a new region against the particles that kept theirs; the candidates are the
+    // primitives whose region boxes overlap, found in the hierarchy.
     gather(*in.pool, s.left.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
-           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
              const int32_t q = s.left[k];
-             query(ix.tri_grid, ix.tri_moved, ix.moved_tri_grid, ix.moved_tris, ix.point_boxes[q], cand);
-             for (int32_t t : cand) point_triangle_pair(s.points[q], t, pairs);
+             const Box& box = ix.point_boxes[q];
+             query_hierarchy(ix, box, [&](int32_t item) {
+               const int32_t t = ix.item_tri[static_cast<size_t>(item)];
+               if (t >= 0 && ix.tri_boxes[static_cast<size_t>(t)].overlaps(box))
+                 point_triangle_pair(s.points[q], t, pairs);
+             });
            });
     if (s.left.size() < np)
       gather(*in.pool, s.changed_tris.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
-             [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+             [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
                const int32_t t = s.changed_tris[k];
-               query(ix.point_grid, ix.point_moved, ix.moved_point_grid, ix.moved_points, ix.tri_boxes[t], cand);
-               for (int32_t q : cand)
-                 if (!s.changed[s.points[q]]) point_triangle_pair(s.points[q], t, pairs);
+               const Box& box = ix.tri_boxes[t];
+               query_hierarchy(ix, box, [&](int32_t item) {
+                 for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                   const int32_t q = ix.owned_points[j];
+                   if (!s.changed[s.points[q]] && ix.point_boxes[q].overlaps(box))
+                     point_triangle_pair(s.points[q], t, pairs);
+                 }
+               });
              });
     // Edge against edge, each pair once, the lower edge first.
     gather(*in.pool, s.changed_edges.size(), kPairGrain, s.part_pairs, s.part_cand, cache.edge_edge,
-           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>& cand) {
+           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
              const int32_t ea = s.changed_edges[k];
-             query(ix.edge_grid, ix.edge_moved, ix.moved_edge_grid, ix.moved_edges, ix.edge_boxes[ea], cand);
-             for (int32_t eb : cand) {
-               if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
-               if (ea < eb)
-                 edge_edge_pair(ea, eb, pairs);
-               else
-                 edge_edge_pair(eb, ea, pairs);
-             }
+             const Box& box = ix.edge_boxes[ea];
+             query_hierarchy(ix, box, [&](int32_t item) {
+               for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
+                 const int32_t eb = ix.owned_edges[j];
+                 if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
+                 if (!ix.edge_boxes[eb].overlaps(box)) continue;
+                 if (ea < eb)
+                   edge_edge_pair(ea, eb, pairs);
+                 else
+                   edge_edge_pair(eb, ea, pairs);
+               }
+             });
            });
   }
 

@@ -2,21 +2,22 @@
 // triangles and edges of every body that has triangles, same body or different bodies (pairs
 // sharing a vertex excluded), kept `thickness` apart (the two sides' half thicknesses added).
 //
-//   broad phase   a spatial hash of regions around the particles (their swept bounds stretched
-//                 ahead along their motion, where they go on to in the next substeps, and grown by
-//                 a margin), and the candidate pairs it gives, kept from substep to substep while their
-//                 particles stay inside their regions. A particle that leaves its region gets a new
-//                 one, and only the pairs of the primitives holding it are dropped and found again
-//                 (each such primitive queried against the others); the hash tables are those of the
-//                 last rebuild, with the primitives moved since in small tables of their own, and are
-//                 rebuilt when an eighth of the primitives have moved. Pairs that cannot come within
-//                 their thickness while the regions hold (their distance, less what the regions let
-//                 them move) are dropped when the pairs are found. The cell is the mean triangle
-//                 region's extent, so a primitive covers a bounded number of cells and the work grows
-//                 linearly with the particle count. The table is a counting sort into buckets (no node
-//                 allocation, iteration in primitive order): deterministic. The loops over particles,
-//                 primitives and pairs are split over the pool's threads and their lists appended in
-//                 part order; the three tables are built at once, each by one thread.
+//   broad phase   regions around the particles (their swept bounds stretched ahead along their
+//                 motion, where they go on to in the next substeps, and grown by a margin), and the
+//                 candidate pairs they give, kept from substep to substep while their particles stay
+//                 inside their regions. A particle that leaves its region gets a new one, and only
+//                 the pairs of the primitives holding it are dropped and found again (each such
+//                 primitive queried against the others). The queries walk a bounding-volume
+//                 hierarchy over the primitives' region boxes, built once for their topology (median
+//                 splits of the items' centres along the widest axis, four items a leaf) and refitted
+//                 in a substep where regions changed. An item is a triangle with the particles and
+//                 edges it owns (each particle and edge owned by the first triangle holding it), or a
+//                 particle or edge held by no triangle, so a query meets each primitive once. Pairs
+//                 that cannot come within their thickness while the regions hold (their distance,
+//                 less what the regions let them move) are dropped when the pairs are found. The
+//                 loops over particles, primitives, items and pairs are split over the pool's
+//                 threads and their lists appended in part order; the contacts are sorted by their
+//                 particles, so they do not depend on the hierarchy's splits or on history.
 //   narrow phase  a kept pair becomes a contact when its swept bounds in this substep, grown by the
 //                 half thicknesses, overlap and it could come within the thickness during the
 //                 substep: its distance at the start is below thickness + how far its vertices move.

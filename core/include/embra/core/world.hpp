@@ -413,8 +413,8 @@ struct SelfCollisionCache {
   std::vector<Vec3> lo, hi;                   // per particle
   std::vector<int32_t> point_triangle;        // (particle, triangle) pairs
   std::vector<int32_t> edge_edge;             // (edge, edge) pairs
-  size_t triangles = 0, edges = 0;            // the primitive counts they were found for
-  std::shared_ptr<SelfCollisionIndex> index;  // the regions' boxes and grids
+  std::vector<int32_t> triangles, edges;      // the primitives they were found for (world indices)
+  std::shared_ptr<SelfCollisionIndex> index;  // the regions' boxes and their hierarchy
 };
 
 struct Contact {
