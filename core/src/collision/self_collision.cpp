@@ -594,8 +594,8 @@ struct Scratch {
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
-  // One list per thread of the pool: grid query results, candidate pairs, contacts (gather).
-  std::vector<std::vector<int32_t>> part_cand, part_pairs;
+  // One list per thread of the pool: candidate pairs, contacts (gather).
+  std::vector<std::vector<int32_t>> part_pairs;
   std::vector<std::vector<SelfContact>> part_contacts;
   std::vector<std::pair<size_t, size_t>> part_kept;  // keep(): the kept pairs' range of each part
 };
@@ -605,22 +605,15 @@ Scratch& scratch() {
   return s;
 }
 
-/// Calls body(k, list, cand) for every k of [0, n), split over the pool's threads, each part
-/// appending to a list of its own (cand: that part's scratch for grid queries); the lists are then
-/// appended to `out` in part order, which is the order one loop over [0, n) gives.
+/// Calls body(k, list) for every k of [0, n), split over the pool's threads, each part appending
+/// to a list of its own; the lists are then appended to `out` in part order, which is the order one
+/// loop over [0, n) gives.
 template <class T, class F>
-void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>>& parts,
-            std::vector<std::vector<int32_t>>& cands, std::vector<T>& out, F&& body) {
-  const size_t threads = static_cast<size_t>(pool.size());
-  parts.resize(threads);
-  cands.resize(threads);
-  for (std::vector<T>& list : parts) list.clear();
-  pool.run(0, n, 1, grain, [&](size_t begin, size_t end, int part) {
-    std::vector<T>& list = parts[static_cast<size_t>(part)];
-    std::vector<int32_t>& cand = cands[static_cast<size_t>(part)];
-    for (size_t k = begin; k < end; ++k) body(k, list, cand);
+void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>>& parts, std::vector<T>& out,
+            F&& body) {
+  pool.collect(0, n, grain, parts, out, [&](size_t begin, size_t end, std::vector<T>& list) {
+    for (size_t k = begin; k < end; ++k) body(k, list);
   });
-  for (const std::vector<T>& list : parts) out.insert(out.end(), list.begin(), list.end());
 }
 
 // Items per thread below which a detection loop is not split.
@@ -1026,8 +1019,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     // Point against triangle: each particle with a new region against every triangle, then each
     // triangle with a new region against the particles that kept theirs; the candidates are the
     // primitives whose region boxes overlap, found in the hierarchy.
-    gather(*in.pool, s.left.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
-           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
+    gather(*in.pool, s.left.size(), kPairGrain, s.part_pairs, cache.point_triangle,
+           [&](size_t k, std::vector<int32_t>& pairs) {
              const int32_t q = s.left[k];
              const Box& box = ix.point_boxes[q];
              query_hierarchy(ix, box, [&](int32_t item) {
@@ -1037,8 +1030,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
              });
            });
     if (s.left.size() < np)
-      gather(*in.pool, s.changed_tris.size(), kPairGrain, s.part_pairs, s.part_cand, cache.point_triangle,
-             [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
+      gather(*in.pool, s.changed_tris.size(), kPairGrain, s.part_pairs, cache.point_triangle,
+             [&](size_t k, std::vector<int32_t>& pairs) {
                const int32_t t = s.changed_tris[k];
                const Box& box = ix.tri_boxes[t];
                query_hierarchy(ix, box, [&](int32_t item) {
@@ -1050,8 +1043,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                });
              });
     // Edge against edge, each pair once, the lower edge first.
-    gather(*in.pool, s.changed_edges.size(), kPairGrain, s.part_pairs, s.part_cand, cache.edge_edge,
-           [&](size_t k, std::vector<int32_t>& pairs, std::vector<int32_t>&) {
+    gather(*in.pool, s.changed_edges.size(), kPairGrain, s.part_pairs, cache.edge_edge,
+           [&](size_t k, std::vector<int32_t>& pairs) {
              const int32_t ea = s.changed_edges[k];
              const Box& box = ix.edge_boxes[ea];
              query_hierarchy(ix, box, [&](int32_t item) {
@@ -1097,8 +1090,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   each(ne, [&](size_t e) { s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]}); });
 
   // Point against triangle.
-  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
-         [&](size_t pair, std::vector<SelfContact>& found, std::vector<int32_t>&) {
+  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_contacts, out,
+         [&](size_t pair, std::vector<SelfContact>& found) {
            const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
            if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;
            const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
@@ -1134,8 +1127,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const size_t point_triangle_contacts = out.size();
 
   // Edge against edge.
-  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_contacts, s.part_cand, out,
-         [&](size_t pair, std::vector<SelfContact>& found, std::vector<int32_t>&) {
+  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_contacts, out,
+         [&](size_t pair, std::vector<SelfContact>& found) {
            const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
            const size_t eb = static_cast<size_t>(cache.edge_edge[2 * pair + 1]);
            if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;
