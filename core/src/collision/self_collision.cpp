@@ -41,6 +41,15 @@ struct Box {
                              static_cast<int>(lo.z() <= o.hi.z()) & static_cast<int>(o.lo.z() <= hi.z()));
   }
   double extent() const { return (hi - lo).maxCoeff(); }
+  /// The box holding nothing: any box united with it is that box.
+  static Box empty() {
+    return {Vec3::Constant(std::numeric_limits<double>::infinity()),
+            Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  }
+  void unite(const Box& o) {
+    lo = lo.cwiseMin(o.lo);
+    hi = hi.cwiseMax(o.hi);
+  }
 };
 
 /// A spatial hash of boxes: every box is listed in the buckets of the cells it overlaps, buckets
@@ -239,8 +248,7 @@ double mean_extent(std::span<const Box> boxes) {
 }
 
 Box box_of(std::initializer_list<Vec3> points, double grow) {
-  Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
-        Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  Box b = Box::empty();
   for (const Vec3& p : points) {
     b.lo = b.lo.cwiseMin(p);
     b.hi = b.hi.cwiseMax(p);
@@ -763,10 +771,6 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
 /// The hierarchy refitted to the primitives' region boxes: an item's box holds its triangle's (which
 /// holds its vertices' and edges') or those of what it owns, a node's its children's.
 void refit_hierarchy(SelfCollisionIndex& ix, ThreadPool& pool, size_t grain) {
-  const auto unite = [](Box& b, const Box& o) {
-    b.lo = b.lo.cwiseMin(o.lo);
-    b.hi = b.hi.cwiseMax(o.hi);
-  };
   pool.run(0, ix.item_tri.size(), 1, grain, [&](size_t begin, size_t end, int) {
     for (size_t k = begin; k < end; ++k) {
       Box& b = ix.item_box[k];
@@ -774,20 +778,19 @@ void refit_hierarchy(SelfCollisionIndex& ix, ThreadPool& pool, size_t grain) {
         b = ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])];
         continue;
       }
-      b = Box{Vec3::Constant(std::numeric_limits<double>::infinity()),
-              Vec3::Constant(-std::numeric_limits<double>::infinity())};
-      for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j) unite(b, ix.point_boxes[ix.owned_points[j]]);
-      for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) unite(b, ix.edge_boxes[ix.owned_edges[j]]);
+      b = Box::empty();
+      for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j) b.unite(ix.point_boxes[ix.owned_points[j]]);
+      for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) b.unite(ix.edge_boxes[ix.owned_edges[j]]);
     }
   });
   for (size_t k = ix.nodes.size(); k-- > 0;) {
     SelfCollisionIndex::Node& node = ix.nodes[k];
     if (node.count > 0) {
       node.box = ix.item_box[static_cast<size_t>(node.first)];
-      for (int32_t j = node.first + 1; j < node.first + node.count; ++j) unite(node.box, ix.item_box[j]);
+      for (int32_t j = node.first + 1; j < node.first + node.count; ++j) node.box.unite(ix.item_box[j]);
     } else {
       node.box = ix.nodes[k + 1].box;
-      unite(node.box, ix.nodes[static_cast<size_t>(node.right)].box);
+      node.box.unite(ix.nodes[static_cast<size_t>(node.right)].box);
     }
   }
 }
@@ -905,12 +908,10 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       s.changed[i] = 1;
     }
     auto region = [&](std::initializer_list<int32_t> ids) {
-      Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
-            Vec3::Constant(-std::numeric_limits<double>::infinity())};
+      Box b = Box::empty();
       double g = 0.0;
       for (int32_t i : ids) {
-        b.lo = b.lo.cwiseMin(cache.lo[i]);
-        b.hi = b.hi.cwiseMax(cache.hi[i]);
+        b.unite({cache.lo[i], cache.hi[i]});
         g = std::max(g, grow_of(i));
       }
       b.lo.array() -= g;
@@ -1078,10 +1079,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const std::vector<double>& m = s.motion;
   auto swept = [&](std::initializer_list<int32_t> ids) {
     Box b = s.swept_point[*ids.begin()];
-    for (int32_t i : ids) {
-      b.lo = b.lo.cwiseMin(s.swept_point[i].lo);
-      b.hi = b.hi.cwiseMax(s.swept_point[i].hi);
-    }
+    for (int32_t i : ids) b.unite(s.swept_point[i]);
     return b;
   };
   s.swept_tri.resize(nt);
