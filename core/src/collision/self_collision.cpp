@@ -17,6 +17,10 @@ namespace {
 
 /// The smallest separation kept between two primitives whose bodies have no thickness (m).
 constexpr double kMinGap = 1e-6;
+// A pair's gap (a lower bound of its distance less its thickness) skips its exact distance when it
+// exceeds the pair's motion by this much times (1 + the largest coordinate magnitude): far more than
+// the rounding of a distance and of a million shifts subtracted from it.
+constexpr double kGapTolerance = 1e-9;
 
 /// A particle's region, in which the self-collision candidate pairs stay valid: its swept bounds,
 /// stretched ahead along its motion by kRegionAhead times that motion (where it will be in the next
@@ -421,6 +425,8 @@ struct SelfCollisionIndex {
   std::vector<int32_t> point_begin, owned_points;  // per item: the particles it owns (points order)
   std::vector<int32_t> edge_begin, owned_edges;    // per item: the edges it owns
   std::vector<self_collision::Box> item_box;       // per item: its primitives' region boxes
+  std::vector<Vec3> start;                         // the positions at the start of the last substep
+  std::vector<double> radius;                      // the half thicknesses the pairs' gaps were measured with
 };
 
 }  // namespace embra
@@ -602,6 +608,14 @@ struct Scratch {
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
+  std::vector<double> shift;  // per particle: how far x_prev is from the last substep's (inf: unknown)
+  // Per triangle and edge: the largest motion and shift of its vertices.
+  struct Moves {
+    double motion, shift;
+  };
+  std::vector<Moves> tri_moves, edge_moves;
+  std::vector<double> part_scale;  // per part of the pool: the largest coordinate magnitude seen
+  std::vector<int32_t> near;       // the kept pairs whose distance is measured in this substep
   // One list per thread of the pool: candidate pairs, contacts (gather).
   std::vector<std::vector<int32_t>> part_pairs;
   std::vector<std::vector<SelfContact>> part_contacts;
@@ -864,7 +878,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   SelfCollisionIndex& ix = *cache.index;
   const size_t np = s.points.size();
   const bool cached = cache.lo.size() == x1.size() && cache.triangles == s.tris && cache.edges == s.edges &&
-                      ix.point_boxes.size() == np;
+                      ix.point_boxes.size() == np && std::ranges::equal(ix.radius, r);
   auto inside = [&](const Vec3& p, int32_t i) {
     return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
   };
@@ -890,6 +904,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       cache.triangles = s.tris;
       cache.edges = s.edges;
       ix = SelfCollisionIndex{};
+      ix.radius.assign(r.begin(), r.end());
       build_hierarchy(ix, s, x1);
       ix.reach.assign(x1.size(), 0.0);
       ix.tri_boxes.resize(nt);
@@ -954,29 +969,37 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
-    auto keep = [&](std::vector<int32_t>& pairs, auto&& stays) {
+    // (Ranges in pairs, each with its gap.)
+    auto keep = [&](std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& stays) {
       s.part_kept.assign(static_cast<size_t>(in.pool->size()), {0, 0});
-      in.pool->run(0, pairs.size() / 2, 1, kContactGrain, [&](size_t begin, size_t end, int part) {
-        size_t kept = 2 * begin;
-        for (size_t k = 2 * begin; k < 2 * end; k += 2)
-          if (stays(pairs[k], pairs[k + 1])) {
-            pairs[kept++] = pairs[k];
-            pairs[kept++] = pairs[k + 1];
+      in.pool->run(0, gaps.size(), 1, kContactGrain, [&](size_t begin, size_t end, int part) {
+        size_t kept = begin;
+        for (size_t k = begin; k < end; ++k)
+          if (stays(pairs[2 * k], pairs[2 * k + 1])) {
+            pairs[2 * kept] = pairs[2 * k];
+            pairs[2 * kept + 1] = pairs[2 * k + 1];
+            gaps[kept++] = gaps[k];
           }
-        s.part_kept[static_cast<size_t>(part)] = {2 * begin, kept};
+        s.part_kept[static_cast<size_t>(part)] = {begin, kept};
       });
       size_t kept = 0;
       for (const auto& [begin, end] : s.part_kept) {
-        if (kept != begin)  // forward, to an earlier place
-          std::copy(pairs.begin() + static_cast<std::ptrdiff_t>(begin),
-                    pairs.begin() + static_cast<std::ptrdiff_t>(end),
-                    pairs.begin() + static_cast<std::ptrdiff_t>(kept));
+        if (kept != begin) {  // forward, to an earlier place
+          std::copy(pairs.begin() + static_cast<std::ptrdiff_t>(2 * begin),
+                    pairs.begin() + static_cast<std::ptrdiff_t>(2 * end),
+                    pairs.begin() + static_cast<std::ptrdiff_t>(2 * kept));
+          std::copy(gaps.begin() + static_cast<std::ptrdiff_t>(begin), gaps.begin() + static_cast<std::ptrdiff_t>(end),
+                    gaps.begin() + static_cast<std::ptrdiff_t>(kept));
+        }
         kept += end - begin;
       }
-      pairs.resize(kept);
+      pairs.resize(2 * kept);
+      gaps.resize(kept);
     };
-    keep(cache.point_triangle, [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
-    keep(cache.edge_edge, [&](int32_t a, int32_t b) { return !s.edge_changed[a] && !s.edge_changed[b]; });
+    keep(cache.point_triangle, cache.point_triangle_gap,
+         [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
+    keep(cache.edge_edge, cache.edge_edge_gap,
+         [&](int32_t a, int32_t b) { return !s.edge_changed[a] && !s.edge_changed[b]; });
     // A pair is kept when the two can come within their thickness while their particles stay in
     // their regions (see above), and they are not neighbours on the surface at rest.
     auto point_triangle_pair = [&](int32_t p, int32_t t, std::vector<int32_t>& pairs) {
@@ -1060,108 +1083,165 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                }
              });
            });
+    // The new pairs' gaps are measured when they are first met below.
+    constexpr double unknown = -std::numeric_limits<double>::infinity();
+    cache.point_triangle_gap.resize(cache.point_triangle.size() / 2, unknown);
+    cache.edge_edge_gap.resize(cache.edge_edge.size() / 2, unknown);
   }
 
   // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
   // stays more than its thickness apart throughout the substep.
+  // Each particle's shift since the last substep's start lowers its pairs' gaps (a distance moves no
+  // more than the two sides' largest shifts).
   s.swept_point.resize(x1.size());
   s.motion.resize(x1.size());
+  s.shift.resize(x1.size());
+  const bool started = ix.start.size() == x0.size();
+  s.part_scale.assign(static_cast<size_t>(in.pool->size()), 0.0);
+  in.pool->run(0, np, 1, kBoxGrain, [&](size_t begin, size_t end, int part) {
+    double scale = 0.0;
+    for (size_t k = begin; k < end; ++k) {
+      const int32_t i = s.points[k];
+      s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+      s.motion[i] = (x1[i] - x0[i]).norm();
+      s.shift[i] = started ? (x0[i] - ix.start[i]).norm() : std::numeric_limits<double>::infinity();
+      scale = std::max({scale, x0[i].cwiseAbs().maxCoeff(), x1[i].cwiseAbs().maxCoeff()});
+      if (started) scale = std::max(scale, ix.start[i].cwiseAbs().maxCoeff());
+    }
+    s.part_scale[static_cast<size_t>(part)] = scale;
+  });
+  // A gap skips the exact distance only when it clears the motion by more than the rounding of the
+  // distances and shifts it was made of.
+  const double tolerance = kGapTolerance * (1.0 + std::ranges::max(s.part_scale));
+  const std::vector<double>& m = s.motion;
   const auto each = [&](size_t n, auto&& f) {  // independent items, split over the pool's threads
     in.pool->run(0, n, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
       for (size_t k = begin; k < end; ++k) f(k);
     });
   };
-  each(s.points.size(), [&](size_t k) {
-    const int32_t i = s.points[k];
-    s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
-    s.motion[i] = (x1[i] - x0[i]).norm();
-  });
-  const std::vector<double>& m = s.motion;
   auto swept = [&](std::initializer_list<int32_t> ids) {
     Box b = s.swept_point[*ids.begin()];
     for (int32_t i : ids) b.unite(s.swept_point[i]);
     return b;
   };
+  auto moves = [&](std::initializer_list<int32_t> ids) {
+    Scratch::Moves mv{0.0, 0.0};
+    for (int32_t i : ids) mv = {std::max(mv.motion, m[i]), std::max(mv.shift, s.shift[i])};
+    return mv;
+  };
   s.swept_tri.resize(nt);
-  each(nt, [&](size_t t) { s.swept_tri[t] = swept({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]}); });
+  s.tri_moves.resize(nt);
+  each(nt, [&](size_t t) {
+    const int32_t* v = &s.tris[3 * t];
+    s.swept_tri[t] = swept({v[0], v[1], v[2]});
+    s.tri_moves[t] = moves({v[0], v[1], v[2]});
+  });
   s.swept_edge.resize(ne);
-  each(ne, [&](size_t e) { s.swept_edge[e] = swept({s.edges[2 * e], s.edges[2 * e + 1]}); });
+  s.edge_moves.resize(ne);
+  each(ne, [&](size_t e) {
+    const int32_t* v = &s.edges[2 * e];
+    s.swept_edge[e] = swept({v[0], v[1]});
+    s.edge_moves[e] = moves({v[0], v[1]});
+  });
 
-  // Point against triangle.
-  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_contacts, out,
-         [&](size_t pair, std::vector<SelfContact>& found) {
-           const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
-           if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;
-           const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
-           const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
-           double bary[3];
-           const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
-           const double motion = m[p] + std::max({m[v[0]], m[v[1]], m[v[2]]});
-           if (d0 >= thk + motion) return;
-           double toi;
-           const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
-           Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
-           Vec3 primary = side;  // closest points at the start
-           if (point_triangle_toi(x0[p], x1[p], x0[v[0]], x1[v[0]], x0[v[1]], x1[v[1]], x0[v[2]], x1[v[2]], thk, toi)) {
-             point_triangle_distance(lerp(x0[p], x1[p], toi), lerp(x0[v[0]], x1[v[0]], toi),
-                                     lerp(x0[v[1]], x1[v[1]], toi), lerp(x0[v[2]], x1[v[2]], toi), bary);
-             side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
-             primary = tri_n;  // touching within the substep: hold it on the triangle's side it came from
-           }
-           SelfContact c{};
-           c.ids[0] = p;
-           for (int j = 0; j < 3; ++j) c.ids[j + 1] = v[j];
-           c.weight[0] = 1.0;
-           for (int j = 0; j < 3; ++j) c.weight[j + 1] = -bary[j];
-           if (!orient_normal(primary, side, side, c.normal) &&
-               !orient_normal(tri_n, x1[p] - x0[p], x0[p] - x1[p], c.normal))
-             return;
-           c.thickness = thk;
-           c.mu_s = mean_mu(in.mu_s, c.ids);
-           c.mu_k = mean_mu(in.mu_k, c.ids);
-           found.push_back(c);
+  // Point against triangle: the pairs whose gap, lowered by their shifts, does not clear their
+  // motion (the others have d0 >= thk + motion below), then their contacts.
+  s.near.clear();
+  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_pairs, s.near,
+         [&](size_t pair, std::vector<int32_t>& near) {
+           const int32_t p = cache.point_triangle[2 * pair];
+           const Scratch::Moves& tm = s.tri_moves[static_cast<size_t>(cache.point_triangle[2 * pair + 1])];
+           double& gap = cache.point_triangle_gap[pair];
+           gap -= s.shift[p] + tm.shift;
+           if (gap < m[p] + tm.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
          });
+  gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
+    const size_t pair = static_cast<size_t>(s.near[k]);
+    const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
+    const Scratch::Moves& tm = s.tri_moves[static_cast<size_t>(t)];
+    const double motion = m[p] + tm.motion;
+    double& gap = cache.point_triangle_gap[pair];
+    const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+    const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+    double bary[3];
+    const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
+    gap = d0 - thk;
+    if (d0 >= thk + motion) return;
+    if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;
+    double toi;
+    const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
+    Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+    Vec3 primary = side;  // closest points at the start
+    if (point_triangle_toi(x0[p], x1[p], x0[v[0]], x1[v[0]], x0[v[1]], x1[v[1]], x0[v[2]], x1[v[2]], thk, toi)) {
+      point_triangle_distance(lerp(x0[p], x1[p], toi), lerp(x0[v[0]], x1[v[0]], toi), lerp(x0[v[1]], x1[v[1]], toi),
+                              lerp(x0[v[2]], x1[v[2]], toi), bary);
+      side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
+      primary = tri_n;  // touching within the substep: hold it on the triangle's side it came from
+    }
+    SelfContact c{};
+    c.ids[0] = p;
+    for (int j = 0; j < 3; ++j) c.ids[j + 1] = v[j];
+    c.weight[0] = 1.0;
+    for (int j = 0; j < 3; ++j) c.weight[j + 1] = -bary[j];
+    if (!orient_normal(primary, side, side, c.normal) && !orient_normal(tri_n, x1[p] - x0[p], x0[p] - x1[p], c.normal))
+      return;
+    c.thickness = thk;
+    c.mu_s = mean_mu(in.mu_s, c.ids);
+    c.mu_k = mean_mu(in.mu_k, c.ids);
+    found.push_back(c);
+  });
 
   const size_t point_triangle_contacts = out.size();
 
-  // Edge against edge.
-  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_contacts, out,
-         [&](size_t pair, std::vector<SelfContact>& found) {
-           const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
-           const size_t eb = static_cast<size_t>(cache.edge_edge[2 * pair + 1]);
-           if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;
-           const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
-           const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
-           double sa, tb;
-           const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
-           const double motion = std::max(m[a0], m[a1]) + std::max(m[b0], m[b1]);
-           if (d0 >= thk + motion) return;
-           const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
-           Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
-           Vec3 primary = side;
-           double toi;
-           if (edge_edge_toi(x0[a0], x0[a1], x0[b0], x0[b1], x1[a0], x1[a1], x1[b0], x1[b1], thk, toi)) {
-             edge_edge_distance(lerp(x0[a0], x1[a0], toi), lerp(x0[a1], x1[a1], toi), lerp(x0[b0], x1[b0], toi),
-                                lerp(x0[b1], x1[b1], toi), sa, tb);
-             side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
-             primary = cross;
-           }
-           SelfContact c{};
-           c.ids[0] = a0;
-           c.ids[1] = a1;
-           c.ids[2] = b0;
-           c.ids[3] = b1;
-           c.weight[0] = 1.0 - sa;
-           c.weight[1] = sa;
-           c.weight[2] = -(1.0 - tb);
-           c.weight[3] = -tb;
-           if (!orient_normal(primary, side, side, c.normal) && !orient_normal(cross, Vec3::Zero(), side, c.normal))
-             return;
-           c.thickness = thk;
-           c.mu_s = mean_mu(in.mu_s, c.ids);
-           c.mu_k = mean_mu(in.mu_k, c.ids);
-           found.push_back(c);
+  // Edge against edge, the same way.
+  s.near.clear();
+  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_pairs, s.near,
+         [&](size_t pair, std::vector<int32_t>& near) {
+           const Scratch::Moves& ma = s.edge_moves[static_cast<size_t>(cache.edge_edge[2 * pair])];
+           const Scratch::Moves& mb = s.edge_moves[static_cast<size_t>(cache.edge_edge[2 * pair + 1])];
+           double& gap = cache.edge_edge_gap[pair];
+           gap -= ma.shift + mb.shift;
+           if (gap < ma.motion + mb.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
          });
+  gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
+    const size_t pair = static_cast<size_t>(s.near[k]);
+    const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
+    const size_t eb = static_cast<size_t>(cache.edge_edge[2 * pair + 1]);
+    const Scratch::Moves &ma = s.edge_moves[ea], &mb = s.edge_moves[eb];
+    const double motion = ma.motion + mb.motion;
+    double& gap = cache.edge_edge_gap[pair];
+    const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
+    const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+    double sa, tb;
+    const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
+    gap = d0 - thk;
+    if (d0 >= thk + motion) return;
+    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;
+    const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
+    Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+    Vec3 primary = side;
+    double toi;
+    if (edge_edge_toi(x0[a0], x0[a1], x0[b0], x0[b1], x1[a0], x1[a1], x1[b0], x1[b1], thk, toi)) {
+      edge_edge_distance(lerp(x0[a0], x1[a0], toi), lerp(x0[a1], x1[a1], toi), lerp(x0[b0], x1[b0], toi),
+                         lerp(x0[b1], x1[b1], toi), sa, tb);
+      side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
+      primary = cross;
+    }
+    SelfContact c{};
+    c.ids[0] = a0;
+    c.ids[1] = a1;
+    c.ids[2] = b0;
+    c.ids[3] = b1;
+    c.weight[0] = 1.0 - sa;
+    c.weight[1] = sa;
+    c.weight[2] = -(1.0 - tb);
+    c.weight[3] = -tb;
+    if (!orient_normal(primary, side, side, c.normal) && !orient_normal(cross, Vec3::Zero(), side, c.normal)) return;
+    c.thickness = thk;
+    c.mu_s = mean_mu(in.mu_s, c.ids);
+    c.mu_k = mean_mu(in.mu_k, c.ids);
+    found.push_back(c);
+  });
 
   // The contacts in an order that depends on what they join only, never on the history of the kept
   // pairs (kept ones first, then the ones found again): a world saved and loaded back, whose pairs
@@ -1173,6 +1253,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const auto split = out.begin() + static_cast<std::ptrdiff_t>(point_triangle_contacts);
   std::sort(out.begin(), split, by_particles);
   std::sort(split, out.end(), by_particles);
+  ix.start.assign(x0.begin(), x0.end());
 }
 
 // --- resolution ------------------------------------------------------------------------------------

@@ -410,9 +410,12 @@ struct SelfContact {
 /// inside the region [lo, hi] it had when they were found.
 struct SelfCollisionIndex;  // collision/self_collision.cpp
 struct SelfCollisionCache {
-  std::vector<Vec3> lo, hi;                   // per particle
-  std::vector<int32_t> point_triangle;        // (particle, triangle) pairs
-  std::vector<int32_t> edge_edge;             // (edge, edge) pairs
+  std::vector<Vec3> lo, hi;             // per particle
+  std::vector<int32_t> point_triangle;  // (particle, triangle) pairs
+  std::vector<int32_t> edge_edge;       // (edge, edge) pairs
+  // Per pair: a lower bound of its distance less its thickness at the start of the last substep
+  // (-inf until it is measured).
+  std::vector<double> point_triangle_gap, edge_edge_gap;
   std::vector<int32_t> triangles, edges;      // the primitives they were found for (world indices)
   std::shared_ptr<SelfCollisionIndex> index;  // the regions' boxes and their hierarchy
 };
