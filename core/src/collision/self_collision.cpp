@@ -969,7 +969,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
-    // (Ranges in pairs, each with its gap.)
+    // (begin, end: pair indices; a pair is two entries of `pairs` and one of `gaps`.)
     auto keep = [&](std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& stays) {
       s.part_kept.assign(static_cast<size_t>(in.pool->size()), {0, 0});
       in.pool->run(0, gaps.size(), 1, kContactGrain, [&](size_t begin, size_t end, int part) {
@@ -1144,17 +1144,26 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     s.edge_moves[e] = moves({v[0], v[1]});
   });
 
-  // Point against triangle: the pairs whose gap, lowered by their shifts, does not clear their
-  // motion (the others have d0 >= thk + motion below), then their contacts.
-  s.near.clear();
-  gather(*in.pool, cache.point_triangle.size() / 2, kContactGrain, s.part_pairs, s.near,
-         [&](size_t pair, std::vector<int32_t>& near) {
-           const int32_t p = cache.point_triangle[2 * pair];
-           const Scratch::Moves& tm = s.tri_moves[static_cast<size_t>(cache.point_triangle[2 * pair + 1])];
-           double& gap = cache.point_triangle_gap[pair];
-           gap -= s.shift[p] + tm.shift;
-           if (gap < m[p] + tm.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
-         });
+  // s.near: the pairs whose gap, lowered by their two sides' shifts, does not clear their motion
+  // (the others have d0 >= thk + motion below); first(id) and second(id) are a side's moves.
+  auto near_pairs = [&](const std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& first, auto&& second) {
+    s.near.clear();
+    gather(*in.pool, gaps.size(), kContactGrain, s.part_pairs, s.near, [&](size_t pair, std::vector<int32_t>& near) {
+      const Scratch::Moves a = first(pairs[2 * pair]), b = second(pairs[2 * pair + 1]);
+      gaps[pair] -= a.shift + b.shift;
+      if (gaps[pair] < a.motion + b.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
+    });
+  };
+  auto tri_moves = [&](int32_t t) { return s.tri_moves[static_cast<size_t>(t)]; };
+  auto edge_moves = [&](int32_t e) { return s.edge_moves[static_cast<size_t>(e)]; };
+
+  // Point against triangle: the pairs near enough, then their contacts.
+  near_pairs(
+      cache.point_triangle, cache.point_triangle_gap,
+      [&](int32_t p) {
+        return Scratch::Moves{m[p], s.shift[p]};
+      },
+      tri_moves);
   gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
     const size_t pair = static_cast<size_t>(s.near[k]);
     const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
@@ -1194,15 +1203,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const size_t point_triangle_contacts = out.size();
 
   // Edge against edge, the same way.
-  s.near.clear();
-  gather(*in.pool, cache.edge_edge.size() / 2, kContactGrain, s.part_pairs, s.near,
-         [&](size_t pair, std::vector<int32_t>& near) {
-           const Scratch::Moves& ma = s.edge_moves[static_cast<size_t>(cache.edge_edge[2 * pair])];
-           const Scratch::Moves& mb = s.edge_moves[static_cast<size_t>(cache.edge_edge[2 * pair + 1])];
-           double& gap = cache.edge_edge_gap[pair];
-           gap -= ma.shift + mb.shift;
-           if (gap < ma.motion + mb.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
-         });
+  near_pairs(cache.edge_edge, cache.edge_edge_gap, edge_moves, edge_moves);
   gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
     const size_t pair = static_cast<size_t>(s.near[k]);
     const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
