@@ -46,7 +46,7 @@ constexpr int kHalvings = 12;
 /// The floor of D over a row's J W J^T: regularises hard rows without changing their solution.
 constexpr double kRegularisation = 1e-10;
 
-enum class Pass { setup, evaluate, clear, warm, keep };
+enum class Pass { count, setup, evaluate, clear, warm, keep };
 /// A distance shorter than its rest by more than this fraction of it is slack in the global solve (a
 /// cable gone loose, a net drawn in, a wrinkle): its row asks for lambda = 0 and the iterations push
 /// it back. A compressed flat net or sheet is where the implicit step buckles, and Newton's steps from
@@ -78,7 +78,8 @@ void add_block(std::vector<Eigen::Triplet<double>>& out, int32_t ua, int32_t ub,
 /// tethers are left to the iterations: they are there to carry a load Gauss-Seidel has not yet
 /// carried across a cloth, which the global solve does itself, and one-sided rows that switch on and
 /// off from one Newton step to the next keep it from converging (the 32 x 32 net never did).
-/// Pass::setup counts the rows and stores each row's alpha~ and the floor of D. Pass::evaluate, at
+/// Pass::count counts the rows only (GlobalSolve::rows), evaluating nothing. Pass::setup counts them
+/// and stores each row's alpha~ and the floor of D. Pass::evaluate, at
 /// positions x and multipliers lambda + t dl (dl: GlobalSolve::step's row part), adds -grad C lambda
 /// into F1 (GlobalSolve::residual's particle part), writes F2 and, with `matrix`, emits K's
 /// constraint blocks, -J and -D into GlobalSolve::triplets (every row emits the same entries whether
@@ -159,6 +160,10 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
   const auto each_array = [&]<Kind K>(KindTag<K>, SolverArray& arr) {
     constexpr int N = arity(K);
     constexpr bool length = K == Kind::distance || K == Kind::tether;
+    if (pass == Pass::count) {
+      r += static_cast<int64_t>(arr.size());
+      return;
+    }
     for (size_t i = 0; i < arr.size(); ++i) {
       const int32_t* p = &arr.ids[i * N];
       auto e = KindTraits<K>::evaluate(p, x);
@@ -176,6 +181,10 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
       });
     // Welds: x0 - x1 = 0, a row per axis.
     SolverArray& weld = g.solve[static_cast<int>(Kind::weld)];
+    if (pass == Pass::count) {
+      r += 3 * static_cast<int64_t>(weld.size() + g.soft_pins.size());
+      continue;
+    }
     for (size_t i = 0; i < weld.size(); ++i) {
       const int32_t p[2] = {weld.ids[2 * i], weld.ids[2 * i + 1]};
       const Vec3 d = x[p[0]] - x[p[1]];
@@ -238,22 +247,27 @@ void World::global_step(double h) {
   const int64_t blocks = static_cast<int64_t>(gs.particle.size());
   if (blocks == 0) return;
   const double inv_h2 = 1.0 / (h * h);
+  if (settings_.global_solve == kGlobalSolveAuto) {
+    // Contacts are not rows of the solve: where they act it would pull into a collider what the
+    // contact projections push out, substep after substep (the POQ drape at the preset never came to
+    // rest). So the automatic mode leaves worlds with colliders or self-collision to the iterations,
+    // and, decided on the rows' count alone, nothing of the solve is evaluated for them.
+    const bool collides = settings_.self_collision != 0 ||
+                          std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; });
+    if (collides) return;
+  }
+  global_terms(x_, inv_h2, static_cast<int>(Pass::count), 0.0, false, false);
+  const int64_t counted = gs.rows;
+  if (settings_.global_solve == kGlobalSolveAuto && 3 * blocks + counted > kGlobalSolveAutoLimit) return;
   gs.inertial = x_;  // x~: where the particles go with no constraint
   gs.eff.clear();
   global_terms(x_, inv_h2, static_cast<int>(Pass::setup), 0.0, false, false);
+  if (gs.rows != counted) throw Error(ErrorCode::internal, "the global solve's row count disagrees with its rows");
   // Newton starts from the last kept solve's multipliers (0 for rows it did not have): the lengths in
   // tension then give their geometric stiffness from the first step.
   if (static_cast<int64_t>(gs.warm.size()) != gs.rows) gs.warm.assign(static_cast<size_t>(gs.rows), 0.0);
   global_terms(x_, inv_h2, static_cast<int>(Pass::warm), 0.0, false, false);
   const int64_t size = 3 * blocks + gs.rows;
-  if (settings_.global_solve == kGlobalSolveAuto) {
-    // Contacts are not rows of the solve: where they act it would pull into a collider what the
-    // contact projections push out, substep after substep (the POQ drape at the preset never came to
-    // rest). So the automatic mode leaves worlds with colliders or self-collision to the iterations.
-    const bool collides = settings_.self_collision != 0 ||
-                          std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; });
-    if (collides || size > kGlobalSolveAutoLimit) return;
-  }
   gs.step.setZero(size);
   // F at x and lambda + t dl into gs.residual; returns |W F1|^2 + |F2|^2.
   const auto evaluate = [&](const std::vector<Vec3>& x, double t, bool matrix) {
