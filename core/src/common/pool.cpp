@@ -1,5 +1,7 @@
-// ThreadPool (pool.hpp): workers that spin briefly for the next job, then sleep on an atomic.
+// ThreadPool (pool.hpp): threads that spin up to 1 ms for the next job, then sleep on an atomic.
 #include "common/pool.hpp"
+
+#include <chrono>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -9,9 +11,14 @@ namespace embra {
 
 namespace {
 
-/// Spins this long (pause instructions, tens of microseconds) before sleeping: the colours of one
-/// pass follow each other within microseconds, and a sleeping worker takes far longer to wake.
-constexpr int kSpins = 4096;
+/// Spins this long before sleeping: the colours of one pass follow each other within microseconds,
+/// and the serial parts between passes (a substep's contact lists, sorts and merges) take up to a
+/// few hundred microseconds, where a sleeping worker takes tens of microseconds to wake (a futex
+/// call each way). A pool left idle spins this long once, then sleeps.
+constexpr std::chrono::microseconds kSpinTime{1000};
+/// Pauses between looks at the clock; after each round the thread yields, so that on a machine
+/// with fewer cores than threads a spinning worker gives its core to one with work.
+constexpr int kPausesPerRound = 64;
 
 inline void relax() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -24,11 +31,15 @@ inline void relax() {
 /// Waits until `a` holds a value other than `old`; returns it.
 template <class T>
 T wait_change(const std::atomic<T>& a, T old) {
-  for (int i = 0; i < kSpins; ++i) {
-    const T now = a.load(std::memory_order_acquire);
-    if (now != old) return now;
-    relax();
-  }
+  const auto until = std::chrono::steady_clock::now() + kSpinTime;
+  do {
+    for (int i = 0; i < kPausesPerRound; ++i) {
+      const T now = a.load(std::memory_order_acquire);
+      if (now != old) return now;
+      relax();
+    }
+    std::this_thread::yield();
+  } while (std::chrono::steady_clock::now() < until);
   for (;;) {
     a.wait(old, std::memory_order_acquire);
     const T now = a.load(std::memory_order_acquire);

@@ -7,9 +7,10 @@
 // same bits for an item whether it is computed in a block of lanes or alone (lanes.hpp). So the
 // result is the same at any thread count, bit for bit.
 //
-// The caller's thread runs part 0; workers wait for work spinning briefly, then sleeping on an
-// atomic (std::atomic::wait), so an idle pool costs nothing and a busy one hands work over in
-// microseconds. One pool serves one world, one call at a time (the C ABI's one-call-at-a-time rule).
+// The caller's thread runs part 0; a waiting thread spins for up to 1 ms (yielding its core between
+// rounds of pauses), then sleeps on an atomic (std::atomic::wait), so a busy pool hands work over in
+// microseconds and an idle one costs nothing after that millisecond. One pool serves one world, one
+// call at a time (the C ABI's one-call-at-a-time rule).
 #pragma once
 
 #include <algorithm>
