@@ -11,13 +11,15 @@ namespace embra {
 
 namespace {
 
-/// Spins this long before sleeping: the colours of one pass follow each other within microseconds,
+/// Waits this long before sleeping: the colours of one pass follow each other within microseconds,
 /// and the serial parts between passes (a substep's contact lists, sorts and merges) take up to a
 /// few hundred microseconds, where a sleeping worker takes tens of microseconds to wake (a futex
-/// call each way). A pool left idle spins this long once, then sleeps.
+/// call each way). A pool left idle waits this long once, then sleeps.
 constexpr std::chrono::microseconds kSpinTime{1000};
-/// Pauses between looks at the clock; after each round the thread yields, so that on a machine
-/// with fewer cores than threads a spinning worker gives its core to one with work.
+/// Looks at the atomic between pauses only, this many times (tens of microseconds: a colour's
+/// hand-over), then in rounds of kPausesPerRound with a yield after each, so that on a machine with
+/// fewer cores than threads a waiting thread gives its core to one with work.
+constexpr int kPauses = 2048;
 constexpr int kPausesPerRound = 64;
 
 inline void relax() {
@@ -31,6 +33,11 @@ inline void relax() {
 /// Waits until `a` holds a value other than `old`; returns it.
 template <class T>
 T wait_change(const std::atomic<T>& a, T old) {
+  for (int i = 0; i < kPauses; ++i) {
+    const T now = a.load(std::memory_order_acquire);
+    if (now != old) return now;
+    relax();
+  }
   const auto until = std::chrono::steady_clock::now() + kSpinTime;
   do {
     for (int i = 0; i < kPausesPerRound; ++i) {
