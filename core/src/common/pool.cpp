@@ -19,7 +19,7 @@ constexpr std::chrono::microseconds kSpinTime{1000};
 /// Looks at the atomic between pauses only, this many times (tens of microseconds: a colour's
 /// hand-over), then in rounds of kPausesPerRound with a yield after each, so that on a machine with
 /// fewer cores than threads a waiting thread gives its core to one with work.
-constexpr int kPauses = 2048;
+constexpr int kPauses = 4096;
 constexpr int kPausesPerRound = 64;
 
 inline void relax() {
