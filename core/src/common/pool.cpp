@@ -30,26 +30,31 @@ inline void relax() {
 #endif
 }
 
+/// Looks at `a` up to `looks` times, pausing between them; true (the value in `now`) once it differs
+/// from `old`.
+template <class T>
+bool changed(const std::atomic<T>& a, T old, int looks, T& now) {
+  for (int i = 0; i < looks; ++i) {
+    now = a.load(std::memory_order_acquire);
+    if (now != old) return true;
+    relax();
+  }
+  return false;
+}
+
 /// Waits until `a` holds a value other than `old`; returns it.
 template <class T>
 T wait_change(const std::atomic<T>& a, T old) {
-  for (int i = 0; i < kPauses; ++i) {
-    const T now = a.load(std::memory_order_acquire);
-    if (now != old) return now;
-    relax();
-  }
+  T now = old;
+  if (changed(a, old, kPauses, now)) return now;
   const auto until = std::chrono::steady_clock::now() + kSpinTime;
   do {
-    for (int i = 0; i < kPausesPerRound; ++i) {
-      const T now = a.load(std::memory_order_acquire);
-      if (now != old) return now;
-      relax();
-    }
+    if (changed(a, old, kPausesPerRound, now)) return now;
     std::this_thread::yield();
   } while (std::chrono::steady_clock::now() < until);
   for (;;) {
     a.wait(old, std::memory_order_acquire);
-    const T now = a.load(std::memory_order_acquire);
+    now = a.load(std::memory_order_acquire);
     if (now != old) return now;
   }
 }

@@ -234,6 +234,14 @@ void World::global_terms(const std::vector<Vec3>& x, double inv_h2, int pass_num
 }
 
 void World::global_step(double h) {
+  const bool automatic = settings_.global_solve == kGlobalSolveAuto;
+  // Contacts are not rows of the solve: where they act it would pull into a collider what the contact
+  // projections push out, substep after substep (the POQ drape at the preset never came to rest). So
+  // the automatic mode leaves worlds with colliders or self-collision to the iterations; it decides
+  // that, and the system's size from a count of its rows, before anything of the solve is evaluated.
+  if (automatic && (settings_.self_collision != 0 ||
+                    std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; })))
+    return;
   if (!global_) global_ = std::make_unique<GlobalSolve>();
   GlobalSolve& gs = *global_;
   const size_t n = x_.size();
@@ -247,18 +255,9 @@ void World::global_step(double h) {
   const int64_t blocks = static_cast<int64_t>(gs.particle.size());
   if (blocks == 0) return;
   const double inv_h2 = 1.0 / (h * h);
-  if (settings_.global_solve == kGlobalSolveAuto) {
-    // Contacts are not rows of the solve: where they act it would pull into a collider what the
-    // contact projections push out, substep after substep (the POQ drape at the preset never came to
-    // rest). So the automatic mode leaves worlds with colliders or self-collision to the iterations,
-    // and, decided on the rows' count alone, nothing of the solve is evaluated for them.
-    const bool collides = settings_.self_collision != 0 ||
-                          std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) { return c.alive; });
-    if (collides) return;
-  }
   global_terms(x_, inv_h2, static_cast<int>(Pass::count), 0.0, false, false);
   const int64_t counted = gs.rows;
-  if (settings_.global_solve == kGlobalSolveAuto && 3 * blocks + counted > kGlobalSolveAutoLimit) return;
+  if (automatic && 3 * blocks + counted > kGlobalSolveAutoLimit) return;
   gs.inertial = x_;  // x~: where the particles go with no constraint
   gs.eff.clear();
   global_terms(x_, inv_h2, static_cast<int>(Pass::setup), 0.0, false, false);
