@@ -11,6 +11,10 @@
 #include <limits>
 #include <numeric>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace embra::self_collision {
 
 namespace {
@@ -36,14 +40,21 @@ constexpr double kRegionAhead = 8.0;
 constexpr double kRegionThickness = 0.25;
 /// Items per leaf of the broad phase's hierarchy.
 constexpr int32_t kLeafItems = 4;
+/// Consecutive items (in leaf order) whose changed primitives share one walk of the hierarchy.
+constexpr size_t kQueryGroup = 8;
+
+/// Whether boxes a and b (lo and hi indexed 0-2) overlap: all six compared, one branch for the
+/// caller, seldom mispredicted.
+template <class B>
+bool overlap(const B& a, const B& b) {
+  return static_cast<bool>(static_cast<int>(a.lo[0] <= b.hi[0]) & static_cast<int>(b.lo[0] <= a.hi[0]) &
+                           static_cast<int>(a.lo[1] <= b.hi[1]) & static_cast<int>(b.lo[1] <= a.hi[1]) &
+                           static_cast<int>(a.lo[2] <= b.hi[2]) & static_cast<int>(b.lo[2] <= a.hi[2]));
+}
 
 struct Box {
   Vec3 lo, hi;
-  bool overlaps(const Box& o) const {  // all six compared, one branch for the caller: seldom mispredicted
-    return static_cast<bool>(static_cast<int>(lo.x() <= o.hi.x()) & static_cast<int>(o.lo.x() <= hi.x()) &
-                             static_cast<int>(lo.y() <= o.hi.y()) & static_cast<int>(o.lo.y() <= hi.y()) &
-                             static_cast<int>(lo.z() <= o.hi.z()) & static_cast<int>(o.lo.z() <= hi.z()));
-  }
+  bool overlaps(const Box& o) const { return overlap(*this, o); }
   double extent() const { return (hi - lo).maxCoeff(); }
   /// The box holding nothing: any box united with it is that box.
   static Box empty() {
@@ -54,6 +65,83 @@ struct Box {
     lo = lo.cwiseMin(o.lo);
     hi = hi.cwiseMax(o.hi);
   }
+};
+
+/// v as a float rounded toward `dir` (-1 down, 1 up); NaN stays NaN.
+float to_float(double v, float dir) {
+  constexpr float big = std::numeric_limits<float>::max(), inf = std::numeric_limits<float>::infinity();
+  if (std::isnan(v)) return std::numeric_limits<float>::quiet_NaN();
+  if (v > big) return dir < 0.0f ? big : inf;
+  if (v < -big) return dir < 0.0f ? -inf : -big;
+  const float f = static_cast<float>(v);
+  if (dir < 0.0f ? !(static_cast<double>(f) > v) : !(static_cast<double>(f) < v)) return f;
+  // one step toward dir: the next float's bits (f is finite here)
+  if (f == 0.0f) return dir * std::numeric_limits<float>::denorm_min();
+  const uint32_t bits = std::bit_cast<uint32_t>(f);
+  return std::bit_cast<float>((f > 0.0f) == (dir > 0.0f) ? bits + 1 : bits - 1);
+}
+/// A box's bounds rounded outward to floats: a filter for Box::overlaps that half the bytes feed
+/// (what overlaps as Box overlaps as FloatBox).
+struct FloatBox {
+  float lo[3], hi[3];
+  static FloatBox outward(const Box& b) {
+    return {{to_float(b.lo.x(), -1.0f), to_float(b.lo.y(), -1.0f), to_float(b.lo.z(), -1.0f)},
+            {to_float(b.hi.x(), 1.0f), to_float(b.hi.y(), 1.0f), to_float(b.hi.z(), 1.0f)}};
+  }
+  static FloatBox empty() {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    return {{inf, inf, inf}, {-inf, -inf, -inf}};
+  }
+  bool overlaps(const FloatBox& o) const { return overlap(*this, o); }
+  void unite(const FloatBox& o) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], o.lo[a]);
+      hi[a] = std::max(hi[a], o.hi[a]);
+    }
+  }
+};
+
+/// Up to N boxes as FloatBoxes side by side, so that a box is tested against all of them in a few
+/// vector instructions.
+template <size_t N>
+class FloatBoxes {
+ public:
+  static_assert(N % 4 == 0 && N <= 32);
+  void add(const Box& b) {
+    const FloatBox f = FloatBox::outward(b);
+    for (int a = 0; a < 3; ++a) {
+      lo_[a][size_] = f.lo[a];
+      hi_[a][size_] = f.hi[a];
+    }
+    ++size_;
+  }
+  size_t size() const { return size_; }
+  /// Bit c set where box c may overlap q: set for every box that overlaps it.
+  uint32_t may_overlap(const FloatBox& q) const {
+    uint32_t mask = 0;
+#if defined(__SSE2__)
+    const __m128 qlx = _mm_set1_ps(q.lo[0]), qly = _mm_set1_ps(q.lo[1]), qlz = _mm_set1_ps(q.lo[2]);
+    const __m128 qhx = _mm_set1_ps(q.hi[0]), qhy = _mm_set1_ps(q.hi[1]), qhz = _mm_set1_ps(q.hi[2]);
+    for (size_t c = 0; c < size_; c += 4) {
+      __m128 hit = _mm_and_ps(_mm_cmple_ps(_mm_load_ps(&lo_[0][c]), qhx), _mm_cmple_ps(qlx, _mm_load_ps(&hi_[0][c])));
+      hit = _mm_and_ps(
+          hit, _mm_and_ps(_mm_cmple_ps(_mm_load_ps(&lo_[1][c]), qhy), _mm_cmple_ps(qly, _mm_load_ps(&hi_[1][c]))));
+      hit = _mm_and_ps(
+          hit, _mm_and_ps(_mm_cmple_ps(_mm_load_ps(&lo_[2][c]), qhz), _mm_cmple_ps(qlz, _mm_load_ps(&hi_[2][c]))));
+      mask |= static_cast<uint32_t>(_mm_movemask_ps(hit)) << c;
+    }
+#else
+    for (size_t c = 0; c < size_; ++c) {
+      const FloatBox b{{lo_[0][c], lo_[1][c], lo_[2][c]}, {hi_[0][c], hi_[1][c], hi_[2][c]}};
+      mask |= static_cast<uint32_t>(b.overlaps(q)) << c;
+    }
+#endif
+    return size_ == 32 ? mask : mask & ((1u << size_) - 1u);
+  }
+
+ private:
+  alignas(16) float lo_[3][N]{}, hi_[3][N]{};
+  size_t size_ = 0;
 };
 
 /// A spatial hash of boxes: every box is listed in the buckets of the cells it overlaps, buckets
@@ -123,8 +211,8 @@ class Grid {
       const int32_t first = start_[bucket], last = start_[bucket + 1];
       for (int32_t e = first; e < last; ++e) {
         const Entry& f = box_entry_[items_[e]];
-        if (!f.overlaps(qf)) continue;  // the float boxes hold the double ones: nothing overlapping is missed
-        if (f.low[0] != kFar) {         // the low cell, when it fits in 32 bits
+        if (!f.box.overlaps(qf.box)) continue;  // the float boxes hold the double ones: nothing overlapping is missed
+        if (f.low[0] != kFar) {                 // the low cell, when it fits in 32 bits
           if (std::max<int64_t>(f.low[0], ql[0]) != i || std::max<int64_t>(f.low[1], ql[1]) != j ||
               std::max<int64_t>(f.low[2], ql[2]) != k)
             continue;
@@ -199,21 +287,15 @@ class Grid {
   /// A box in a bucket: its bounds rounded outward to floats (a bucket's scan reads half the bytes),
   /// its lowest cell and its index.
   struct Entry {
-    float lo[3], hi[3];
+    FloatBox box;
     int32_t low[3];  // the box's lowest cell, or kFar in low[0] when a coordinate does not fit
     int32_t index;
-    bool overlaps(const Entry& o) const {
-      return static_cast<bool>(static_cast<int>(lo[0] <= o.hi[0]) & static_cast<int>(o.lo[0] <= hi[0]) &
-                               static_cast<int>(lo[1] <= o.hi[1]) & static_cast<int>(o.lo[1] <= hi[1]) &
-                               static_cast<int>(lo[2] <= o.hi[2]) & static_cast<int>(o.lo[2] <= hi[2]));
-    }
   };
   Entry entry_of(const Box& b, const Span& s, int32_t index) const {
     Entry e{};
+    e.box = FloatBox::outward(b);
     bool fits = true;
     for (int a = 0; a < 3; ++a) {
-      e.lo[a] = to_float(b.lo[a], -1.0f);
-      e.hi[a] = to_float(b.hi[a], 1.0f);
       const int64_t c = s.lo[a];
       fits = fits && c > kFar && c <= std::numeric_limits<int32_t>::max();
       e.low[a] = fits ? static_cast<int32_t>(c) : kFar;
@@ -221,19 +303,6 @@ class Grid {
     if (!fits) e.low[0] = kFar;
     e.index = index;
     return e;
-  }
-  /// v as a float rounded toward `dir` (-1 down, 1 up); NaN stays NaN.
-  static float to_float(double v, float dir) {
-    constexpr float big = std::numeric_limits<float>::max(), inf = std::numeric_limits<float>::infinity();
-    if (std::isnan(v)) return std::numeric_limits<float>::quiet_NaN();
-    if (v > big) return dir < 0.0f ? big : inf;
-    if (v < -big) return dir < 0.0f ? -inf : -big;
-    const float f = static_cast<float>(v);
-    if (dir < 0.0f ? !(static_cast<double>(f) > v) : !(static_cast<double>(f) < v)) return f;
-    // one step toward dir: the next float's bits (f is finite here)
-    if (f == 0.0f) return dir * std::numeric_limits<float>::denorm_min();
-    const uint32_t bits = std::bit_cast<uint32_t>(f);
-    return std::bit_cast<float>((f > 0.0f) == (dir > 0.0f) ? bits + 1 : bits - 1);
   }
   std::vector<int32_t> start_, big_;
   std::vector<int32_t> items_;  // the boxes of each bucket
@@ -416,7 +485,7 @@ struct SelfCollisionIndex {
   std::vector<self_collision::Box> tri_boxes, edge_boxes, point_boxes;  // point_boxes in points order
   std::vector<double> reach;                                            // per particle: its region's diagonal
   struct Node {
-    self_collision::Box box;
+    self_collision::FloatBox box;
     int32_t first = 0, count = 0;  // a leaf's items [first, first + count); count 0: internal
     int32_t right = 0;             // internal: the right child (the left is the next node)
   };
@@ -424,7 +493,7 @@ struct SelfCollisionIndex {
   std::vector<int32_t> item_tri;                   // per item: its triangle, or -1
   std::vector<int32_t> point_begin, owned_points;  // per item: the particles it owns (points order)
   std::vector<int32_t> edge_begin, owned_edges;    // per item: the edges it owns
-  std::vector<self_collision::Box> item_box;       // per item: its primitives' region boxes
+  std::vector<self_collision::FloatBox> item_box;  // per item: its primitives' region boxes
   std::vector<Vec3> start;                         // the positions at the start of the last substep
   std::vector<double> radius;                      // the half thicknesses the pairs' gaps were measured with
 };
@@ -604,8 +673,11 @@ struct Scratch {
   std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
   std::vector<int32_t> tri_body, edge_body;
   // The particles that left their regions (points order) and the primitives holding them.
-  std::vector<int32_t> left, changed_tris, changed_edges;
+  std::vector<int32_t> left;
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
+  std::vector<uint8_t> item_changed;                    // per item: holds a changed primitive
+  std::vector<uint8_t> group_changed;                   // per group of kQueryGroup items: holds a changed primitive
+  std::vector<int32_t> groups;                          // the groups that do
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
   std::vector<double> shift;  // per particle: how far x_prev is from the last substep's (inf: unknown)
@@ -641,7 +713,7 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
 // Items per thread below which a detection loop is not split. A query of the hierarchy costs
 // microseconds, so a few tens of them are worth a hand-over; the folded 64 x 64 cloth queries about
 // 140 points and 630 triangles a substep, and boxes 4,096 particles and 7,938 triangles.
-constexpr size_t kPairGrain = 16;      // primitives queried against the hierarchy
+constexpr size_t kPairGrain = 4;       // groups of items queried against the hierarchy
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
 constexpr size_t kBoxGrain = 1024;     // particles or primitives boxed
 
@@ -784,19 +856,22 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
   ix.item_box.resize(items);
 }
 
-/// The hierarchy refitted to the primitives' region boxes: an item's box holds its triangle's (which
-/// holds its vertices' and edges') or those of what it owns, a node's its children's.
-void refit_hierarchy(SelfCollisionIndex& ix, ThreadPool& pool, size_t grain) {
+/// The hierarchy refitted to the primitives' region boxes: a changed item's box holds its triangle's
+/// (which holds its vertices' and edges') or those of what it owns, a node's its children's.
+void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_changed, ThreadPool& pool, size_t grain) {
   pool.run(0, ix.item_tri.size(), 1, grain, [&](size_t begin, size_t end, int) {
     for (size_t k = begin; k < end; ++k) {
-      Box& b = ix.item_box[k];
+      if (!item_changed[k]) continue;
+      FloatBox& b = ix.item_box[k];
       if (ix.item_tri[k] >= 0) {
-        b = ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])];
+        b = FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]);
         continue;
       }
-      b = Box::empty();
-      for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j) b.unite(ix.point_boxes[ix.owned_points[j]]);
-      for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) b.unite(ix.edge_boxes[ix.owned_edges[j]]);
+      b = FloatBox::empty();
+      for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
+        b.unite(FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
+      for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j)
+        b.unite(FloatBox::outward(ix.edge_boxes[ix.owned_edges[j]]));
     }
   });
   for (size_t k = ix.nodes.size(); k-- > 0;) {
@@ -816,7 +891,7 @@ void refit_hierarchy(SelfCollisionIndex& ix, ThreadPool& pool, size_t grain) {
 /// threads' caches): the median splits halve every node, so the hierarchy is at most 31 deep below
 /// its root and the walk holds at most one pending right child a level.
 template <class F>
-void query_hierarchy(const SelfCollisionIndex& ix, const Box& q, F&& visit) {
+void query_hierarchy(const SelfCollisionIndex& ix, const FloatBox& q, F&& visit) {
   std::array<int32_t, 64> stack;
   size_t top = 0;
   stack[top++] = 0;
@@ -941,8 +1016,6 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       return d;
     };
     // The primitives holding them: new boxes.
-    s.changed_tris.clear();
-    s.changed_edges.clear();
     s.tri_changed.assign(nt, 0);
     s.edge_changed.assign(ne, 0);
     // (boxes and marks split over the threads, then the lists in index order)
@@ -962,12 +1035,24 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
         s.edge_changed[e] = 1;
       }
     });
-    for (size_t t = 0; t < nt; ++t)
-      if (s.tri_changed[t]) s.changed_tris.push_back(static_cast<int32_t>(t));
-    for (size_t e = 0; e < ne; ++e)
-      if (s.edge_changed[e]) s.changed_edges.push_back(static_cast<int32_t>(e));
     for (int32_t k : s.left) ix.point_boxes[k] = region({s.points[k]});
-    refit_hierarchy(ix, *in.pool, kBoxGrain);
+    // The items holding a changed primitive, and the groups of kQueryGroup items that hold one.
+    const size_t items = ix.item_tri.size();
+    s.item_changed.resize(items);
+    s.group_changed.assign((items + kQueryGroup - 1) / kQueryGroup, 0);
+    in.pool->run(0, s.group_changed.size(), 1, kBoxGrain / kQueryGroup, [&](size_t begin, size_t end, int) {
+      for (size_t g = begin; g < end; ++g)
+        for (size_t k = g * kQueryGroup; k < std::min(items, (g + 1) * kQueryGroup); ++k) {
+          const int32_t t = ix.item_tri[k];
+          uint8_t any = t >= 0 && s.tri_changed[static_cast<size_t>(t)];
+          for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
+            any |= s.changed[s.points[ix.owned_points[j]]];
+          for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) any |= s.edge_changed[ix.owned_edges[j]];
+          s.item_changed[k] = any;
+          s.group_changed[g] |= any;
+        }
+    });
+    refit_hierarchy(ix, s.item_changed, *in.pool, kBoxGrain);
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
@@ -1042,46 +1127,96 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       }
       pairs.insert(pairs.end(), {ea, eb});
     };
+    // The queries, a group of kQueryGroup consecutive items (neighbours in the hierarchy's leaf
+    // order) at a time: the hierarchy is walked once with the union of the boxes of the group's
+    // changed primitives, and each item met is tested against each of them, its box first. A pair
+    // is the same box overlap test as in one walk a primitive, so the same pairs are found; only
+    // their order in the lists differs (the contacts are sorted).
     // Point against triangle: each particle with a new region against every triangle, then each
-    // triangle with a new region against the particles that kept theirs; the candidates are the
-    // primitives whose region boxes overlap, found in the hierarchy.
-    gather(*in.pool, s.left.size(), kPairGrain, s.part_pairs, cache.point_triangle,
+    // triangle with a new region against the particles that kept theirs.
+    // Edge against edge, each pair once, the lower edge first.
+    const bool kept_some = s.left.size() < np;
+    s.groups.clear();
+    for (size_t g = 0; g < s.group_changed.size(); ++g)
+      if (s.group_changed[g]) s.groups.push_back(static_cast<int32_t>(g));
+    // A group's items: [first, last).
+    auto group_items = [&](size_t k) {
+      const size_t first = static_cast<size_t>(s.groups[k]) * kQueryGroup;
+      return std::pair{first, std::min(items, first + kQueryGroup)};
+    };
+    gather(*in.pool, s.groups.size(), kPairGrain, s.part_pairs, cache.point_triangle,
            [&](size_t k, std::vector<int32_t>& pairs) {
-             const int32_t q = s.left[k];
-             const Box& box = ix.point_boxes[q];
-             query_hierarchy(ix, box, [&](int32_t item) {
+             std::array<int32_t, 3 * kQueryGroup> left;  // points order
+             std::array<int32_t, kQueryGroup> tris;
+             FloatBoxes<3 * kQueryGroup> left_boxes;
+             FloatBoxes<kQueryGroup> tri_boxes;
+             Box q = Box::empty();
+             const auto [first, last] = group_items(k);
+             for (size_t item = first; item < last; ++item) {
+               for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                 const int32_t p = ix.owned_points[j];
+                 if (!s.changed[s.points[p]]) continue;
+                 left[left_boxes.size()] = p;
+                 left_boxes.add(ix.point_boxes[p]);
+                 q.unite(ix.point_boxes[p]);
+               }
+               const int32_t t = ix.item_tri[item];
+               if (kept_some && t >= 0 && s.tri_changed[static_cast<size_t>(t)]) {
+                 tris[tri_boxes.size()] = t;
+                 tri_boxes.add(ix.tri_boxes[static_cast<size_t>(t)]);
+                 q.unite(ix.tri_boxes[static_cast<size_t>(t)]);
+               }
+             }
+             if (left_boxes.size() + tri_boxes.size() == 0) return;
+             query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
+               const FloatBox& item_box = ix.item_box[static_cast<size_t>(item)];
                const int32_t t = ix.item_tri[static_cast<size_t>(item)];
-               if (t >= 0 && ix.tri_boxes[static_cast<size_t>(t)].overlaps(box))
-                 point_triangle_pair(s.points[q], t, pairs);
+               if (t >= 0)
+                 for (uint32_t hits = left_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
+                   const int32_t p = left[static_cast<size_t>(std::countr_zero(hits))];
+                   if (ix.tri_boxes[static_cast<size_t>(t)].overlaps(ix.point_boxes[p]))
+                     point_triangle_pair(s.points[p], t, pairs);
+                 }
+               for (uint32_t hits = tri_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
+                 const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
+                 const Box& box = ix.tri_boxes[static_cast<size_t>(tc)];
+                 for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                   const int32_t p = ix.owned_points[j];
+                   if (!s.changed[s.points[p]] && ix.point_boxes[p].overlaps(box))
+                     point_triangle_pair(s.points[p], tc, pairs);
+                 }
+               }
              });
            });
-    if (s.left.size() < np)
-      gather(*in.pool, s.changed_tris.size(), kPairGrain, s.part_pairs, cache.point_triangle,
-             [&](size_t k, std::vector<int32_t>& pairs) {
-               const int32_t t = s.changed_tris[k];
-               const Box& box = ix.tri_boxes[t];
-               query_hierarchy(ix, box, [&](int32_t item) {
-                 for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
-                   const int32_t q = ix.owned_points[j];
-                   if (!s.changed[s.points[q]] && ix.point_boxes[q].overlaps(box))
-                     point_triangle_pair(s.points[q], t, pairs);
-                 }
-               });
-             });
-    // Edge against edge, each pair once, the lower edge first.
-    gather(*in.pool, s.changed_edges.size(), kPairGrain, s.part_pairs, cache.edge_edge,
+    gather(*in.pool, s.groups.size(), kPairGrain, s.part_pairs, cache.edge_edge,
            [&](size_t k, std::vector<int32_t>& pairs) {
-             const int32_t ea = s.changed_edges[k];
-             const Box& box = ix.edge_boxes[ea];
-             query_hierarchy(ix, box, [&](int32_t item) {
+             std::array<int32_t, 3 * kQueryGroup> changed;
+             FloatBoxes<3 * kQueryGroup> boxes;
+             Box q = Box::empty();
+             const auto [first, last] = group_items(k);
+             for (size_t item = first; item < last; ++item)
                for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
-                 const int32_t eb = ix.owned_edges[j];
-                 if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
-                 if (!ix.edge_boxes[eb].overlaps(box)) continue;
-                 if (ea < eb)
-                   edge_edge_pair(ea, eb, pairs);
-                 else
-                   edge_edge_pair(eb, ea, pairs);
+                 const int32_t e = ix.owned_edges[j];
+                 if (!s.edge_changed[e]) continue;
+                 changed[boxes.size()] = e;
+                 boxes.add(ix.edge_boxes[e]);
+                 q.unite(ix.edge_boxes[e]);
+               }
+             if (boxes.size() == 0) return;
+             query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
+               for (uint32_t hits = boxes.may_overlap(ix.item_box[static_cast<size_t>(item)]); hits != 0;
+                    hits &= hits - 1) {
+                 const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
+                 const Box& box = ix.edge_boxes[ea];
+                 for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
+                   const int32_t eb = ix.owned_edges[j];
+                   if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
+                   if (!ix.edge_boxes[eb].overlaps(box)) continue;
+                   if (ea < eb)
+                     edge_edge_pair(ea, eb, pairs);
+                   else
+                     edge_edge_pair(eb, ea, pairs);
+                 }
                }
              });
            });

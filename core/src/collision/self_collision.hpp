@@ -8,11 +8,13 @@
 //                 inside their regions. A particle that leaves its region gets a new one, and only
 //                 the pairs of the primitives holding it are dropped and found again (each such
 //                 primitive queried against the others). The queries walk a bounding-volume
-//                 hierarchy over the primitives' region boxes, built once for their topology (median
-//                 splits of the items' centres along the widest axis, four items a leaf) and refitted
-//                 in a substep where regions changed. An item is a triangle with the particles and
-//                 edges it owns (each particle and edge owned by the first triangle holding it), or a
-//                 particle or edge held by no triangle, so a query meets each primitive once. Pairs
+//                 hierarchy over the primitives' region boxes (rounded outward to floats), built once
+//                 for their topology (median splits of the items' centres along the widest axis, four
+//                 items a leaf) and refitted where regions changed; eight neighbouring items' changed
+//                 primitives share a walk, made with their united box, each item met then tested
+//                 against each of them. An item is a triangle with the particles and edges it owns
+//                 (each particle and edge owned by the first triangle holding it), or a particle or
+//                 edge held by no triangle, so a query meets each primitive once. Pairs
 //                 that cannot come within their thickness while the regions hold (their distance,
 //                 less what the regions let them move) are dropped when the pairs are found. The
 //                 loops over particles, primitives, items and pairs are split over the pool's
