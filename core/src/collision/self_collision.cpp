@@ -672,12 +672,10 @@ namespace {
 struct Scratch {
   std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
   std::vector<int32_t> tri_body, edge_body;
-  // The particles that left their regions (points order) and the primitives holding them.
-  std::vector<int32_t> left;
+  std::vector<int32_t> left;  // the particles that left their regions (points order)
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<uint8_t> item_changed;                    // per item: holds a changed primitive
-  std::vector<uint8_t> group_changed;                   // per group of kQueryGroup items: holds a changed primitive
-  std::vector<int32_t> groups;                          // the groups that do
+  std::vector<int32_t> groups;                          // the groups of kQueryGroup items holding a changed item
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
   std::vector<double> shift;  // per particle: how far x_prev is from the last substep's (inf: unknown)
@@ -710,9 +708,10 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
   });
 }
 
-// Items per thread below which a detection loop is not split. A query of the hierarchy costs
-// microseconds, so a few tens of them are worth a hand-over; the folded 64 x 64 cloth queries about
-// 140 points and 630 triangles a substep, and boxes 4,096 particles and 7,938 triangles.
+// Items per thread below which a detection loop is not split. A group's walk of the hierarchy
+// costs tens of microseconds, so a few of them are worth a hand-over; the folded 64 x 64 cloth
+// queries again about 200 points, 900 triangles and 1,000 edges a substep, and boxes 4,096
+// particles and 7,938 triangles.
 constexpr size_t kPairGrain = 4;       // groups of items queried against the hierarchy
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
 constexpr size_t kBoxGrain = 1024;     // particles or primitives boxed
@@ -1036,21 +1035,18 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       }
     });
     for (int32_t k : s.left) ix.point_boxes[k] = region({s.points[k]});
-    // The items holding a changed primitive, and the groups of kQueryGroup items that hold one.
+    // The items holding a changed primitive.
     const size_t items = ix.item_tri.size();
     s.item_changed.resize(items);
-    s.group_changed.assign((items + kQueryGroup - 1) / kQueryGroup, 0);
-    in.pool->run(0, s.group_changed.size(), 1, kBoxGrain / kQueryGroup, [&](size_t begin, size_t end, int) {
-      for (size_t g = begin; g < end; ++g)
-        for (size_t k = g * kQueryGroup; k < std::min(items, (g + 1) * kQueryGroup); ++k) {
-          const int32_t t = ix.item_tri[k];
-          uint8_t any = t >= 0 && s.tri_changed[static_cast<size_t>(t)];
-          for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
-            any |= s.changed[s.points[ix.owned_points[j]]];
-          for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) any |= s.edge_changed[ix.owned_edges[j]];
-          s.item_changed[k] = any;
-          s.group_changed[g] |= any;
-        }
+    in.pool->run(0, items, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t k = begin; k < end; ++k) {
+        const int32_t t = ix.item_tri[k];
+        uint8_t any = t >= 0 && s.tri_changed[static_cast<size_t>(t)];
+        for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
+          any |= s.changed[s.points[ix.owned_points[j]]];
+        for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) any |= s.edge_changed[ix.owned_edges[j]];
+        s.item_changed[k] = any;
+      }
     });
     refit_hierarchy(ix, s.item_changed, *in.pool, kBoxGrain);
     // The kept pairs: neither side holds a particle with a new region.
@@ -1137,8 +1133,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     // Edge against edge, each pair once, the lower edge first.
     const bool kept_some = s.left.size() < np;
     s.groups.clear();
-    for (size_t g = 0; g < s.group_changed.size(); ++g)
-      if (s.group_changed[g]) s.groups.push_back(static_cast<int32_t>(g));
+    for (size_t k = 0; k < items; ++k)
+      if (s.item_changed[k] && (s.groups.empty() || static_cast<size_t>(s.groups.back()) != k / kQueryGroup))
+        s.groups.push_back(static_cast<int32_t>(k / kQueryGroup));
     // A group's items: [first, last).
     auto group_items = [&](size_t k) {
       const size_t first = static_cast<size_t>(s.groups[k]) * kQueryGroup;
