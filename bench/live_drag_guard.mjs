@@ -10,7 +10,7 @@
 //     (default host_adapters/node/live/session.js, 30,10,3,1, 1.5 m, 120 frames)
 //
 // SESSION.js may be another checkout's session.js (the drag before the guard, for comparison).
-// Needs host_adapters/node's packages and EMBRA_LIBRARY (or libembra.so.1 on the loader's path).
+// Needs host_adapters/node's packages and EMBRA_LIBRARY (or libembra.so.2 on the loader's path).
 
 import fs from 'node:fs';
 import os from 'node:os';

@@ -5,7 +5,7 @@
 //   node bench/live_fps.mjs [SCENE.json] [SECONDS]     (default examples/large/poq_drape_32.json, 20)
 //
 // Needs the page built (cd host_adapters/web && npm run build), host_adapters/node's packages and
-// EMBRA_LIBRARY (or libembra.so.1 on the loader's path).
+// EMBRA_LIBRARY (or libembra.so.2 on the loader's path).
 
 import fs from 'node:fs';
 import os from 'node:os';

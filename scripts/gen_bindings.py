@@ -42,6 +42,7 @@ PINS_OUT = os.path.join("capi", "src", "enum_pins_generated.hpp")
 SCHEMA_ENUMS: List[Tuple[Tuple[str, ...], str]] = [
     (("definitions", "body", "properties", "generate", "items", "enum"), "GENERATE"),
     (("definitions", "panel_mesh", "then", "properties", "pins", "enum"), "PANEL_PINS"),
+    (("definitions", "panel_corners", "enum"), "PANEL_CORNERS"),
     (("definitions", "constraint_batch", "properties", "kind", "enum"), "CONSTRAINT"),
     (("definitions", "collider", "properties", "shape", "enum"), "COLLIDER"),
     (("definitions", "pin", "properties", "support", "enum"), "PIN_SUPPORT"),
@@ -55,6 +56,7 @@ CORE_ENUMS: Dict[str, Tuple[str, Optional[str]]] = {
     "CONSTRAINT": ("embra::Kind", "embra::kKindCount"),
     "COLLIDER": ("embra::ColliderShape", "embra::kColliderShapeCount"),
     "PANEL_PINS": ("embra::PanelPins", None),
+    "PANEL_CORNERS": ("embra::PanelCorners", None),
     "PIN_SUPPORT": ("embra::PinSupport", "embra::kPinSupportCount"),
     "AREA_LOAD": ("embra::AreaLoadMode", "embra::kAreaLoadModeCount"),
     "PANEL_METRIC": ("embra::PanelMetric", "embra::kPanelMetricCount"),

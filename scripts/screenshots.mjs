@@ -2,7 +2,7 @@
 // tests/web/replay.test.mjs run by hand): each scene served by embra-live, opened in headless
 // Chromium, shot once the scene reached the given frame.
 //
-//   node scripts/screenshots.mjs        (needs the page built, and EMBRA_LIBRARY or libembra.so.1)
+//   node scripts/screenshots.mjs        (needs the page built, and EMBRA_LIBRARY or libembra.so.2)
 
 import fs from 'node:fs';
 import os from 'node:os';

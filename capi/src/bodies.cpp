@@ -4,6 +4,8 @@
 
 using namespace embra::capi;
 
+static_assert(EMBRA_FRICTION_STRIBECK_SPEED == embra::kFrictionStribeckSpeed, "embra.h states the friction law");
+
 // EMBRA_GENERATE_* flags are passed to the core as they are: each is pinned to its core flag.
 static_assert(static_cast<uint32_t>(EMBRA_GENERATE_STRETCH) == embra::generate_stretch);
 static_assert(static_cast<uint32_t>(EMBRA_GENERATE_SHEAR) == embra::generate_shear);

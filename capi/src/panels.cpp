@@ -32,6 +32,7 @@ embra_panel_mesh_def embra_default_panel_mesh_def(void) {
   d.panel_size = 0.8;
   const embra::PanelMeshDesc p;
   d.pins = static_cast<int32_t>(p.pins);
+  d.corners = static_cast<int32_t>(p.corners);
   to_c(kPanelMeshCopies, p, d);
   return d;
 }
@@ -60,6 +61,8 @@ embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_
     }
     to_core(kPanelMeshCopies, *def, d);
     d.pins = static_cast<embra::PanelPins>(def->pins);
+    d.corners = static_cast<embra::PanelCorners>(def->corners);  // checked by build_panel_mesh
+    if (def->reserved0 != 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.reserved0 must be 0");
     d.group = to_id(def->group);
     d.tolerances = embra::io::parse_tolerances(world->meta.tolerances);  // the world's, in force
     const embra::Id id = embra::build_panel_mesh(world->world, d);
@@ -131,6 +134,22 @@ embra_status embra_panel_mesh_get_panel_count(const embra_world* world, embra_bo
   });
 }
 
+embra_status embra_panel_mesh_get_corner_particles(const embra_world* world, embra_body_id body, int32_t* out,
+                                                   int64_t capacity, int64_t* out_count) {
+  return guard("embra_panel_mesh_get_corner_particles", world, [&] {
+    need(out_count, "out_count");
+    const embra::PanelLayout& l = layout_of(world, body);
+    const int64_t n = 8 * static_cast<int64_t>(l.panel_count());
+    if (fits(out, capacity, n, "values"))
+      for (int32_t p = 0; p < l.panel_count(); ++p)
+        for (int k = 0; k < 4; ++k) {
+          out[8 * static_cast<int64_t>(p) + k] = l.top(p, k);
+          out[8 * static_cast<int64_t>(p) + 4 + k] = l.bottom(p, k);
+        }
+    *out_count = n;
+  });
+}
+
 embra_tolerances embra_default_tolerances(void) {
   return from_tolerances(embra::Tolerances{});
 }
@@ -196,7 +215,7 @@ embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_
     const embra::PanelLayout& l = layout_of(world, body);
     if (metric < 0 || metric >= embra::kPanelMetricCount)
       refuse(EMBRA_ERROR_INVALID_ARGUMENT, "metric " + num(metric) + " is not an EMBRA_PANEL_METRIC_ value");
-    const int64_t n = 8 * static_cast<int64_t>(l.panel_count());
+    const int64_t n = l.particle_count();
     if (!fits(out, capacity, n, "values")) {
       *out_count = n;
       return;

@@ -62,6 +62,9 @@ namespace Embra
     /// <summary>EMBRA_PANEL_PINS_*.</summary>
     public enum PanelPins { None = 0, TopCorners = 1, TopAndBottomCorners = 2 }
 
+    /// <summary>EMBRA_PANEL_CORNERS_*.</summary>
+    public enum PanelCorners { Welded = 0, Shared = 1 }
+
     /// <summary>EMBRA_PANEL_METRIC_*.</summary>
     public enum PanelMetric { Planarity = 0, Thickness = 1, Miter = 2, CornerDistance = 3, Conical = 4 }
 
@@ -445,7 +448,7 @@ namespace Embra
     [StructLayout(LayoutKind.Sequential)]
     public unsafe struct PanelMeshDef
     {
-        public const int CurrentVersion = 1;
+        public const int CurrentVersion = 2;
         public int Version;
         public int VertexCount;
         public IntPtr Positions;
@@ -464,6 +467,8 @@ namespace Embra
         public double FrictionDynamic;
         public double SlideCompliance;
         public GroupId Group;
+        public int Corners;
+        public int Reserved0;
     }
 
     /// <summary>embra_tolerance.</summary>
@@ -597,7 +602,7 @@ namespace Embra
     public static partial class Native
     {
         /// <summary>The EMBRA_ABI_VERSION these bindings were generated for (the SONAME's number).</summary>
-        public const int AbiVersion = 1;
+        public const int AbiVersion = 2;
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_last_error_message();
         [DllImport(Library, CallingConvention = C)] public static extern IntPtr embra_status_name(int status);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_version();
@@ -703,6 +708,7 @@ namespace Embra
         [DllImport(Library, CallingConvention = C)] public static extern PanelMeshDef embra_default_panel_mesh_def();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_create(IntPtr world, ref PanelMeshDef def, out BodyId body, out int firstParticle);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_panel_count(IntPtr world, BodyId body, out int count);
+        [DllImport(Library, CallingConvention = C)] public static extern int embra_panel_mesh_get_corner_particles(IntPtr world, BodyId body, [Out] int[] buffer, long capacity, out long count);
         [DllImport(Library, CallingConvention = C)] public static extern Tolerances embra_default_tolerances();
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_get_tolerances(IntPtr world, out Tolerances tolerances);
         [DllImport(Library, CallingConvention = C)] public static extern int embra_world_set_tolerances(IntPtr world, ref Tolerances tolerances);

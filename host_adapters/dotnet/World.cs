@@ -503,16 +503,24 @@ namespace Embra
         /// <summary>A body's triangles as world particle indices, 3 per triangle.</summary>
         public int[] BodyTriangles(BodyId body)
         {
+            return BodyInts(body, Native.embra_body_get_triangles);
+        }
+
+        private delegate int IntsReader(IntPtr world, BodyId body, int[] buffer, long capacity, out long count);
+
+        /// <summary>A body's int list read by `read` (asked for its count first).</summary>
+        private int[] BodyInts(BodyId body, IntsReader read)
+        {
             long n = 0;
-            Call(w => Native.embra_body_get_triangles(w, body, null, 0, out n));
+            Call(w => read(w, body, null, 0, out n));
             var out_ = new int[n];
-            Call(w => Native.embra_body_get_triangles(w, body, out_, out_.LongLength, out n));
+            Call(w => read(w, body, out_, out_.LongLength, out n));
             return out_;
         }
 
         // --- panel meshes ----------------------------------------------------------------------
         /// <summary>Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create): 8 particles per
-        /// panel. With positions (xyz per top vertex) and quads (4 indices per quad) the mesh is theirs;
+        /// panel welded, 2 per vertex shared (def.Corners). With positions (xyz per top vertex) and quads (4 indices per quad) the mesh is theirs;
         /// without, a grid of def.GridColumns x def.GridRows square panels. `def` (default:
         /// embra_default_panel_mesh_def()) supplies the rest; its pointers and counts are set here.</summary>
         public Body CreatePanelMesh(PanelMeshDef? def = null, double[] positions = null, int[] quads = null)
@@ -537,7 +545,9 @@ namespace Embra
                 Call(w => Native.embra_panel_mesh_create(w, ref d, out id, out first));
                 body.Id = id;
                 body.First = first;
-                body.Count = 8 * (d.VertexCount != 0 ? d.QuadCount : d.GridColumns * d.GridRows);
+                int count = 0;
+                Call(w => Native.embra_body_get_particles(w, id, out first, out count));
+                body.Count = count;
             }
             return body;
         }
@@ -547,6 +557,13 @@ namespace Embra
             int n = 0;
             Call(w => Native.embra_panel_mesh_get_panel_count(w, body, out n));
             return n;
+        }
+
+        /// <summary>The world particle of each panel corner (embra_panel_mesh_get_corner_particles): 8 a
+        /// panel, its top corners 0-3 then its bottom corners 0-3.</summary>
+        public int[] PanelCornerParticles(BodyId body)
+        {
+            return BodyInts(body, Native.embra_panel_mesh_get_corner_particles);
         }
 
         /// <summary>The fabrication tolerances the metrics are judged against (the scene's, else the defaults).</summary>
@@ -575,7 +592,7 @@ namespace Embra
             return s;
         }
 
-        /// <summary>One error value per particle of a panel-mesh body (8 per panel, in body order) for a
+        /// <summary>One error value per particle of a panel-mesh body (in body order) for a
         /// colour map, into `into` when given (capacity = its length) or a new array.</summary>
         public double[] VertexErrors(BodyId body, PanelMetric metric, double[] into = null)
         {

@@ -13,7 +13,9 @@
  * top and bottom quads, both diagonal splits) so the numbers do not rest on the library's own code.
  *
  * With --large SCENE PANELS it runs one of the larger versions instead (examples/large/: 16 x 16 and
- * 32 x 32 panels over the same area, the same sphere and path) for the scene's 300 frames: settled
+ * 32 x 32 panels over the same area, the same sphere and path, their corners shared; the panels'
+ * corners are read with embra_panel_mesh_get_corner_particles, so either layout is checked) for the
+ * scene's 300 frames: settled
  * at the end with max thickness error <= 0.00005, max planarity <= 1e-6 top and bottom and max miter
  * twist <= 0.001, and within every target of the scene's tolerance document (corner off plane
  * too); our own planarity equal to the reported one every frame; no panel face inside the sphere at
@@ -95,13 +97,13 @@ static vec sphere_centre(int frame) {
 /* Over every panel of positions x at `frame`: the largest planarity of a top or bottom quad, which
  * must equal the reported one (m), and the deepest point of a panel face (top or bottom triangle)
  * inside the sphere of `radius` at `centre`, kept in *inside_max. */
-static void panel_checks(const double* x, int32_t panels, vec centre, double radius, const embra_panel_metrics* m,
-                         int frame, double* inside_max) {
+static void panel_checks(const double* x, const int32_t* corner, int32_t panels, vec centre, double radius,
+                         const embra_panel_metrics* m, int frame, double* inside_max) {
   double planarity_max = 0.0;
   for (int32_t p = 0; p < panels; ++p)
     for (int layer = 0; layer < 2; ++layer) {
-      const int32_t o = 8 * p + 4 * layer;
-      const vec q0 = at(x, o), q1 = at(x, o + 1), q2 = at(x, o + 2), q3 = at(x, o + 3);
+      const int32_t* c = corner + 8 * p + 4 * layer;
+      const vec q0 = at(x, c[0]), q1 = at(x, c[1]), q2 = at(x, c[2]), q3 = at(x, c[3]);
       const double pl = planarity(q0, q1, q2, q3);
       if (pl > planarity_max) planarity_max = pl;
       const double d1 = radius - triangle_distance(centre, q0, q1, q2);
@@ -115,9 +117,13 @@ static void panel_checks(const double* x, int32_t panels, vec centre, double rad
   CHECK_NEAR(planarity_max, reported, 1e-15);
 }
 
-/* Loads a drape scene and finds its panel mesh (the scene's first body): NULL if it cannot. */
-static embra_world* open_drape(const char* path, int32_t expect_panels, int32_t* first, int32_t* count) {
+/* Loads a drape scene and finds its panel mesh (the scene's first body) and the particle of each
+ * panel corner (8 a panel, body-local, into *corner: free it): NULL if it cannot. Corners welded,
+ * 8 particles a panel; shared, 2 a vertex of the grid. */
+static embra_world* open_drape(const char* path, int32_t expect_panels, int32_t* first, int32_t* count,
+                               int32_t** corner) {
   embra_world* w = NULL;
+  *corner = NULL;
   CHECK_OK(embra_world_load_file(&w, path));
   if (w == NULL) return NULL;
   const embra_body_id body = {0, 1};
@@ -125,7 +131,23 @@ static embra_world* open_drape(const char* path, int32_t expect_panels, int32_t*
   CHECK_OK(embra_panel_mesh_get_panel_count(w, body, &panels));
   CHECK_INT(panels, expect_panels);
   CHECK_OK(embra_body_get_particles(w, body, first, count));
-  CHECK_INT(*count, 8 * expect_panels);
+  int64_t n = 0;
+  CHECK_OK(embra_panel_mesh_get_corner_particles(w, body, NULL, 0, &n));
+  CHECK_INT((int)n, 8 * expect_panels);
+  *corner = malloc(sizeof(int32_t) * (size_t)(8 * expect_panels));
+  if (!CHECK(*corner != NULL) || panels != expect_panels) {
+    embra_world_destroy(w);
+    return NULL;
+  }
+  CHECK_OK(embra_panel_mesh_get_corner_particles(w, body, *corner, n, &n));
+  int32_t side = 1;
+  while (side * side < panels) ++side;
+  const int shared = panels > 1 && (*corner)[1] == (*corner)[8 + 0]; /* panel 0's corner 1 is panel 1's corner 0 */
+  CHECK_INT(*count, shared ? 2 * (side + 1) * (side + 1) : 8 * expect_panels);
+  for (int64_t i = 0; i < n; ++i) {
+    (*corner)[i] -= *first;
+    CHECK((*corner)[i] >= 0 && (*corner)[i] < *count);
+  }
   return w;
 }
 
@@ -135,7 +157,8 @@ static void test_drape(const char* dir) {
   const embra_body_id body = {0, 1};
   const int32_t panels = 16;
   int32_t first = 0, count = 0;
-  embra_world* w = open_drape(path, panels, &first, &count);
+  int32_t* corner = NULL;
+  embra_world* w = open_drape(path, panels, &first, &count, &corner);
   if (w == NULL) return;
   /* The scene's objects through the id lists: one body, its four corner pins (each on a particle
    * sitting at its target before any step) and the sphere where the scene puts it. */
@@ -168,7 +191,11 @@ static void test_drape(const char* dir) {
   CHECK_NEAR(tol.unit_scale, 1250.0, 0.0);
   CHECK_NEAR(tol.thickness.target, 5e-5, 0.0);
   double* x = malloc(sizeof(double) * 3 * (size_t)count);
-  if (!CHECK(x != NULL)) return;
+  if (!CHECK(x != NULL)) {
+    free(corner);
+    embra_world_destroy(w);
+    return;
+  }
   const double radius = 1.0;
   double worst_inside = 0.0;
   int settled_from = -1, back_from = -1;
@@ -198,7 +225,7 @@ static void test_drape(const char* dir) {
       const double off = fabs(ball_at[k] - (k == 0 ? centre.x : k == 1 ? centre.y : centre.z));
       if (off > ball_off) ball_off = off;
     }
-    panel_checks(x, panels, centre, radius, &m, f, &worst_inside);
+    panel_checks(x, corner, panels, centre, radius, &m, f, &worst_inside);
   }
   CAPI_CONTEXT("%s", "");
   printf(
@@ -234,16 +261,19 @@ static void test_drape(const char* dir) {
   CHECK_STATUS(embra_panel_mesh_export_cuts(w, body, 7, NULL, 0, &len), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_STATUS(embra_panel_mesh_get_vertex_errors(w, body, 9, NULL, 0, &n), EMBRA_ERROR_INVALID_ARGUMENT);
   free(x);
+  free(corner);
   embra_world_destroy(w);
 }
 
 static void test_large(const char* path, int32_t panels) {
   const embra_body_id body = {0, 1};
   int32_t first = 0, count = 0;
-  embra_world* w = open_drape(path, panels, &first, &count);
+  int32_t* corner = NULL;
+  embra_world* w = open_drape(path, panels, &first, &count, &corner);
   if (w == NULL) return;
   double* x = malloc(sizeof(double) * 3 * (size_t)count);
   if (!CHECK(x != NULL)) {
+    free(corner);
     embra_world_destroy(w);
     return;
   }
@@ -266,7 +296,7 @@ static void test_large(const char* path, int32_t panels) {
         m.thickness.max <= 5e-5 && m.planarity_top.max <= 1e-6 && m.planarity_bottom.max <= 1e-6 && m.miter.max <= 1e-3;
     if (within && within_from < 0) within_from = f;
     if (!within) within_from = -1;
-    panel_checks(x, panels, sphere_centre(f), 1.0, &m, f, &worst_inside);
+    panel_checks(x, corner, panels, sphere_centre(f), 1.0, &m, f, &worst_inside);
   }
   CAPI_CONTEXT("%s", "");
   printf(
@@ -289,7 +319,7 @@ static void test_large(const char* path, int32_t panels) {
           const int32_t ui = q % side + (l == 1 || l == 2), uj = q / side + (l >= 2);
           if (vi != ui || vj != uj) continue;
           for (int layer = 0; layer < 2; ++layer) {
-            const vec d = sub(at(x, 8 * p + 4 * layer + k), at(x, 8 * q + 4 * layer + l));
+            const vec d = sub(at(x, corner[8 * p + 4 * layer + k]), at(x, corner[8 * q + 4 * layer + l]));
             if (sqrt(dot(d, d)) > own_gap) own_gap = sqrt(dot(d, d));
           }
         }
@@ -307,6 +337,7 @@ static void test_large(const char* path, int32_t panels) {
   CHECK(m.miter.max <= 1e-3);
   CHECK(worst_inside <= 1e-6);
   free(x);
+  free(corner);
   embra_world_destroy(w);
 }
 

@@ -215,6 +215,7 @@ std::map<std::string, std::vector<json>> code_defaults() {
   c[pm + "friction_dynamic"] = {p.friction_dynamic};
   c[pm + "slide_compliance"] = {p.slide_compliance};
   c[pm + "pins"] = {panel_pins_name(p.pins)};
+  c[d + "panel_corners"] = {p.corners == EMBRA_PANEL_CORNERS_WELDED ? "welded" : "shared"};
   c[pm + "group"] = {group_name(p.group)};
 
   // An area load's mode left out is a zeroed embra_area_load's (there is no default def).

@@ -167,6 +167,9 @@ TEST(PanelMesh, RefusedInputChangesNothing) {
 // each vertex the mirror symmetry across the meridian plane makes opposite face angles sum equal
 // (a conical vertex), so the face offset exists. Built as the top layer with its face offset, all
 // three metrics read zero, and with gravity off it stays so.
+// Both corner layouts: welded (the offsets meet per panel, the welds hold the copies together) and
+// shared (one bottom particle a vertex at the thickness from all four of its panels' planes, which
+// exists only because the mesh is conical).
 TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
   constexpr int around = 24, rows = 4;
   constexpr double radius = 3.0;
@@ -185,34 +188,93 @@ TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
       const int32_t a = i * around + j, b = i * around + (j + 1) % around;
       quads.insert(quads.end(), {a, b, b + around, a + around});  // east, then north: outward normal
     }
-  World w(test::settings(20, 1));
+  for (PanelCorners corners : {PanelCorners::welded, PanelCorners::shared}) {
+    const bool shared = corners == PanelCorners::shared;
+    SCOPED_TRACE(shared ? "corners shared" : "corners welded");
+    World w(test::settings(20, 1));
+    PanelMeshDesc d;
+    d.positions = pos;
+    d.quads = quads;
+    d.thickness = 0.05;
+    d.corners = corners;
+    const Id body = build_panel_mesh(w, d);
+    const PanelLayout& l = *w.panel_layout(body);
+    EXPECT_EQ(w.particle_count(), shared ? 2 * around * (rows + 1) : 8 * around * rows);
+    EXPECT_EQ(conical_vertices(l).size(), static_cast<size_t>(around * (rows - 1)));
+    const PanelErrors before = measure_panels(l, w.positions());
+    const PanelReport r0 = report_panels(before, Tolerances{});
+    EXPECT_LT(r0.conical.max, 1e-13);
+    EXPECT_LT(r0.planarity_top.max, 1e-14);
+    EXPECT_LT(r0.planarity_bottom.max, 1e-14);
+    EXPECT_LT(r0.thickness.max, 1e-12);
+    EXPECT_LT(r0.miter.max, 1e-12);
+    // The bottom layer lies on the sphere of radius 3 - 0.05 / cos(half the angle between rows):
+    // every bottom corner is below its top corner (inside the sphere).
+    for (int32_t p = 0; p < l.panel_count(); ++p)
+      for (int k = 0; k < 4; ++k) EXPECT_LT(w.positions()[l.bottom(p, k)].norm(), radius - 0.049);
+    for (int f = 0; f < 60; ++f) w.step();
+    const PanelReport r1 = report_panels(measure_panels(l, w.positions()), Tolerances{});
+    EXPECT_LT(r1.planarity_top.max, 1e-12);
+    EXPECT_LT(r1.planarity_bottom.max, 1e-12);
+    EXPECT_LT(r1.thickness.max, 1e-10);
+    EXPECT_LT(r1.miter.max, 1e-10);
+    if (shared) {
+      EXPECT_EQ(r1.corner_gap.max, 0.0);
+    }
+    EXPECT_LT(w.report().max_speed, 1e-9);
+    RecordProperty(shared ? "shared_after_60_frames_thickness" : "conical_after_60_frames_thickness",
+                   test::sci(r1.thickness.max));
+    RecordProperty(shared ? "shared_after_60_frames_miter" : "conical_after_60_frames_miter", test::sci(r1.miter.max));
+  }
+}
+
+// A 3 x 2 grid with corners shared: one top and one bottom particle per mesh vertex (12 each), the
+// panels on a vertex on the same two particles; each panel's mass in eighths on its corners; the
+// top's 17 edges once each with the 12 diagonals, a slide distance per vertex, no welds.
+TEST(PanelMesh, SharedCornersOneParticlePerVertexAndLayer) {
+  World w(test::settings(10, 1));
+  std::vector<double> positions;
+  std::vector<int32_t> quads;
+  panel_grid(3, 2, 0.8, Vec3(0.0, 0.0, 1.0), positions, quads);
   PanelMeshDesc d;
-  d.positions = pos;
+  d.positions = positions;
   d.quads = quads;
-  d.thickness = 0.05;
+  d.density = 2.0;
+  d.corners = PanelCorners::shared;
+  d.pins = PanelPins::top_corners;
   const Id body = build_panel_mesh(w, d);
   const PanelLayout& l = *w.panel_layout(body);
-  EXPECT_EQ(conical_vertices(l).size(), static_cast<size_t>(around * (rows - 1)));
-  const PanelErrors before = measure_panels(l, w.positions());
-  const PanelReport r0 = report_panels(before, Tolerances{});
-  EXPECT_LT(r0.conical.max, 1e-13);
-  EXPECT_LT(r0.planarity_top.max, 1e-14);
-  EXPECT_LT(r0.planarity_bottom.max, 1e-14);
-  EXPECT_LT(r0.thickness.max, 1e-12);
-  EXPECT_LT(r0.miter.max, 1e-12);
-  // The bottom layer lies on the sphere of radius 3 - 0.05 / cos(half the angle between rows):
-  // every bottom corner is below its top corner (inside the sphere).
-  for (int32_t p = 0; p < l.panel_count(); ++p)
-    for (int k = 0; k < 4; ++k) EXPECT_LT(w.positions()[l.bottom(p, k)].norm(), radius - 0.049);
-  for (int f = 0; f < 60; ++f) w.step();
-  const PanelReport r1 = report_panels(measure_panels(l, w.positions()), Tolerances{});
-  EXPECT_LT(r1.planarity_top.max, 1e-12);
-  EXPECT_LT(r1.planarity_bottom.max, 1e-12);
-  EXPECT_LT(r1.thickness.max, 1e-10);
-  EXPECT_LT(r1.miter.max, 1e-10);
-  EXPECT_LT(w.report().max_speed, 1e-9);
-  RecordProperty("conical_after_60_frames_thickness", test::sci(r1.thickness.max));
-  RecordProperty("conical_after_60_frames_miter", test::sci(r1.miter.max));
+  EXPECT_TRUE(l.shared);
+  EXPECT_EQ(w.particle_count(), 24);
+  EXPECT_EQ(w.pin_count(), 4u);
+  double mass = 0.0;
+  for (int32_t i = 0; i < w.particle_count(); ++i) mass += 1.0 / w.inverse_masses()[i];
+  EXPECT_NEAR(mass, 2.0 * 6 * 0.64, 1e-12);
+  for (int32_t p = 0; p < 6; ++p)
+    for (int k = 0; k < 4; ++k) {
+      const int32_t v = quads[4 * static_cast<size_t>(p) + k];
+      EXPECT_EQ(l.top(p, k), v);
+      EXPECT_EQ(l.bottom(p, k), 12 + v);
+      EXPECT_NEAR((w.positions()[l.top(p, k)] - w.positions()[l.bottom(p, k)] - Vec3(0, 0, 0.01)).norm(), 0.0, 1e-15);
+    }
+  const Id g = w.default_group();
+  EXPECT_EQ(w.constraint_count(g, Kind::weld).first, 0);
+  EXPECT_EQ(w.constraint_count(g, Kind::distance).first, 17 + 12 + 12);
+  EXPECT_EQ(w.constraint_count(g, Kind::plane_offset).first, 24);
+  EXPECT_EQ(w.constraint_count(g, Kind::planarity).first, 6 + 17);
+  const PanelErrors e = measure_panels(l, w.positions());
+  const PanelReport r = report_panels(e, Tolerances{});
+  EXPECT_EQ(r.corner_gap.max, 0.0);
+  EXPECT_LT(r.thickness.max, 1e-15);
+  EXPECT_TRUE(r.within_tolerance);
+  EXPECT_EQ(vertex_errors(l, e, PanelMetric::miter).size(), 24u);
+  // A vertex on no quad has no panel to take its particles' mass: refused, nothing changed.
+  positions.insert(positions.end(), {5.0, 5.0, 5.0});
+  d.positions = positions;
+  const int64_t constraints = w.constraint_count();
+  EXPECT_THROW(build_panel_mesh(w, d), Error);
+  EXPECT_EQ(w.particle_count(), 24);
+  EXPECT_EQ(w.constraint_count(), constraints);
 }
 
 // An optimised PQ mesh is planar to its optimiser's tolerance, not to rounding. This one is stated

@@ -4,7 +4,7 @@
 // colour function's for the frame's per-vertex fields.
 //
 //   (cd host_adapters/web && npm run build)
-//   EMBRA_LIBRARY=build/libembra.so.1 node --test tests/web/live.test.mjs
+//   EMBRA_LIBRARY=build/libembra.so.2 node --test tests/web/live.test.mjs
 // ctest runs it as web.live after web.build. Needs host_adapters/node's packages (npm ci there).
 
 import assert from 'node:assert/strict';

@@ -11,7 +11,7 @@
 // page's frames are the drag's only.
 //
 //   (cd host_adapters/web && npm run build)
-//   EMBRA_LIBRARY=build/libembra.so.1 node --test tests/web/live_drag32.test.mjs
+//   EMBRA_LIBRARY=build/libembra.so.2 node --test tests/web/live_drag32.test.mjs
 // ctest runs it as web.live_drag32 after web.build. Needs host_adapters/node's packages.
 
 import assert from 'node:assert/strict';

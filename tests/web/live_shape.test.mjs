@@ -4,7 +4,7 @@
 // pin dot dragged moves its pin.
 //
 //   (cd host_adapters/web && npm run build)
-//   EMBRA_LIBRARY=build/libembra.so.1 node --test tests/web/live_shape.test.mjs
+//   EMBRA_LIBRARY=build/libembra.so.2 node --test tests/web/live_shape.test.mjs
 // ctest runs it as web.live_shape after web.build. Needs host_adapters/node's packages.
 
 import assert from 'node:assert/strict';

@@ -365,6 +365,10 @@ EMBRA_API embra_status embra_world_contact_group(const embra_world* world, embra
  * Bodies: simplicial complexes (points, edges, triangles, tetrahedra) with a material
  * ------------------------------------------------------------------------------------------- */
 
+/* m/s: the slip speed over which friction falls from its static to its dynamic coefficient
+ * (mu = dynamic + (static - dynamic) exp(-speed / EMBRA_FRICTION_STRIBECK_SPEED)). */
+#define EMBRA_FRICTION_STRIBECK_SPEED 0.01
+
 typedef struct embra_material {
   double mass;               /* kg for the whole body, spread by lumped length/area/volume; used
                                 when > 0. Default 0 (use density) */
@@ -376,7 +380,11 @@ typedef struct embra_material {
   double volume_compliance;  /* m^3/N on tetrahedra; default 0 */
   double damping;            /* 1/s velocity decay of the body's particles; default 0 */
   double thickness;          /* m; particles keep half of it off colliders; default 0 */
-  double friction_static;    /* against colliders (geometric mean with the collider's); 0.5 */
+  double friction_static;    /* against colliders (geometric mean with the collider's); 0.5. Coulomb
+                                friction after each substep: a contact's slip is removed up to mu
+                                times its push, mu falling continuously from friction_static at rest
+                                to friction_dynamic as the slip speed passes
+                                EMBRA_FRICTION_STRIBECK_SPEED */
   double friction_dynamic;   /* 0.3 */
 } embra_material;
 
@@ -1293,7 +1301,18 @@ enum {
   EMBRA_PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2 /* and at their bottom corners */
 };
 
-#define EMBRA_PANEL_MESH_DEF_VERSION 1
+/* How the panels on one mesh vertex hold together (embra_panel_mesh_def.corners). */
+enum {
+  EMBRA_PANEL_CORNERS_WELDED = 0, /* 8 particles a panel (its top corners 0-3, then its bottom corners
+                                     0-3, panel after panel); the corners on one vertex welded (hard) */
+  EMBRA_PANEL_CORNERS_SHARED = 1  /* 2 particles a vertex (the top layer's vertices in order, then the
+                                     bottom layer's) that its panels share: no welds, the offset quads
+                                     round a vertex meet in one point exactly (the paper's POQ
+                                     condition), so the top mesh is held conical; about 4 times fewer
+                                     particles, and the load reaches the pins in fewer iterations */
+};
+
+#define EMBRA_PANEL_MESH_DEF_VERSION 2
 typedef struct embra_panel_mesh_def {
   int32_t version;         /* EMBRA_PANEL_MESH_DEF_VERSION */
   int32_t vertex_count;    /* top mesh vertices; 0: build the grid below instead */
@@ -1319,6 +1338,9 @@ typedef struct embra_panel_mesh_def {
   double friction_dynamic; /* default 0.3 */
   double slide_compliance; /* m/N of the bottom-to-top soft distance (>= 0; 0 = none); default 1e-3 */
   embra_group_id group;    /* group of every constraint; {0,0} = default group */
+  int32_t corners;         /* EMBRA_PANEL_CORNERS_*; default EMBRA_PANEL_CORNERS_WELDED. Shared: every
+                              vertex must be on a quad */
+  int32_t reserved0;       /* 0 */
 } embra_panel_mesh_def;
 
 EMBRA_API embra_panel_mesh_def embra_default_panel_mesh_def(void);
@@ -1330,6 +1352,11 @@ EMBRA_API embra_status embra_panel_mesh_create(embra_world* world, const embra_p
 /* Number of panels of a panel-mesh body (EMBRA_ERROR_INVALID_ARGUMENT if the body is not one). */
 EMBRA_API embra_status embra_panel_mesh_get_panel_count(const embra_world* world, embra_body_id body,
                                                         int32_t* out_count);
+/* The world particle of each panel corner: 8 a panel, its top corners 0-3 then its bottom corners
+ * 0-3 (corner k on the panel's quad vertex k), panel after panel; *out_count = 8 * panels. Corners
+ * of panels on one vertex are distinct particles when welded, one particle when shared. */
+EMBRA_API embra_status embra_panel_mesh_get_corner_particles(const embra_world* world, embra_body_id body, int32_t* out,
+                                                             int64_t capacity, int64_t* out_count);
 
 typedef struct embra_tolerance {
   double target; /* at or below: within tolerance (drawn grey) */
@@ -1398,7 +1425,7 @@ enum {
   EMBRA_PANEL_METRIC_CONICAL = 4          /* rad, the conical defect at its mesh vertex (0 elsewhere) */
 };
 /* Per-vertex error field for colour maps (figures 12 and 13: grey at or below the target, shaded
- * up to the max): one double per particle of the body (8 per panel, in body order) into out
+ * up to the max): one double per particle of the body (in body order) into out
  * (capacity in doubles). *out_count (required) receives the count; out NULL and capacity 0 only
  * ask for it. */
 EMBRA_API embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_body_id body, int32_t metric,

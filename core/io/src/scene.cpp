@@ -668,6 +668,8 @@ static_assert(std::size(kAreaLoadModeNames) == kAreaLoadModeCount);
 
 /// The panel pins' names in the scene format, by PanelPins.
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
+/// The panel corners' names in the scene format, by PanelCorners.
+constexpr const char* kPanelCornersNames[] = {"welded", "shared"};
 
 constexpr std::tuple kTolerancesRows{Row{"unit_scale", &Tolerances::unit_scale},
                                      Row{"planarity", &Tolerances::planarity},
@@ -1395,6 +1397,14 @@ class Builder {
   /// A panel mesh: generated (grid, inline quads or an OBJ of quads) through build_panel_mesh, as a C
   /// host would; or, as a saved scene writes it, the layout of a body listed in "bodies" whose
   /// constraints and pins are listed in their own sections.
+  /// A panel mesh's "corners" (the schema has checked it is one of kPanelCornersNames).
+  static PanelCorners panel_corners(const json& p) {
+    if (p.contains("corners"))
+      for (int k = 0; k < static_cast<int>(std::size(kPanelCornersNames)); ++k)
+        if (p["corners"] == kPanelCornersNames[k]) return static_cast<PanelCorners>(k);
+    return PanelCorners::welded;
+  }
+
   void panel_mesh(World& w, const json& p, const std::string& at) {
     if (!p.contains("generator")) {
       PanelLayout l;
@@ -1403,6 +1413,7 @@ class Builder {
       for (const json& q : p["quads"])
         for (const json& v : q) l.quads.push_back(v.get<int32_t>());
       l.thickness = p["thickness"].get<double>();
+      l.shared = panel_corners(p) == PanelCorners::shared;
       guard(at, [&] {
         w.set_panel_layout(l);
         return 0;
@@ -1448,6 +1459,7 @@ class Builder {
     if (p.contains("pins"))  // the schema has checked it is one of kPanelPinsNames
       for (int k = 0; k < static_cast<int>(std::size(kPanelPinsNames)); ++k)
         if (p["pins"] == kPanelPinsNames[k]) d.pins = static_cast<PanelPins>(k);
+    d.corners = panel_corners(p);
     d.group = group(p, "group", at);
     std::vector<bool> had(w.pins().size());
     for (size_t i = 0; i < w.pins().size(); ++i) had[i] = w.pins()[i].alive;
@@ -1727,7 +1739,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
     panel_meshes.push_back({{"body", bodies[l.body.index]["name"]},
                             {"vertex_count", l.vertex_count},
                             {"quads", quads},
-                            {"thickness", l.thickness}});
+                            {"thickness", l.thickness},
+                            {"corners", kPanelCornersNames[l.shared ? 1 : 0]}});
   }
   if (!panel_meshes.empty()) doc["panel_meshes"] = panel_meshes;
 

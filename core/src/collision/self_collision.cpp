@@ -1,6 +1,7 @@
 // Self-collision: broad phase, narrow phase in space-time, projection and friction (see the header).
 #include "collision/self_collision.hpp"
 
+#include "common/friction.hpp"
 #include "common/pool.hpp"
 #include "common/triangle.hpp"
 
@@ -1427,7 +1428,7 @@ void add_corrections(std::span<const SelfContact> contacts, std::span<const doub
 }
 
 void apply_friction(std::span<const SelfContact> contacts, std::span<Vec3> x, std::span<const Vec3> x_prev,
-                    std::span<const double> w) {
+                    std::span<const double> w, double h) {
   for (const SelfContact& c : contacts) {
     if (c.lambda <= 0.0) continue;
     const double denom = denominator(c, w);
@@ -1437,13 +1438,8 @@ void apply_friction(std::span<const SelfContact> contacts, std::span<Vec3> x, st
     const Vec3 tangential = slip - slip.dot(c.normal) * c.normal;
     const double len = tangential.norm();
     const double push = denom * c.lambda;  // the normal correction, a length
-    double f;
-    if (len < c.mu_s * push)
-      f = 1.0;
-    else if (len > 0.0)
-      f = std::min(c.mu_k * push / len, 1.0);
-    else
-      continue;
+    const double f = friction_fraction(len, push, c.mu_s, c.mu_k, h);
+    if (f == 0.0) continue;
     // Remove the fraction f of the relative tangential motion, shared by inverse mass.
     for (int k = 0; k < 4; ++k) x[c.ids[k]] -= (f * w[c.ids[k]] * c.weight[k] / denom) * tangential;
   }

@@ -70,9 +70,10 @@ void project(std::span<SelfContact> contacts, std::span<Vec3> x, std::span<const
 /// Adds each contact's w_k c_k lambda n to `out` (the realignment of Settings::realign_passes).
 void add_corrections(std::span<const SelfContact> contacts, std::span<const double> w, std::span<Vec3> out);
 
-/// Friction on the relative tangential motion of the pushing contacts.
+/// Friction (friction_fraction) on the relative tangential motion of the pushing contacts over a
+/// substep of h seconds.
 void apply_friction(std::span<const SelfContact> contacts, std::span<Vec3> x, std::span<const Vec3> x_prev,
-                    std::span<const double> w);
+                    std::span<const double> w, double h);
 
 /// max(-C, 0): how far a contact is inside its thickness.
 double penetration(const SelfContact& c, std::span<const Vec3> x);

@@ -822,10 +822,11 @@ void World::set_panel_layout(const PanelLayout& layout) {
   const BodyInfo& b = body(layout.body);
   if (layout.quads.empty() || layout.quads.size() % 4 != 0) invalid("panel layout quads must be 4 indices per panel");
   const int64_t panels = static_cast<int64_t>(layout.quads.size() / 4);
-  if (8 * panels != b.particle_count)
-    invalid("panel layout has " + std::to_string(panels) + " panels but the body has " +
-            std::to_string(b.particle_count) + " particles (8 per panel expected)");
   if (layout.vertex_count < 1) invalid("panel layout vertex_count must be >= 1");
+  if (layout.particle_count() != b.particle_count)
+    invalid("panel layout has " + std::to_string(panels) + " panels on " + std::to_string(layout.vertex_count) +
+            " vertices but the body has " + std::to_string(b.particle_count) + " particles (" +
+            (layout.shared ? "2 per vertex, corners shared" : "8 per panel, corners welded") + " expected)");
   for (size_t q = 0; q < layout.quads.size(); q += 4)
     for (size_t k = 0; k < 4; ++k) {
       const int32_t v = layout.quads[q + k];

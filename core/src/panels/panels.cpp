@@ -252,7 +252,7 @@ std::vector<double> vertex_errors(const PanelLayout& layout, const PanelErrors& 
   std::optional<PanelTopology> own;
   const PanelTopology& topology = topology_of(layout, own);
   const int32_t n = layout.panel_count();
-  std::vector<double> out(static_cast<size_t>(8) * n, 0.0);
+  std::vector<double> out(static_cast<size_t>(layout.particle_count()), 0.0);
   auto raise = [&](int32_t particle, double v) {
     double& slot = out[particle - layout.first_particle];
     slot = std::max(slot, v);
@@ -416,9 +416,14 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     invalid("panel mesh quads must be a non-empty array of 4 indices per quad");
   const int64_t nv = static_cast<int64_t>(d.positions.size() / 3);
   const int64_t np = static_cast<int64_t>(d.quads.size() / 4);
-  if (8 * np + world.particle_count() > limits::kMaxParticles)
-    invalid("a world holds at most 2097152 particles; " + std::to_string(np) +
-            " panels (8 particles each) would make " + std::to_string(8 * np + world.particle_count()));
+  const int32_t corners = static_cast<int32_t>(d.corners);
+  if (corners < 0 || corners > 1) invalid("panel mesh corners must be 0 (welded) or 1 (shared)");
+  const bool shared = d.corners == PanelCorners::shared;
+  const int64_t particles = shared ? 2 * nv : 8 * np;
+  if (particles + world.particle_count() > limits::kMaxParticles)
+    invalid("a world holds at most 2097152 particles; " + std::to_string(np) + " panels on " + std::to_string(nv) +
+            " vertices (" + (shared ? "2 particles a vertex" : "8 particles a panel") + ") would make " +
+            std::to_string(particles + world.particle_count()));
   for (double c : d.positions) check_finite(c, "panel mesh vertex coordinate");
   check_positive(d.thickness, "panel thickness");
   check_zero_or_positive(d.mass, "panel mesh mass");
@@ -475,6 +480,11 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
 
   // --- bottom layer: each vertex offset to where its faces' offset planes meet ---
   const auto around = corners_around(d.quads, nv);
+  if (shared)
+    for (int64_t v = 0; v < nv; ++v)
+      if (around[v].empty())
+        invalid("vertex " + std::to_string(v) +
+                " is on no quad (a panel mesh with shared corners makes a particle of every vertex)");
   std::vector<Vec3> face_normal(np);
   std::vector<double> area(np);
   for (int64_t q = 0; q < np; ++q) {
@@ -597,18 +607,33 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   for (double s : area) total_area += s;
   std::vector<double> masses;
   std::vector<int32_t> triangles;
-  for (int64_t q = 0; q < np; ++q) {
-    const int32_t* v = &d.quads[4 * q];
-    for (int k = 0; k < 4; ++k) xyz.insert(xyz.end(), {P(v[k]).x(), P(v[k]).y(), P(v[k]).z()});
-    for (int k = 0; k < 4; ++k) {
-      const Vec3 b = P(v[k]) + offset[v[k]];
-      xyz.insert(xyz.end(), {b.x(), b.y(), b.z()});
-    }
+  // The layout first (body-local: first_particle 0 until the body exists), so that particles and
+  // triangles are placed as its top() and bottom() say.
+  PanelLayout layout;
+  layout.vertex_count = static_cast<int32_t>(nv);
+  layout.quads.assign(d.quads.begin(), d.quads.end());
+  layout.thickness = d.thickness;
+  layout.shared = shared;
+  xyz.assign(static_cast<size_t>(3 * particles), 0.0);
+  masses.assign(static_cast<size_t>(particles), 0.0);
+  for (int32_t q = 0; q < np; ++q) {
+    const int32_t* v = &d.quads[4 * static_cast<int64_t>(q)];
+    // Each panel's mass in eighths on its corners (summed where corners are shared).
     const double m = d.mass > 0.0 ? d.mass * area[q] / total_area : d.density * area[q];
-    for (int k = 0; k < 8; ++k) masses.push_back(m / 8.0);
-    const int32_t o = static_cast<int32_t>(8 * q);
-    triangles.insert(triangles.end(), {o, o + 1, o + 2, o, o + 2, o + 3});
-    triangles.insert(triangles.end(), {o + 4, o + 6, o + 5, o + 4, o + 7, o + 6});
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 t = P(v[k]), b = P(v[k]) + offset[v[k]];
+      const int32_t it = layout.top(q, k), ib = layout.bottom(q, k);
+      for (int c = 0; c < 3; ++c) {
+        xyz[3 * static_cast<size_t>(it) + c] = t[c];
+        xyz[3 * static_cast<size_t>(ib) + c] = b[c];
+      }
+      masses[static_cast<size_t>(it)] += m / 8.0;
+      masses[static_cast<size_t>(ib)] += m / 8.0;
+    }
+    auto T = [&](int k) { return layout.top(q, k); };
+    auto B = [&](int k) { return layout.bottom(q, k); };
+    triangles.insert(triangles.end(), {T(0), T(1), T(2), T(0), T(2), T(3)});
+    triangles.insert(triangles.end(), {B(0), B(2), B(1), B(0), B(3), B(2)});
   }
   BodyDesc body;
   body.positions = xyz;
@@ -620,13 +645,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   body.material.friction_dynamic = d.friction_dynamic;
   body.material.bend_compliance = 0.0;
   const Id id = world.create_body(body);
-  const int32_t first = world.body(id).first_particle;
-  PanelLayout layout;
   layout.body = id;
-  layout.first_particle = first;
-  layout.vertex_count = static_cast<int32_t>(nv);
-  layout.quads.assign(d.quads.begin(), d.quads.end());
-  layout.thickness = d.thickness;
+  layout.first_particle = world.body(id).first_particle;
 
   // --- constraints ---
   auto add = [&](Kind kind, const std::vector<int32_t>& ids, const std::vector<double>& rest, double compliance) {
@@ -642,16 +662,20 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   const std::vector<Vec3>& x = world.positions();
   std::vector<int32_t> ids;
   std::vector<double> rest;
-  // (a) the top quad braced: 4 edges and 2 diagonals.
+  // (a) the top quad braced: 4 edges and 2 diagonals (an edge two panels share, once).
   for (int32_t p = 0; p < np; ++p)
     for (auto [i, j] : {std::pair{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}}) {
+      const int32_t vi = d.quads[4 * static_cast<size_t>(p) + i], vj = d.quads[4 * static_cast<size_t>(p) + j];
+      const bool edge =
+          (i + 1) % 4 == j;  // else a diagonal; an inner edge is (vi, vj) in one panel, (vj, vi) in the other
+      if (shared && edge && vi > vj && undirected[edge_key(vi, vj)] == 2) continue;
       ids.insert(ids.end(), {layout.top(p, i), layout.top(p, j)});
       rest.push_back((x[layout.top(p, i)] - x[layout.top(p, j)]).norm());
     }
   add(Kind::distance, ids, rest, 0.0);
-  // (b) welds at shared vertices, top and bottom.
+  // (b) welded: the corners on one vertex welded, top and bottom.
   ids.clear();
-  for (int64_t v = 0; v < nv; ++v)
+  for (int64_t v = 0; v < nv && !shared; ++v)
     for (size_t f = 1; f < around[v].size(); ++f) {
       const auto [p0, k0] = around[v][0];
       const auto [p, k] = around[v][f];
@@ -682,6 +706,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
     rest.clear();
     for (int32_t p = 0; p < np; ++p)
       for (int k = 0; k < 4; ++k) {
+        if (shared && around[d.quads[4 * static_cast<size_t>(p) + k]][0] != std::pair{p, k}) continue;  // once a vertex
         ids.insert(ids.end(), {layout.bottom(p, k), layout.top(p, k)});
         rest.push_back((x[layout.bottom(p, k)] - x[layout.top(p, k)]).norm());
       }

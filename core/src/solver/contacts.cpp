@@ -4,6 +4,7 @@
 
 #include "collision/collider_shapes.hpp"
 #include "collision/self_collision.hpp"
+#include "common/friction.hpp"
 #include "common/pool.hpp"
 
 #include <algorithm>
@@ -146,13 +147,13 @@ void World::find_face_contacts() {
     const double r = col.desc.radius + col.desc.thickness;
     const double move = (col.position - col.position_prev).norm();
     // A panel's four triangles (two a layer) that come within reach of the sphere.
-    auto look_at = [&](int32_t first_particle, size_t p, std::vector<FaceContact>& found) {
+    auto look_at = [&](const PanelLayout& l, int32_t p, std::vector<FaceContact>& found) {
       for (int layer = 0; layer < 2; ++layer)
         for (int half = 0; half < 2; ++half) {
-          const int32_t o = first_particle + 8 * static_cast<int32_t>(p) + 4 * layer;
-          const int32_t across = layer == 0 ? 4 : -4;
-          const int32_t ids[3] = {o, o + 1 + half, o + 2 + half};
-          const int32_t partner[3] = {ids[0] + across, ids[1] + across, ids[2] + across};
+          auto corner = [&](int k, bool top) { return top ? l.top(p, k) : l.bottom(p, k); };
+          const bool top = layer == 0;
+          const int32_t ids[3] = {corner(0, top), corner(1 + half, top), corner(2 + half, top)};
+          const int32_t partner[3] = {corner(0, !top), corner(1 + half, !top), corner(2 + half, !top)};
           if (slab_weight(ids[0], partner[0]) == 0.0 && slab_weight(ids[1], partner[1]) == 0.0 &&
               slab_weight(ids[2], partner[2]) == 0.0)
             continue;
@@ -168,7 +169,7 @@ void World::find_face_contacts() {
     for (const PanelLayout& l : panel_layouts_)
       pool_->collect(0, static_cast<size_t>(l.panel_count()), kFaceGrain, face_parts_, face_contacts_,
                      [&](size_t begin, size_t end, std::vector<FaceContact>& found) {
-                       for (size_t p = begin; p < end; ++p) look_at(l.first_particle, p, found);
+                       for (size_t p = begin; p < end; ++p) look_at(l, static_cast<int32_t>(p), found);
                      });
   }
 }
@@ -178,36 +179,50 @@ double World::slab_weight(int32_t a, int32_t b) const {
   return wa > 0.0 && wb > 0.0 ? 1.0 / (1.0 / wa + 1.0 / wb) : 0.0;  // 1 / (m_a + m_b), no overflow
 }
 
-void World::project_face_contacts() {
-  for (FaceContact& fc : face_contacts_) {
-    const Collider& col = colliders_[fc.collider];
-    const Vec3& a = x_[fc.ids[0]];
-    const Vec3& b = x_[fc.ids[1]];
-    const Vec3& c = x_[fc.ids[2]];
-    const Vec3 bary = closest_barycentric(col.position, a, b, c);
-    const Vec3 q = bary[0] * a + bary[1] * b + bary[2] * c;
-    const Vec3 d = q - col.position;
-    const double len = d.norm();
-    if (!(len > 1e-12)) continue;
-    const Vec3 n = d / len;
-    const double gap = len - (col.desc.radius + col.desc.thickness);
-    double ws[3], denom = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      ws[k] = slab_weight(fc.ids[k], fc.partner[k]);
-      denom += ws[k] * bary[k] * bary[k];
-    }
-    if (denom <= 0.0) continue;
-    // Hard, unilateral: C = gap >= 0, grad_k C = b_k n, corner k and its partner moving as one.
-    const double lambda = std::max(fc.lambda - gap / denom, 0.0);
-    const double dl = lambda - fc.lambda;
-    fc.lambda = lambda;
-    if (dl == 0.0) continue;
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 step = (ws[k] * bary[k] * dl) * n;
-      x_[fc.ids[k]] += step;
-      x_[fc.partner[k]] += step;
-    }
+namespace {
+
+/// One projection of a face contact (hard, unilateral: C = gap >= 0, grad_k C = b_k n, corner k and
+/// its partner across the thickness moving as one particle of their joint mass, `weight`): lambda
+/// accumulates the push. Returns the push added (0: none) and, in `normal_force`, the force it adds on
+/// the movable corner pairs times h^2 (sum over them of b_k, times the push, along n).
+template <class Weight>
+double project_face(FaceContact& fc, const Collider& col, std::vector<Vec3>& x, Weight weight, Vec3& normal_force) {
+  const Vec3& a = x[fc.ids[0]];
+  const Vec3& b = x[fc.ids[1]];
+  const Vec3& c = x[fc.ids[2]];
+  const Vec3 bary = closest_barycentric(col.position, a, b, c);
+  const Vec3 q = bary[0] * a + bary[1] * b + bary[2] * c;
+  const Vec3 d = q - col.position;
+  const double len = d.norm();
+  if (!(len > 1e-12)) return 0.0;
+  const Vec3 n = d / len;
+  const double gap = len - (col.desc.radius + col.desc.thickness);
+  double ws[3], denom = 0.0, share = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    ws[k] = weight(fc.ids[k], fc.partner[k]);
+    denom += ws[k] * bary[k] * bary[k];
+    if (ws[k] > 0.0) share += bary[k];
   }
+  if (denom <= 0.0) return 0.0;
+  const double lambda = std::max(fc.lambda - gap / denom, 0.0);
+  const double dl = lambda - fc.lambda;
+  fc.lambda = lambda;
+  if (dl == 0.0) return 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 step = (ws[k] * bary[k] * dl) * n;
+    x[fc.ids[k]] += step;
+    x[fc.partner[k]] += step;
+  }
+  normal_force = (share * dl) * n;
+  return dl;
+}
+
+}  // namespace
+
+void World::project_face_contacts() {
+  const auto weight = [this](int32_t a, int32_t b) { return slab_weight(a, b); };
+  Vec3 unused;
+  for (FaceContact& fc : face_contacts_) project_face(fc, colliders_[fc.collider], x_, weight, unused);
 }
 
 void World::find_shape_contacts(int32_t index, const std::vector<int32_t>* only, size_t begin, size_t end,
@@ -316,11 +331,19 @@ void World::settle_contacts_on_surface() {
       ct.force_h2 -= (gap / w_[i]) * n;
     }
   }
+  // Face contacts likewise: friction moves a face's corners by their weights in the contact point,
+  // and where panels share corners that tilts their other faces; each face is projected once more.
+  const auto weight = [this](int32_t a, int32_t b) { return slab_weight(a, b); };
+  for (FaceContact& fc : face_contacts_) {
+    Vec3 push = Vec3::Zero();
+    if (project_face(fc, colliders_[fc.collider], x_, weight, push) != 0.0) fc.force_h2 += push;
+  }
 }
 
-void World::apply_friction() {
-  // Friction (Macklin et al. 2014): the tangential slip relative to the collider is removed while
-  // it is below mu_s times the normal push, else reduced by mu_k times it.
+void World::apply_friction(double h) {
+  // Friction (friction_fraction): the tangential slip relative to the collider is removed while it
+  // is below mu times the normal push, else reduced by mu times it; mu falls from mu_s to mu_k with
+  // the slip speed.
   Group& g = groups_[settings_.contact_group.index];
   for (Contact& ct : g.contacts) {
     if (ct.lambda <= 0.0) continue;
@@ -335,15 +358,11 @@ void World::apply_friction() {
     const double len = tangential.norm();
     const double mu_s = std::sqrt(mu_s_[i] * c.desc.friction_static);
     const double mu_k = std::sqrt(mu_k_[i] * c.desc.friction_dynamic);
-    Vec3 moved = Vec3::Zero();
-    if (len < mu_s * ct.lambda)
-      moved = -tangential;
-    else if (len > 0.0)
-      moved = -tangential * std::min(mu_k * ct.lambda / len, 1.0);
+    const Vec3 moved = -friction_fraction(len, ct.lambda, mu_s, mu_k, h) * tangential;
     x_[i] += moved;
     ct.force_h2 += moved / w_[i];
   }
-  self_collision::apply_friction(self_contacts_, x_, x_prev_, w_);
+  self_collision::apply_friction(self_contacts_, x_, x_prev_, w_, h);
   // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
   // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the
   // inverse of their joint mass).
@@ -370,11 +389,7 @@ void World::apply_friction() {
     mu_k = std::sqrt(mu_k * c.desc.friction_dynamic);
     // lambda is the push of the contact point (in length: sum_k w_k b_k^2 lambda moves it by that).
     const double push = fc.lambda * denom;
-    Vec3 remove = Vec3::Zero();
-    if (len < mu_s * push)
-      remove = tangential;
-    else if (len > 0.0)
-      remove = tangential * std::min(mu_k * push / len, 1.0);
+    const Vec3 remove = friction_fraction(len, push, mu_s, mu_k, h) * tangential;
     double share = 0.0;  // of the movable corner pairs: pair k moves as a force b_k / denom remove / h^2
     for (int k = 0; k < 3; ++k) {
       const double ws = slab_weight(fc.ids[k], fc.partner[k]);

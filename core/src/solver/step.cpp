@@ -671,7 +671,7 @@ void World::step(const StepControl& control) {
       if (track_pins_ && settings_.global_solve && settings_.realign_passes == 0) restart_pin_impulses();
       track_pins_ = false;
       catch_late_contacts();
-      apply_friction();
+      apply_friction(h);
       settle_contacts_on_surface();
       update_velocities(h);
       check_state_in_range();

@@ -5,7 +5,7 @@
 const koffi = require('koffi');
 
 // --- #define constants: ranges and limits, struct versions ---
-const ABI_VERSION = 1;
+const ABI_VERSION = 2;
 const MAX_ABS_VALUE = 1e300;
 const MIN_POSITIVE = 1e-300;
 const MAX_DT = 1e6;
@@ -19,6 +19,7 @@ const GLOBAL_SOLVE_AUTO = 2;
 const GLOBAL_SOLVE_AUTO_LIMIT = 20000;
 const SOLVER_DEF_VERSION = 2;
 const GROUP_DEF_VERSION = 1;
+const FRICTION_STRIBECK_SPEED = 0.01;
 const BODY_DEF_VERSION = 1;
 const CONSTRAINT_DEF_VERSION = 1;
 const CONSTRAINT_BATCH_DEF_VERSION = 1;
@@ -32,7 +33,7 @@ const SOLVE_RESIDUAL_TARGET_RAD = 1e-3;
 const SOLVE_RESIDUAL_TARGET_M3 = 1e-9;
 const SOLVE_WORST_RESIDUAL = 16;
 const SOLVE_DEF_VERSION = 1;
-const PANEL_MESH_DEF_VERSION = 1;
+const PANEL_MESH_DEF_VERSION = 2;
 const TOLERANCES_VERSION = 1;
 const PANEL_METRICS_VERSION = 1;
 const LOAD_OPTIONS_VERSION = 1;
@@ -118,6 +119,10 @@ const PANEL_PINS_NONE = 0;
 const PANEL_PINS_TOP_CORNERS = 1;
 const PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2;
 
+// --- EMBRA_PANEL_CORNERS_* ---
+const PANEL_CORNERS_WELDED = 0;
+const PANEL_CORNERS_SHARED = 1;
+
 // --- EMBRA_PANEL_METRIC_* ---
 const PANEL_METRIC_PLANARITY = 0;
 const PANEL_METRIC_THICKNESS = 1;
@@ -139,6 +144,7 @@ const SOLVE_UNTIL_NAMES = Object.freeze({ settled: 0, tolerance: 1 });
 const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_tolerance: 1, oscillating: 2, drifting: 3 });
 const AREA_LOAD_NAMES = Object.freeze({ normal: 0, true_area: 1, projected_area: 2 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
+const PANEL_CORNERS_NAMES = Object.freeze({ welded: 0, shared: 1 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
 const CUTS_NAMES = Object.freeze({ json: 0, csv: 1 });
 
@@ -412,6 +418,8 @@ const PanelMeshDef = koffi.struct('embra_panel_mesh_def', {
   friction_dynamic: 'double',
   slide_compliance: 'double',
   group: GroupIdType,
+  corners: 'int32_t',
+  reserved0: 'int32_t',
 });
 const Tolerance = koffi.struct('embra_tolerance', {
   target: 'double',
@@ -646,6 +654,7 @@ const PROTOTYPES = {
   embra_default_panel_mesh_def: 'embra_panel_mesh_def embra_default_panel_mesh_def(void)',
   embra_panel_mesh_create: 'embra_status embra_panel_mesh_create(embra_world *world, const embra_panel_mesh_def *def, _Out_ embra_body_id *out_body, _Out_ int32_t *out_first_particle)',
   embra_panel_mesh_get_panel_count: 'embra_status embra_panel_mesh_get_panel_count(const embra_world *world, embra_body_id body, _Out_ int32_t *out_count)',
+  embra_panel_mesh_get_corner_particles: 'embra_status embra_panel_mesh_get_corner_particles(const embra_world *world, embra_body_id body, int32_t *out, int64_t capacity, _Out_ int64_t *out_count)',
   embra_default_tolerances: 'embra_tolerances embra_default_tolerances(void)',
   embra_world_get_tolerances: 'embra_status embra_world_get_tolerances(const embra_world *world, _Out_ embra_tolerances *out_tolerances)',
   embra_world_set_tolerances: 'embra_status embra_world_set_tolerances(embra_world *world, const embra_tolerances *tolerances)',
@@ -684,7 +693,7 @@ module.exports = {
   koffi, STRUCTS, PROTOTYPES,
   ABI_VERSION, MAX_ABS_VALUE, MIN_POSITIVE, MAX_DT, MAX_UNIT_SCALE, MAX_PARTICLES, MAX_CONSTRAINTS,
   MAX_PASSES_PER_STEP, MAX_OBJ_BYTES, MAX_THREADS, GLOBAL_SOLVE_AUTO, GLOBAL_SOLVE_AUTO_LIMIT,
-  SOLVER_DEF_VERSION, GROUP_DEF_VERSION, BODY_DEF_VERSION, CONSTRAINT_DEF_VERSION,
+  SOLVER_DEF_VERSION, GROUP_DEF_VERSION, FRICTION_STRIBECK_SPEED, BODY_DEF_VERSION, CONSTRAINT_DEF_VERSION,
   CONSTRAINT_BATCH_DEF_VERSION, PIN_DEF_VERSION, SUPPORT_DEF_VERSION, POLYLINE_SUPPORT_DEF_VERSION,
   MESH_SUPPORT_DEF_VERSION, COLLIDER_DEF_VERSION, SOLVE_RESIDUAL_TARGET_M, SOLVE_RESIDUAL_TARGET_RAD,
   SOLVE_RESIDUAL_TARGET_M3, SOLVE_WORST_RESIDUAL, SOLVE_DEF_VERSION, PANEL_MESH_DEF_VERSION,
@@ -700,13 +709,14 @@ module.exports = {
   COLLIDER_BOX, COLLIDER_CAPSULE, COLLIDER_CONVEX, COLLIDER_MESH, RESIDUAL_PINS, RESIDUAL_CONTACTS,
   SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE,
   SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA,
-  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_METRIC_PLANARITY,
-  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
-  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
-  SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES,
-  GroupIdType, BodyIdType, PinIdType, ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef,
-  ConstraintDef, ConstraintBatchDef, BrokenConstraint, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef,
-  ColliderDef, StepReport, KindResidual, ConstraintResidual, GroupConflict, Reaction, ColliderReaction,
-  GroupReport, SolveDef, SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances,
-  MetricSummary, PanelMetrics, LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_CORNERS_WELDED,
+  PANEL_CORNERS_SHARED, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
+  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
+  PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES,
+  PANEL_PINS_NAMES, PANEL_CORNERS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType,
+  ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef,
+  BrokenConstraint, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef, ColliderDef, StepReport,
+  KindResidual, ConstraintResidual, GroupConflict, Reaction, ColliderReaction, GroupReport, SolveDef,
+  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
+  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

@@ -28,6 +28,7 @@ const SHAPES = capi.COLLIDER_NAMES;
 const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
+const PANEL_CORNERS = capi.PANEL_CORNERS_NAMES;
 const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
 const AREA_LOAD_MODES = capi.AREA_LOAD_NAMES;
 const AREA_LOAD_MODE_NAMES = Object.fromEntries(Object.entries(AREA_LOAD_MODES).map(([k, v]) => [v, k]));
@@ -533,11 +534,16 @@ class World {
 
   /** A body's triangles as world particle indices, 3 per triangle (an Int32Array). */
   bodyTriangles(body) {
+    return this.#bodyInt32s('embra_body_get_triangles', body);
+  }
+
+  /** A body's int32 list read by `fn` (asked for its count first), as an Int32Array. */
+  #bodyInt32s(fn, body) {
     const b = toId(body, BodyId, 'body');
     const n = [0];
-    this.#call('embra_body_get_triangles', b, null, 0, n);
+    this.#call(fn, b, null, 0, n);
     const out = new Int32Array(n[0]);
-    this.#call('embra_body_get_triangles', b, out, out.length, n);
+    this.#call(fn, b, out, out.length, n);
     return out;
   }
 
@@ -545,9 +551,10 @@ class World {
 
   /**
    * Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create) and returns its Body (8 particles
-   * per panel). settings: positions and quads (the top quad mesh: xyz per vertex, 4 indices per quad)
-   * or, without them, a grid of grid_columns x grid_rows panels of panel_size at origin; pins (a
-   * PANEL_PINS name or number); group; any other embra_panel_mesh_def field (thickness, mass, ...).
+   * per panel welded, 2 per vertex shared). settings: positions and quads (the top quad mesh: xyz per
+   * vertex, 4 indices per quad) or, without them, a grid of grid_columns x grid_rows panels of
+   * panel_size at origin; pins (a PANEL_PINS name or number); corners (a PANEL_CORNERS name or
+   * number); group; any other embra_panel_mesh_def field (thickness, mass, ...).
    */
   createPanelMesh(settings) {
     const o = options(settings, 'createPanelMesh settings');
@@ -555,6 +562,7 @@ class World {
     const positions = take(o, 'positions');
     const quads = take(o, 'quads');
     if (o.has('pins')) d.pins = enumValue(take(o, 'pins'), PANEL_PINS, 'pins');
+    if (o.has('corners')) d.corners = enumValue(take(o, 'corners'), PANEL_CORNERS, 'corners');
     for (const key of ['vertex_count', 'quad_count']) {
       if (o.has(key)) throw new TypeError(`createPanelMesh: ${key} is taken from positions and quads`);
     }
@@ -562,7 +570,6 @@ class World {
     if ((positions === undefined || positions === null) !== (quads === undefined || quads === null)) {
       throw new TypeError('createPanelMesh: positions and quads go together (neither: a grid)');
     }
-    let panels = d.grid_columns * d.grid_rows;
     if (positions !== undefined && positions !== null) {
       const xyz = buf.doublesIn(positions, 'positions');
       const q = buf.intsIn(quads, 'quads');
@@ -570,12 +577,20 @@ class World {
       d.vertex_count = xyzCount(xyz, 'positions');
       d.quads = q;
       d.quad_count = buf.int32(wholeTuples(q, 4, 'quads', 'indices'), 'quad count');
-      panels = d.quad_count;
     }
     const body = {};
     const first = [0];
     this.#call('embra_panel_mesh_create', d, body, first);
-    return new Body(new BodyId(body.index, body.generation), first[0], 8 * panels);
+    const id = new BodyId(body.index, body.generation);
+    return new Body(id, first[0], this.bodyParticles(id).count);
+  }
+
+  /**
+   * The world particle of each panel corner (embra_panel_mesh_get_corner_particles): an Int32Array of
+   * 8 a panel, its top corners 0-3 then its bottom corners 0-3.
+   */
+  panelCornerParticles(body) {
+    return this.#bodyInt32s('embra_panel_mesh_get_corner_particles', body);
   }
 
   /** The number of panels of a panel-mesh body. */
@@ -1598,6 +1613,6 @@ if (typeof Symbol.dispose === 'symbol') {
 }
 
 module.exports = {
-  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_METRICS, SOLVE_UNTIL,
+  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_CORNERS, PANEL_METRICS, SOLVE_UNTIL,
   CUTS_FORMATS, EmbraError, wrapIds,
 };

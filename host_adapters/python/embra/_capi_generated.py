@@ -7,7 +7,7 @@ import ctypes
 from ctypes import POINTER, c_char, c_char_p, c_double, c_int32, c_int64, c_uint32, c_void_p  # noqa: F401
 
 # --- #define constants: ranges and limits, struct versions ---
-ABI_VERSION = 1
+ABI_VERSION = 2
 MAX_ABS_VALUE = 1e300
 MIN_POSITIVE = 1e-300
 MAX_DT = 1e6
@@ -21,6 +21,7 @@ GLOBAL_SOLVE_AUTO = 2
 GLOBAL_SOLVE_AUTO_LIMIT = 20000
 SOLVER_DEF_VERSION = 2
 GROUP_DEF_VERSION = 1
+FRICTION_STRIBECK_SPEED = 0.01
 BODY_DEF_VERSION = 1
 CONSTRAINT_DEF_VERSION = 1
 CONSTRAINT_BATCH_DEF_VERSION = 1
@@ -34,7 +35,7 @@ SOLVE_RESIDUAL_TARGET_RAD = 1e-3
 SOLVE_RESIDUAL_TARGET_M3 = 1e-9
 SOLVE_WORST_RESIDUAL = 16
 SOLVE_DEF_VERSION = 1
-PANEL_MESH_DEF_VERSION = 1
+PANEL_MESH_DEF_VERSION = 2
 TOLERANCES_VERSION = 1
 PANEL_METRICS_VERSION = 1
 LOAD_OPTIONS_VERSION = 1
@@ -120,6 +121,10 @@ PANEL_PINS_NONE = 0
 PANEL_PINS_TOP_CORNERS = 1
 PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2
 
+# --- EMBRA_PANEL_CORNERS_* ---
+PANEL_CORNERS_WELDED = 0
+PANEL_CORNERS_SHARED = 1
+
 # --- EMBRA_PANEL_METRIC_* ---
 PANEL_METRIC_PLANARITY = 0
 PANEL_METRIC_THICKNESS = 1
@@ -141,6 +146,7 @@ SOLVE_UNTIL_NAMES = {"settled": 0, "tolerance": 1}
 SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "oscillating": 2, "drifting": 3}
 AREA_LOAD_NAMES = {"normal": 0, "true_area": 1, "projected_area": 2}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
+PANEL_CORNERS_NAMES = {"welded": 0, "shared": 1}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}
 CUTS_NAMES = {"json": 0, "csv": 1}
 
@@ -539,6 +545,8 @@ class PanelMeshDef(_Struct):
         ("friction_dynamic", c_double),
         ("slide_compliance", c_double),
         ("group", GroupId),
+        ("corners", c_int32),
+        ("reserved0", c_int32),
     ]
 
 
@@ -766,6 +774,7 @@ PROTOTYPES = {
     "embra_default_panel_mesh_def": (PanelMeshDef, []),
     "embra_panel_mesh_create": (c_int32, [c_void_p, POINTER(PanelMeshDef), POINTER(BodyId), POINTER(c_int32)]),
     "embra_panel_mesh_get_panel_count": (c_int32, [c_void_p, BodyId, POINTER(c_int32)]),
+    "embra_panel_mesh_get_corner_particles": (c_int32, [c_void_p, BodyId, POINTER(c_int32), c_int64, POINTER(c_int64)]),
     "embra_default_tolerances": (Tolerances, []),
     "embra_world_get_tolerances": (c_int32, [c_void_p, POINTER(Tolerances)]),
     "embra_world_set_tolerances": (c_int32, [c_void_p, POINTER(Tolerances)]),

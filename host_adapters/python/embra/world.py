@@ -27,6 +27,7 @@ SHAPES = dict(_capi.COLLIDER_NAMES)
 KINDS = dict(_capi.CONSTRAINT_NAMES)
 GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
+PANEL_CORNERS = dict(_capi.PANEL_CORNERS_NAMES)
 PIN_SUPPORTS = dict(_capi.PIN_SUPPORT_NAMES)
 AREA_LOAD_MODES = dict(_capi.AREA_LOAD_NAMES)
 AREA_LOAD_MODE_NAMES = {v: k for k, v in _capi.AREA_LOAD_NAMES.items()}
@@ -429,30 +430,36 @@ class World:
         self._call("embra_body_set_rest_scale", _id(body, BodyId, "body"), float(scale), float(scale_u),
                    float(scale_v))
 
-    def body_triangles(self, body):
-        """A body's triangles as world particle indices: numpy (t, 3) int32, or flat array('i')."""
+    def _body_int32s(self, function, body, width):
+        """A body's int32 list read by `function` (asked for its count first): numpy (n / width,
+        width) int32, or a flat array('i')."""
         b = _id(body, BodyId, "body")
         n = c_int64()
-        self._call("embra_body_get_triangles", b, None, 0, byref(n))
+        self._call(function, b, None, 0, byref(n))
         if buf.np is not None:
-            out = buf.np.empty((n.value // 3, 3), dtype=buf.np.int32)
+            out = buf.np.empty((n.value // width, width), dtype=buf.np.int32)
             pointer = out.ctypes.data_as(ctypes.POINTER(c_int32))
         else:
             from array import array
             out = array(buf._INT32_CODE, bytes(4 * n.value))
             pointer = ctypes.cast((c_int32 * n.value).from_buffer(out), ctypes.POINTER(c_int32))
-        self._call("embra_body_get_triangles", b, pointer, n.value, byref(n))
+        self._call(function, b, pointer, n.value, byref(n))
         return out
 
+    def body_triangles(self, body):
+        """A body's triangles as world particle indices: numpy (t, 3) int32, or flat array('i')."""
+        return self._body_int32s("embra_body_get_triangles", body, 3)
+
     # --- panel meshes --------------------------------------------------------------------------
-    def create_panel_mesh(self, positions=None, quads=None, *, pins=None, group=None, **fields):
+    def create_panel_mesh(self, positions=None, quads=None, *, pins=None, corners=None, group=None, **fields):
         """Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create) and returns its Body (id,
-        first particle, 8 particles per panel).
+        first particle, count: 8 particles per panel welded, 2 per vertex shared).
 
         positions and quads: the top quad mesh (xyz per vertex; 4 vertex indices per quad, flat,
         nested or numpy); without them, a grid of grid_columns x grid_rows square panels of
         panel_size at origin. pins: "none", "top_corners", "top_and_bottom_corners" or the number;
-        any other PanelMeshDef field as a keyword (thickness=0.01, mass=16.0, damping=9.0, ...)."""
+        corners: "welded" or "shared" (PANEL_CORNERS) or the number; any other PanelMeshDef field as
+        a keyword (thickness=0.01, mass=16.0, damping=9.0, ...)."""
         d = lib.embra_default_panel_mesh_def()
         _fill(d, fields, "PanelMeshDef")
         keep = []
@@ -473,11 +480,17 @@ class World:
             d.quads, d.quad_count = q, buf.int32(m // 4, "quad count")
         if pins is not None:
             d.pins = _enum(pins, PANEL_PINS, "pins")
+        if corners is not None:
+            d.corners = _enum(corners, PANEL_CORNERS, "corners")
         d.group = _id(group, GroupId, "group")
         body, first = BodyId(), c_int32()
         self._call("embra_panel_mesh_create", byref(d), byref(body), byref(first))
-        panels = d.quad_count if d.vertex_count else d.grid_columns * d.grid_rows
-        return Body(body, first.value, 8 * panels)
+        return Body(body, first.value, self.body_particles(body)[1])
+
+    def panel_corner_particles(self, body):
+        """The world particle of each panel corner (embra_panel_mesh_get_corner_particles): numpy
+        (panels, 8) int32 (top corners 0-3, then bottom corners 0-3), or a flat array('i')."""
+        return self._body_int32s("embra_panel_mesh_get_corner_particles", body, 8)
 
     def panel_count(self, body):
         """The number of panels of a panel-mesh body."""
@@ -1213,5 +1226,5 @@ class Solved:
         return text + ")"
 
 
-__all__ = ["World", "Body", "Solved", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_METRICS",
+__all__ = ["World", "Body", "Solved", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_CORNERS", "PANEL_METRICS",
            "CUTS_FORMATS", "SOLVE_UNTIL", "EmbraError"]

@@ -194,12 +194,27 @@ test('grid builder, pins, tolerances and a mesh of quads', () => {
   const w = new embra.World();
   try {
     const d = embra.defaultPanelMeshDef();
-    assert.deepEqual([d.version, d.grid_columns, d.grid_rows, d.pins], [1, 4, 4, embra.PANEL_PINS.none]);
+    assert.deepEqual([d.version, d.grid_columns, d.grid_rows], [embra.capi.PANEL_MESH_DEF_VERSION, 4, 4]);
+    assert.deepEqual([d.pins, d.corners], [embra.PANEL_PINS.none, embra.PANEL_CORNERS.welded]);
     assert.deepEqual([d.panel_size, d.thickness, d.density, d.slide_compliance], [0.8, 0.01, 1.0, 1e-3]);
     assert.deepEqual([d.friction_static, d.friction_dynamic], [0.5, 0.3]);
     assert.ok(d.group.equals(new embra.GroupId()));
+    // Corners shared: one top and one bottom particle per vertex of the 3 x 4 vertex grid, the panels
+    // on a vertex on the same particles (panel 0's corner 1 is panel 1's corner 0).
+    const ws = new embra.World();
+    try {
+      const shared = ws.createPanelMesh({ grid_columns: 2, grid_rows: 3, corners: 'shared' });
+      assert.deepEqual([shared.first, shared.count, ws.panelCount(shared)], [0, 24, 6]);
+      const c = ws.panelCornerParticles(shared);
+      assert.equal(c.length, 48);
+      assert.deepEqual([c[1], c[2], Math.max(...c)], [c[8 + 0], c[8 + 3], 23]);
+      assert.equal(ws.panelMetrics(shared).within_tolerance, 1);
+    } finally {
+      ws.close();
+    }
     const body = w.createPanelMesh({ grid_columns: 2, grid_rows: 3, pins: 'top_and_bottom_corners' });
     assert.deepEqual([body.first, body.count, w.panelCount(body)], [0, 48, 6]);
+    assert.deepEqual(Array.from(w.panelCornerParticles(body)), Array.from({ length: 48 }, (_, i) => i));
     assert.equal(w.counts().particles, 48);
     assert.equal(w.counts().pins, 8);
     let m = w.panelMetrics(body);

@@ -205,11 +205,21 @@ def test_vertex_errors_fill_a_numpy_array_in_place(scene):
 def test_grid_builder_pins_tolerances_and_a_mesh_of_quads():
     with embra.World() as w:
         d = embra.default_panel_mesh_def()
-        assert (d.version, d.grid_columns, d.grid_rows, d.pins) == (1, 4, 4, embra.PANEL_PINS["none"])
+        assert (d.version, d.grid_columns, d.grid_rows) == (embra._capi.PANEL_MESH_DEF_VERSION, 4, 4)
+        assert (d.pins, d.corners) == (embra.PANEL_PINS["none"], embra.PANEL_CORNERS["welded"])
         assert (d.panel_size, d.thickness, d.density, d.slide_compliance) == (0.8, 0.01, 1.0, 1e-3)
         assert (d.friction_static, d.friction_dynamic, d.group) == (0.5, 0.3, embra.GroupId())
+        # Corners shared: one top and one bottom particle per vertex of the 3 x 4 vertex grid, the
+        # panels on a vertex on the same particles (panel 0's corner 1 is panel 1's corner 0).
+        with embra.World() as ws:
+            shared = ws.create_panel_mesh(grid_columns=2, grid_rows=3, corners="shared")
+            assert (shared.first, shared.count) == (0, 24) and ws.panel_count(shared) == 6
+            c = [int(v) for v in flat(ws.panel_corner_particles(shared))]
+            assert len(c) == 48 and c[1] == c[8 + 0] and c[2] == c[8 + 3] and max(c) == 23
+            assert embra.as_dict(ws.panel_metrics(shared))["within_tolerance"] == 1
         body = w.create_panel_mesh(grid_columns=2, grid_rows=3, pins="top_and_bottom_corners")
         assert (body.first, body.count) == (0, 48) and w.panel_count(body) == 6
+        assert [int(v) for v in flat(w.panel_corner_particles(body))] == list(range(48))
         assert embra.as_dict(w.counts())["particles"] == 48 and w.counts().pins == 8
         m = embra.as_dict(w.panel_metrics(body))
         assert m["within_tolerance"] == 1 and m["miter"]["count"] == 2 * 4 + 3 * 3

@@ -28,6 +28,11 @@
 namespace embra {
 
 enum class PanelPins : int32_t { none = 0, top_corners = 1, top_and_bottom_corners = 2 };
+/// How the panels on one mesh vertex hold together: each panel with corners of its own, welded to
+/// the others' (8 particles a panel), or one top and one bottom particle a vertex that its panels
+/// share (2 a vertex, no welds: the offset quads of the panels round a vertex meet in one point, the
+/// paper's POQ condition, which asks the top mesh to stay conical).
+enum class PanelCorners : int32_t { welded = 0, shared = 1 };
 
 /// A metric's tolerance: its target and the end of its colour scale.
 struct Tolerance {
@@ -57,7 +62,8 @@ struct PanelMeshDesc {
   double friction_static = 0.5, friction_dynamic = 0.3;
   double slide_compliance = 1e-3;    // m/N of the soft distance from each bottom corner to its top corner
   PanelPins pins = PanelPins::none;  // hard pins at the mesh's corners (vertices on one panel only)
-  Id group;                          // group of every constraint; null = the default group
+  PanelCorners corners = PanelCorners::welded;
+  Id group;  // group of every constraint; null = the default group
   // The tolerances in force (the world's tolerance document; through the C ABI the one set with
   // embra_world_set_tolerances, in a scene its "tolerances"): a top quad is accepted when its
   // planarity (quad_planarity) is within its target. The corner distance (quad_corner_distance) is
@@ -65,11 +71,12 @@ struct PanelMeshDesc {
   Tolerances tolerances{};
 };
 
-/// Builds a panel mesh: one body (8 particles per panel, top and bottom triangles for drawing and
-/// face contact), its constraints, its pins and its layout. Every argument is checked first (a
-/// quad with a repeated or out-of-range vertex, a degenerate quad, a non-manifold edge, a
-/// non-positive thickness, a quad whose planarity is beyond the target of desc.tolerances are
-/// refused) and nothing changes on a refusal. Returns the body.
+/// Builds a panel mesh: one body (8 particles per panel welded, 2 per vertex shared; top and bottom
+/// triangles for drawing and face contact), its constraints, its pins and its layout. Every
+/// argument is checked first (a quad with a repeated or out-of-range vertex, a degenerate quad, a
+/// non-manifold edge, a non-positive thickness, a quad whose planarity is beyond the target of
+/// desc.tolerances, with shared corners a vertex on no quad, are refused) and nothing changes on a
+/// refusal. Returns the body.
 Id build_panel_mesh(World& world, const PanelMeshDesc& desc);
 
 /// The vertices (3 each) and quads (4 each) of an n x m grid of square panels of side `size` in the

@@ -58,6 +58,12 @@ struct Id {
   friend bool operator==(const Id&, const Id&) = default;
 };
 
+/// m/s: the slip speed over which friction falls from its static to its dynamic coefficient (to
+/// 1/e of the difference at this speed; Stribeck's curve without its viscous rise). Contacts at rest
+/// hold with the static coefficient, contacts sliding faster than a few times this speed with the
+/// dynamic one, and the change between them is continuous.
+constexpr double kFrictionStribeckSpeed = 0.01;
+
 struct Material {
   double mass = 0.0;                // kg for the whole body; used when > 0
   double density = 1.0;             // kg per unit of the body's measure (length, area or volume) otherwise
@@ -68,7 +74,7 @@ struct Material {
   double damping = 0.0;             // 1/s, velocity decay rate
   double thickness = 0.0;           // m, shell thickness: particles keep half of it off colliders
   double friction_static = 0.5;     // against colliders (geometric mean with the collider's)
-  double friction_dynamic = 0.3;
+  double friction_dynamic = 0.3;    // reached as the slip speed passes kFrictionStribeckSpeed
 };
 
 enum GenerateFlags : uint32_t {
@@ -603,11 +609,13 @@ struct Attachment {
 std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors,
                                                int32_t per_particle);
 
-/// A panel mesh (core/include/embra/core/panels.hpp): a body whose particles are its panels' corners,
-/// 8 per panel in panel order: the top quad's corners 0-3, then the bottom quad's corners 0-3 (the
-/// bottom layer, `thickness` below the top on the side opposite the top's normal). `quads` gives,
-/// per panel, the vertex of the top mesh each corner sits on (counter-clockwise seen from the top's
-/// normal side): corners of different panels on one mesh vertex are welded.
+/// A panel mesh (core/include/embra/core/panels.hpp): a body whose particles are its panels' corners.
+/// Welded (`shared` false): 8 per panel in panel order, the top quad's corners 0-3, then the bottom
+/// quad's corners 0-3 (the bottom layer, `thickness` below the top on the side opposite the top's
+/// normal); corners of different panels on one mesh vertex are welded. Shared: 2 per mesh vertex,
+/// the top layer's vertices 0 .. vertex_count - 1, then the bottom layer's in the same order; the
+/// panels on a vertex share its two particles. `quads` gives, per panel, the vertex of the top mesh
+/// each corner sits on (counter-clockwise seen from the top's normal side).
 struct PanelTopology;  // panels.hpp
 
 struct PanelLayout {
@@ -616,12 +624,23 @@ struct PanelLayout {
   int32_t vertex_count = 0;    // vertices of the top mesh
   std::vector<int32_t> quads;  // 4 mesh vertex indices per panel
   double thickness = 0.0;      // model units
+  bool shared = false;         // corners shared per mesh vertex (2 particles a vertex), else welded
   // Derived from the quads by World::set_panel_layout (panel_topology, panels.hpp) for the metrics;
   // null in a layout made by hand, for which the metrics derive it each time.
   std::shared_ptr<const PanelTopology> topology;
   int32_t panel_count() const { return static_cast<int32_t>(quads.size() / 4); }
-  int32_t top(int32_t panel, int corner) const { return first_particle + 8 * panel + corner; }
-  int32_t bottom(int32_t panel, int corner) const { return first_particle + 8 * panel + 4 + corner; }
+  int32_t top(int32_t panel, int corner) const {
+    return shared ? first_particle + quads[static_cast<size_t>(4 * panel + corner)]
+                  : first_particle + 8 * panel + corner;
+  }
+  int32_t bottom(int32_t panel, int corner) const {
+    return shared ? first_particle + vertex_count + quads[static_cast<size_t>(4 * panel + corner)]
+                  : first_particle + 8 * panel + 4 + corner;
+  }
+  /// Particles of the body: 8 a panel welded, 2 a vertex shared.
+  int64_t particle_count() const {
+    return shared ? 2 * int64_t{vertex_count} : 8 * static_cast<int64_t>(quads.size() / 4);
+  }
 };
 
 /// The projection kernels this machine runs: "avx2" (4 constraints at a time), "vec2" (2) or
@@ -909,7 +928,7 @@ class World {
   // The step's stages (step.cpp lists them in order).
   void begin_frame(const StepControl& control);
   void solve(double h, const StepControl& control);
-  void apply_friction();
+  void apply_friction(double h);
   void update_velocities(double h);
   // Throws Error(numerical), with a Warning, at the first particle whose position or velocity is
   // non-finite or beyond limits::kMaxAbsValue.
