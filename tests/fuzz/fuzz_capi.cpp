@@ -738,13 +738,16 @@ void Session::op_panel_mesh() {
   if (which & 32) d.friction_dynamic = in_.value();
   if (which & 64) d.slide_compliance = in_.value();
   if (in_.chance(2)) d.pins = in_.u8() % 5 - 1;
+  if (in_.chance(2)) d.corners = in_.u8() % 4 - 1;
+  if (in_.chance(32)) d.reserved0 = 1;
   if (in_.chance(2)) d.group = pick_id(in_, groups_);
   embra_body_id id{};
-  const embra_status s = call("embra_panel_mesh_create(vertices " + std::to_string(d.vertex_count) + ", quads " +
-                                  std::to_string(d.quad_count) + ", grid " + std::to_string(d.grid_columns) + " x " +
-                                  std::to_string(d.grid_rows) + ", size " + fmt(d.panel_size) + ", mask " +
-                                  std::to_string(which) + ", pins " + std::to_string(d.pins) + ")",
-                              true, [&] { return embra_panel_mesh_create(world_, &d, &id, nullptr); });
+  const embra_status s =
+      call("embra_panel_mesh_create(vertices " + std::to_string(d.vertex_count) + ", quads " +
+               std::to_string(d.quad_count) + ", grid " + std::to_string(d.grid_columns) + " x " +
+               std::to_string(d.grid_rows) + ", size " + fmt(d.panel_size) + ", mask " + std::to_string(which) +
+               ", pins " + std::to_string(d.pins) + ", corners " + std::to_string(d.corners) + ")",
+           true, [&] { return embra_panel_mesh_create(world_, &d, &id, nullptr); });
   if (s == EMBRA_OK) {
     bodies_.push_back(id);
     refresh_ids();  // the mesh's pins
@@ -877,6 +880,14 @@ void Session::op_read() {
       call("embra_panel_mesh_get_panel_count", false,
            [&] { return embra_panel_mesh_get_panel_count(world_, b, &panels); });
       call("embra_panel_mesh_get_corner_gap", false, [&] { return embra_panel_mesh_get_corner_gap(world_, b, &gap); });
+      int64_t n = 0;
+      if (call("embra_panel_mesh_get_corner_particles(count)", false,
+               [&] { return embra_panel_mesh_get_corner_particles(world_, b, nullptr, 0, &n); }) == EMBRA_OK) {
+        std::vector<int32_t> c(static_cast<size_t>(n) + 1);
+        const int64_t capacity = in_.chance(8) ? n - 1 : n;
+        call("embra_panel_mesh_get_corner_particles(capacity " + std::to_string(capacity) + ")", false,
+             [&] { return embra_panel_mesh_get_corner_particles(world_, b, c.data(), capacity, &n); });
+      }
       break;
     }
     case 11: {
