@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # The solver's kernel sets (scalar, 2-wide SSE2, 4-wide AVX2; chosen at run time, EMBRA_KERNELS
 # forces one) compute the same bits: a draped cloth (distance and dihedral kernels), a pinned cloth
-# (chain, dihedral and automatic tether kernels) and a panel mesh (distance, planarity and
-# plane-offset kernels, island by island) stepped with each set end in byte-identical final.json
-# files; so does the panel mesh with its rows in their passes instead (EMBRA_ISLANDS=off).
+# (chain, dihedral and automatic tether kernels), a welded panel mesh (distance, planarity and
+# plane-offset kernels, island by island) and one with its corners shared (the same kernels colour
+# by colour: its rows join every panel) stepped with each set end in byte-identical final.json
+# files; so do the panel meshes with their rows in their passes instead (EMBRA_ISLANDS=off).
 #
 # usage: kernels_same_bits.sh EMBRA_CLI SOURCE_DIR WORK_DIR
 set -u
 cli=$1 source=$2 work=$3
 mkdir -p "$work"
 fail=0
-for scene in examples/cloth_drape.json:60 tests/scenes/kernels/pinned_cloth.json:90 examples/large/poq_drape_16.json:40; do
+for scene in examples/cloth_drape.json:60 tests/scenes/kernels/pinned_cloth.json:90 examples/poq_drape.json:120 \
+  examples/large/poq_drape_16.json:40; do
   path=$source/${scene%%:*} frames=${scene##*:} name=$(basename "${scene%%:*}" .json)
   first=""
   for set in scalar vec2 avx2 passes; do
