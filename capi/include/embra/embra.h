@@ -1269,10 +1269,12 @@ EMBRA_API embra_status embra_world_write_obj(const embra_world* world, const cha
  * Panel meshes: Planar Offset Quads (the paper's section 4)
  *
  * A panel mesh is built from a quad mesh, the top layer, given as vertices and quads or as an
- * n x m grid of square panels. Each quad becomes a panel of its own, 8 particles in the body (panel
- * p: top corners first + 8p + 0..3, bottom corners first + 8p + 4..7, corner k on quad vertex k):
- * the top quad braced rigid (4 edges and 2 diagonals, hard) and held planar (EMBRA_CONSTRAINT_
- * PLANARITY), the corners of adjacent panels on one mesh vertex welded top and bottom (panels pivot
+ * n x m grid of square panels. Each quad becomes a panel, welded (the default: 8 particles of its
+ * own in the body; panel p: top corners first + 8p + 0..3, bottom corners first + 8p + 4..7, corner
+ * k on quad vertex k) or sharing its corners (2 particles a mesh vertex v: top first + v, bottom
+ * first + vertex_count + v; embra_panel_mesh_get_corner_particles gives either): the top quad
+ * braced rigid (4 edges and 2 diagonals, hard) and held planar (EMBRA_CONSTRAINT_PLANARITY),
+ * welded: the corners of adjacent panels on one mesh vertex welded top and bottom (panels pivot
  * about their borders), each bottom corner held `thickness` below the plane of its top corner's
  * triangle (EMBRA_CONSTRAINT_PLANE_OFFSET: it slides along it), every edge's joint (miter face:
  * the edge's two top and two bottom corners) held planar, and a soft distance from each bottom
