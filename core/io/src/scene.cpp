@@ -671,6 +671,16 @@ constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_botto
 /// The panel corners' names in the scene format, by PanelCorners.
 constexpr const char* kPanelCornersNames[] = {"welded", "shared"};
 
+/// The enumerator `o[key]` names in `names` (the schema has checked it is one of them), or `absent`
+/// when `o` has no `key`.
+template <class E, size_t N>
+E named_enum(const json& o, const char* key, const char* const (&names)[N], E absent) {
+  if (o.contains(key))
+    for (size_t k = 0; k < N; ++k)
+      if (o[key] == names[k]) return static_cast<E>(k);
+  return absent;
+}
+
 constexpr std::tuple kTolerancesRows{Row{"unit_scale", &Tolerances::unit_scale},
                                      Row{"planarity", &Tolerances::planarity},
                                      Row{"planarity_distance", &Tolerances::planarity_distance},
@@ -1046,9 +1056,7 @@ class Builder {
       AreaLoad a;
       for (int k = 0; k < 3; ++k)
         a.particles[k] = particle(w, l["particles"][k], at + "/particles/" + std::to_string(k));
-      if (l.contains("mode"))  // the schema has checked it is one of kAreaLoadModeNames
-        for (int k = 0; k < kAreaLoadModeCount; ++k)
-          if (l["mode"] == kAreaLoadModeNames[k]) a.mode = static_cast<AreaLoadMode>(k);
+      a.mode = named_enum(l, "mode", kAreaLoadModeNames, a.mode);
       a.pressure = l["pressure"].get<double>();
       if (l.contains("direction")) a.direction = vec3(l["direction"]);
       guard(at, [&] {
@@ -1397,14 +1405,6 @@ class Builder {
   /// A panel mesh: generated (grid, inline quads or an OBJ of quads) through build_panel_mesh, as a C
   /// host would; or, as a saved scene writes it, the layout of a body listed in "bodies" whose
   /// constraints and pins are listed in their own sections.
-  /// A panel mesh's "corners" (the schema has checked it is one of kPanelCornersNames).
-  static PanelCorners panel_corners(const json& p) {
-    if (p.contains("corners"))
-      for (int k = 0; k < static_cast<int>(std::size(kPanelCornersNames)); ++k)
-        if (p["corners"] == kPanelCornersNames[k]) return static_cast<PanelCorners>(k);
-    return PanelCorners::welded;
-  }
-
   void panel_mesh(World& w, const json& p, const std::string& at) {
     if (!p.contains("generator")) {
       PanelLayout l;
@@ -1413,7 +1413,7 @@ class Builder {
       for (const json& q : p["quads"])
         for (const json& v : q) l.quads.push_back(v.get<int32_t>());
       l.thickness = p["thickness"].get<double>();
-      l.shared = panel_corners(p) == PanelCorners::shared;
+      l.shared = named_enum(p, "corners", kPanelCornersNames, PanelCorners::welded) == PanelCorners::shared;
       guard(at, [&] {
         w.set_panel_layout(l);
         return 0;
@@ -1456,10 +1456,8 @@ class Builder {
     d.quads = quads;
     read_rows(kPanelMeshRows, p, d);
     if (doc_.contains("tolerances")) d.tolerances = parse_tolerances(doc_["tolerances"].dump());
-    if (p.contains("pins"))  // the schema has checked it is one of kPanelPinsNames
-      for (int k = 0; k < static_cast<int>(std::size(kPanelPinsNames)); ++k)
-        if (p["pins"] == kPanelPinsNames[k]) d.pins = static_cast<PanelPins>(k);
-    d.corners = panel_corners(p);
+    d.pins = named_enum(p, "pins", kPanelPinsNames, d.pins);
+    d.corners = named_enum(p, "corners", kPanelCornersNames, d.corners);
     d.group = group(p, "group", at);
     std::vector<bool> had(w.pins().size());
     for (size_t i = 0; i < w.pins().size(); ++i) had[i] = w.pins()[i].alive;
@@ -1511,9 +1509,7 @@ class Builder {
       d.particle = particles[i];
       d.target = w.positions()[particles[i]];
       read_rows(kPinRows, p, d);
-      if (p.contains("support"))  // the schema has checked it is one of kPinSupportNames
-        for (int k = 0; k < kPinSupportCount; ++k)
-          if (p["support"] == kPinSupportNames[k]) d.support = static_cast<PinSupport>(k);
+      d.support = named_enum(p, "support", kPinSupportNames, d.support);
       if (p.contains("axis")) d.axis = vec3(p["axis"]);
       if (p.contains("points"))
         for (const json& c : p["points"]) d.curve.push_back(vec3(c));

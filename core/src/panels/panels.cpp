@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -419,7 +420,15 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   const int32_t corners = static_cast<int32_t>(d.corners);
   if (corners < 0 || corners > 1) invalid("panel mesh corners must be 0 (welded) or 1 (shared)");
   const bool shared = d.corners == PanelCorners::shared;
-  const int64_t particles = shared ? 2 * nv : 8 * np;
+  if (nv > std::numeric_limits<int32_t>::max()) invalid("panel mesh has more vertices than an int32 counts");
+  // The layout first (body-local: first_particle 0 until the body exists): it places the particles
+  // and triangles, and says how many particles there are.
+  PanelLayout layout;
+  layout.vertex_count = static_cast<int32_t>(nv);
+  layout.quads.assign(d.quads.begin(), d.quads.end());
+  layout.thickness = d.thickness;
+  layout.shared = shared;
+  const int64_t particles = layout.particle_count();
   if (particles + world.particle_count() > limits::kMaxParticles)
     invalid("a world holds at most 2097152 particles; " + std::to_string(np) + " panels on " + std::to_string(nv) +
             " vertices (" + (shared ? "2 particles a vertex" : "8 particles a panel") + ") would make " +
@@ -607,13 +616,6 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   for (double s : area) total_area += s;
   std::vector<double> masses;
   std::vector<int32_t> triangles;
-  // The layout first (body-local: first_particle 0 until the body exists), so that particles and
-  // triangles are placed as its top() and bottom() say.
-  PanelLayout layout;
-  layout.vertex_count = static_cast<int32_t>(nv);
-  layout.quads.assign(d.quads.begin(), d.quads.end());
-  layout.thickness = d.thickness;
-  layout.shared = shared;
   xyz.assign(static_cast<size_t>(3 * particles), 0.0);
   masses.assign(static_cast<size_t>(particles), 0.0);
   for (int32_t q = 0; q < np; ++q) {
@@ -675,7 +677,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   add(Kind::distance, ids, rest, 0.0);
   // (b) welded: the corners on one vertex welded, top and bottom.
   ids.clear();
-  for (int64_t v = 0; v < nv && !shared; ++v)
+  for (int64_t v = 0; v < (shared ? 0 : nv); ++v)
     for (size_t f = 1; f < around[v].size(); ++f) {
       const auto [p0, k0] = around[v][0];
       const auto [p, k] = around[v][f];
