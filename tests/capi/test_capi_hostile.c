@@ -8,7 +8,7 @@
  * - a failed step with scene actions leaves the saved scene byte-identical;
  * - an empty world steps; a huge dt with self-collision fails cleanly;
  * - the limits on particles and on work per step are refused before anything is allocated;
- * - a cancel request stops the next step and changes nothing. */
+ * - a cancel request stops the next step and changes nothing, the last frame's contacts included. */
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -404,6 +404,32 @@ static void test_cancel_before_a_step(void) {
   embra_world_destroy(w);
 }
 
+/* A cloth landing on the floor: the saved world carries the last frame's contact forces, and a
+ * cancelled step keeps them. */
+static void test_cancel_keeps_the_contacts(void) {
+  embra_world* w = NULL;
+  embra_collider_def ground = embra_default_collider_def(); /* a plane, normal +z */
+  embra_collider_id cid;
+  int32_t first = 0;
+  char* before;
+  char* after;
+  CHECK_OK(embra_world_create(&w, NULL));
+  cloth(w, 0.1, 1.0, &first);
+  ground.position[2] = -0.001;
+  CHECK_OK(embra_collider_create(w, &ground, &cid));
+  CHECK_OK(embra_world_step(w));
+  CHECK_OK(embra_world_step(w));
+  before = capi_test_save(w);
+  CHECK(before != NULL && strstr(before, "\"force_h2\"") != NULL);
+  CHECK_OK(embra_world_cancel(w));
+  CHECK_STATUS(embra_world_step(w), EMBRA_ERROR_CANCELLED);
+  after = capi_test_save(w);
+  CHECK(before != NULL && after != NULL && strcmp(before, after) == 0);
+  free(before);
+  free(after);
+  embra_world_destroy(w);
+}
+
 int main(void) {
   if (embra_check_abi(EMBRA_ABI_VERSION) != EMBRA_OK) return 1;
   RUN(test_extreme_values_round_trip);
@@ -416,5 +442,6 @@ int main(void) {
   RUN(test_empty_world_steps);
   RUN(test_huge_dt_with_self_collision);
   RUN(test_cancel_before_a_step);
+  RUN(test_cancel_keeps_the_contacts);
   return capi_test_finish();
 }

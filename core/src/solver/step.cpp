@@ -580,6 +580,9 @@ World::FrameStart World::frame_start() const {
   FrameStart f;
   f.x = x_;
   f.v = v_;
+  if (settings_.contact_group.index < groups_.size()) f.contacts = groups_[settings_.contact_group.index].contacts;
+  f.self_contacts = self_contacts_;
+  f.face_contacts = face_contacts_;
   for (const Pin& p : pins_) {
     f.pin_lambda.push_back(p.lambda);
     f.pin_target.push_back(p.target);
@@ -620,8 +623,8 @@ void World::restore(const FrameStart& f) {
   }
   settings_.gravity = f.gravity;
   // The multipliers the reports read (forces, the worst constraints, reactions) go back to the last
-  // completed frame's (end_frame's copy, reversed); the failed frame's contacts are dropped (each
-  // substep finds them afresh).
+  // completed frame's (end_frame's copy, reversed), and so do the contacts (each substep finds its
+  // own afresh; the last completed frame's carry the forces that are saved and reported).
   for (Group& g : groups_) {
     for (int k = 0; k < kKindCount && !solver_dirty_; ++k) {
       SolverArray& a = g.solve[k];
@@ -635,8 +638,9 @@ void World::restore(const FrameStart& f) {
     }
     g.contacts.clear();
   }
-  face_contacts_.clear();
-  self_contacts_.clear();
+  if (settings_.contact_group.index < groups_.size()) groups_[settings_.contact_group.index].contacts = f.contacts;
+  face_contacts_ = f.face_contacts;
+  self_contacts_ = f.self_contacts;
 }
 
 void World::step(const StepControl& control) {

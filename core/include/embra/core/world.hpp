@@ -936,10 +936,14 @@ class World {
   void end_frame();
   void measure();
   void apply_plasticity();  // model/plasticity.cpp
-  /// What a frame that does not complete restores (step): the state, and the pin targets,
-  /// collider poses, gravity and rest scales that StepControl::before_frame may change.
+  /// What a frame that does not complete restores (step): the state, the last completed frame's
+  /// contacts (saved with the world: the statics read their forces), and the pin targets, collider
+  /// poses, gravity and rest scales that StepControl::before_frame may change.
   struct FrameStart {
     std::vector<Vec3> x, v;
+    std::vector<Contact> contacts;  // the contact group's
+    std::vector<SelfContact> self_contacts;
+    std::vector<FaceContact> face_contacts;
     std::vector<Vec3> pin_lambda, pin_target;
     std::vector<Vec3> collider_position;
     std::vector<Eigen::Quaterniond> collider_rotation;
