@@ -844,6 +844,7 @@ void World::set_panel_layout(const PanelLayout& layout) {
   copy.first_particle = b.first_particle;
   copy.topology = std::make_shared<const PanelTopology>(panel_topology(copy));
   panel_layouts_.push_back(std::move(copy));
+  solver_dirty_ = true;  // its panels may become islands (build_islands)
 }
 
 const PanelLayout* World::panel_layout(Id body_id) const {
@@ -1087,12 +1088,162 @@ class RestSurface {
   std::vector<int32_t> nbr_start_, nbr_, tri_, vt_start_, vt_, across_;
 };
 
+/// An island's rows in projection order: (row kind: 0 distance, 1 planarity, 2 plane offset; index
+/// into that kind's solver array).
+using IslandRows = std::vector<std::pair<int8_t, int32_t>>;
+constexpr Kind kIslandRowKinds[IslandPlan::kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
+
+/// The plan of `islands`, colour by colour: colour c holds islands [colour_start[c],
+/// colour_start[c + 1]), which share no particle. Islands of one shape (the rows' kinds on the
+/// same local particles, numbered by first use) go in items of up to kItemIslands, per colour.
+/// None when an island uses more than kSlots particles.
+IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector<IslandRows>& islands,
+                        const std::vector<int32_t>& colour_start) {
+  IslandPlan plan;
+  std::map<std::vector<int8_t>, int32_t> shape_of;
+  std::vector<int32_t> local(particle_count, -1);
+  plan.colour_start.push_back(0);
+  for (size_t c = 0; c + 1 < colour_start.size(); ++c) {
+    std::vector<int32_t> first(plan.shapes.size(), -1);  // per shape: its first island of this colour
+    for (int32_t is = colour_start[c]; is < colour_start[c + 1]; ++is) {
+      const IslandRows& list = islands[static_cast<size_t>(is)];
+      std::vector<int8_t> key, slots;
+      std::vector<int32_t> particles, row;
+      for (const auto& [kr, i] : list) {
+        const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
+        const int n = arity(kIslandRowKinds[kr]);
+        key.push_back(kr);
+        for (int j = 0; j < 4; ++j) {
+          int8_t slot = 0;
+          if (j < n) {
+            const int32_t p = a.ids[n * static_cast<size_t>(i) + j];
+            if (local[p] < 0) {
+              if (particles.size() == static_cast<size_t>(IslandPlan::kSlots)) return {};
+              local[p] = static_cast<int32_t>(particles.size());
+              particles.push_back(p);
+            }
+            slot = static_cast<int8_t>(local[p]);
+          }
+          slots.push_back(slot);
+          key.push_back(slot);
+        }
+        row.push_back(i);
+      }
+      for (int32_t q : particles) local[q] = -1;
+      key.push_back(static_cast<int8_t>(particles.size()));
+      const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(plan.shapes.size()));
+      if (fresh) {
+        IslandPlan::Shape shape;
+        shape.slots = static_cast<int32_t>(particles.size());
+        shape.steps = static_cast<int32_t>(list.size());
+        for (const auto& [kr, i] : list) shape.kind.push_back(kr);
+        shape.slot = slots;
+        plan.shapes.push_back(std::move(shape));
+        first.push_back(-1);
+      }
+      IslandPlan::Shape& shape = plan.shapes[it->second];
+      if (first[it->second] < 0) first[it->second] = static_cast<int32_t>(shape.islands());
+      shape.particle.insert(shape.particle.end(), particles.begin(), particles.end());
+      shape.row.insert(shape.row.end(), row.begin(), row.end());
+    }
+    for (size_t sh = 0; sh < plan.shapes.size(); ++sh) {
+      if (first[sh] < 0) continue;
+      const int32_t count = static_cast<int32_t>(plan.shapes[sh].islands());
+      for (int32_t at = first[sh]; at < count; at += IslandPlan::kItemIslands)
+        plan.items.push_back({static_cast<int32_t>(sh), at, std::min(IslandPlan::kItemIslands, count - at)});
+    }
+    plan.colour_start.push_back(static_cast<int32_t>(plan.items.size()));
+  }
+  return plan;
+}
+
+/// The rows as the panels of panel meshes with shared corners hold them: each row goes to the
+/// first panel (in layout, then panel order) whose 8 corner particles hold all its particles, each
+/// panel's rows by kind and then in the order they were added (so panels alike have one shape),
+/// and the panels coloured greedily, in order, so that no two of a colour share a corner particle
+/// (four colours on a grid). False when a row lies in no panel or a panel holds over kSteps rows.
+bool panel_islands(const Group& g, size_t particle_count, const std::vector<PanelLayout>& layouts,
+                   std::vector<IslandRows>& islands, std::vector<int32_t>& colour_start) {
+  std::vector<std::array<int32_t, 8>> cells;
+  for (const PanelLayout& l : layouts) {
+    if (!l.shared) continue;
+    for (int32_t p = 0; p < l.panel_count(); ++p) {
+      std::array<int32_t, 8> cell{};
+      for (int k = 0; k < 4; ++k) cell[k] = l.top(p, k), cell[4 + k] = l.bottom(p, k);
+      if (std::all_of(cell.begin(), cell.end(),
+                      [&](int32_t q) { return q >= 0 && static_cast<size_t>(q) < particle_count; }))
+        cells.push_back(cell);
+    }
+  }
+  if (cells.empty()) return false;
+  // The cells on each particle (compressed rows).
+  std::vector<int32_t> start(particle_count + 1, 0), on;
+  for (const auto& cell : cells)
+    for (int32_t q : cell) ++start[static_cast<size_t>(q) + 1];
+  for (size_t i = 0; i < particle_count; ++i) start[i + 1] += start[i];
+  on.resize(static_cast<size_t>(start.back()));
+  std::vector<int32_t> fill(start.begin(), start.end() - 1);
+  for (size_t c = 0; c < cells.size(); ++c)
+    for (int32_t q : cells[c]) on[static_cast<size_t>(fill[static_cast<size_t>(q)]++)] = static_cast<int32_t>(c);
+  // Each row to its first cell; per cell (row kind, the row's constraint index, its solver index).
+  std::vector<std::vector<std::array<int32_t, 3>>> rows_of(cells.size());
+  for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
+    const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
+    const int n = arity(kIslandRowKinds[kr]);
+    for (size_t i = 0; i < a.size(); ++i) {
+      const int32_t* ids = &a.ids[n * i];
+      int32_t home = -1;
+      for (int32_t at = start[static_cast<size_t>(ids[0])]; at < start[static_cast<size_t>(ids[0]) + 1] && home < 0;
+           ++at) {
+        const auto& cell = cells[static_cast<size_t>(on[static_cast<size_t>(at)])];
+        bool all = true;
+        for (int j = 1; j < n && all; ++j) all = std::find(cell.begin(), cell.end(), ids[j]) != cell.end();
+        if (all) home = on[static_cast<size_t>(at)];
+      }
+      if (home < 0) return false;
+      auto& list = rows_of[static_cast<size_t>(home)];
+      list.push_back({kr, a.source[i], static_cast<int32_t>(i)});
+      if (list.size() > static_cast<size_t>(IslandPlan::kSteps)) return false;
+    }
+  }
+  // Greedy colours: each cell with rows takes the first colour none of its coloured neighbours has.
+  std::vector<int8_t> colour(cells.size(), -1);
+  int colours = 0;
+  for (size_t c = 0; c < cells.size(); ++c) {
+    if (rows_of[c].empty()) continue;
+    uint64_t taken = 0;
+    for (int32_t q : cells[c])
+      for (int32_t at = start[static_cast<size_t>(q)]; at < start[static_cast<size_t>(q) + 1]; ++at)
+        if (const int8_t k = colour[static_cast<size_t>(on[static_cast<size_t>(at)])]; k >= 0)
+          taken |= uint64_t{1} << k;
+    const int k = std::countr_one(taken);
+    if (k >= 64) return false;
+    colour[c] = static_cast<int8_t>(k);
+    colours = std::max(colours, k + 1);
+  }
+  islands.clear();
+  colour_start.assign(1, 0);
+  for (int k = 0; k < colours; ++k) {
+    for (size_t c = 0; c < cells.size(); ++c) {
+      if (colour[c] != k) continue;
+      auto list = rows_of[c];
+      std::sort(list.begin(), list.end());
+      IslandRows& rows = islands.emplace_back();
+      for (const auto& r : list) rows.emplace_back(static_cast<int8_t>(r[0]), r[2]);
+    }
+    colour_start.push_back(static_cast<int32_t>(islands.size()));
+  }
+  return true;
+}
+
 /// The group's distance, planarity and plane-offset rows as islands (IslandPlan), or none when they
-/// do not form small islands, when another kind is projected between them, or when the distances
-/// are chained (their first pass is the chain pass). The kinds World::project_group projects before
-/// the distances are listed here: any other kind with rows keeps the passes.
-IslandPlan build_islands(const Group& g, size_t particle_count) {
-  constexpr Kind kRowKinds[IslandPlan::kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
+/// do not form islands or when another kind is projected between them. Islands are the sets of rows
+/// joined by shared particles when each is small and the distances are not chained (a panel mesh
+/// with welded corners: its panels, in one colour), else a panel mesh's panels with shared corners,
+/// coloured (panel_islands), whose plan takes the place of the distances' chains (the caller drops
+/// them). The kinds World::project_group projects before the distances are listed here: any other
+/// kind with rows keeps the passes.
+IslandPlan build_islands(const Group& g, size_t particle_count, const std::vector<PanelLayout>& layouts) {
   for (int k = 0; k < kKindCount; ++k) {
     const Kind kind = static_cast<Kind>(k);
     const bool before =
@@ -1100,7 +1251,6 @@ IslandPlan build_islands(const Group& g, size_t particle_count) {
     const bool row = kind == Kind::distance || kind == Kind::planarity || kind == Kind::plane_offset;
     if (!before && !row && g.solve[k].size() > 0) return {};
   }
-  if (!g.solve[static_cast<int>(Kind::distance)].chain_start.empty()) return {};
   // Union-find over the particles the rows join.
   std::vector<int32_t> parent(particle_count, -1);
   auto find = [&](int32_t p) {
@@ -1114,7 +1264,7 @@ IslandPlan build_islands(const Group& g, size_t particle_count) {
     return r;
   };
   size_t rows = 0;
-  for (Kind kind : kRowKinds) {
+  for (Kind kind : kIslandRowKinds) {
     const SolverArray& a = g.solve[static_cast<int>(kind)];
     const int n = arity(kind);
     rows += a.size();
@@ -1127,68 +1277,28 @@ IslandPlan build_islands(const Group& g, size_t particle_count) {
   if (rows == 0) return {};
   // Each island's rows in the passes' order, islands in the order of their first row.
   std::vector<int32_t> island_of(particle_count, -1);
-  std::vector<std::vector<std::pair<int8_t, int32_t>>> island_rows;
-  for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
-    const SolverArray& a = g.solve[static_cast<int>(kRowKinds[kr])];
-    const int n = arity(kRowKinds[kr]);
-    for (size_t i = 0; i < a.size(); ++i) {
+  std::vector<IslandRows> islands;
+  bool small = g.solve[static_cast<int>(Kind::distance)].chain_start.empty();
+  for (int kr = 0; kr < IslandPlan::kRowKinds && small; ++kr) {
+    const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
+    const int n = arity(kIslandRowKinds[kr]);
+    for (size_t i = 0; i < a.size() && small; ++i) {
       int32_t& island = island_of[find(a.ids[n * i])];
       if (island < 0) {
-        island = static_cast<int32_t>(island_rows.size());
-        island_rows.emplace_back();
+        island = static_cast<int32_t>(islands.size());
+        islands.emplace_back();
       }
-      island_rows[island].emplace_back(static_cast<int8_t>(kr), static_cast<int32_t>(i));
-      if (island_rows[island].size() > static_cast<size_t>(IslandPlan::kSteps)) return {};
+      islands[island].emplace_back(static_cast<int8_t>(kr), static_cast<int32_t>(i));
+      small = islands[island].size() <= static_cast<size_t>(IslandPlan::kSteps);
     }
   }
-  IslandPlan plan;
-  // Shapes: the rows' kinds and local particles (numbered by first use), islands grouped by shape.
-  std::map<std::vector<int8_t>, int32_t> shape_of;
-  std::vector<int32_t> local(particle_count, -1);
-  for (const auto& list : island_rows) {
-    std::vector<int8_t> key, slots;
-    std::vector<int32_t> particles, row;
-    for (const auto& [kr, i] : list) {
-      const SolverArray& a = g.solve[static_cast<int>(kRowKinds[kr])];
-      const int n = arity(kRowKinds[kr]);
-      key.push_back(kr);
-      for (int j = 0; j < 4; ++j) {
-        int8_t slot = 0;
-        if (j < n) {
-          const int32_t p = a.ids[n * static_cast<size_t>(i) + j];
-          if (local[p] < 0) {
-            if (particles.size() == static_cast<size_t>(IslandPlan::kSlots)) return {};
-            local[p] = static_cast<int32_t>(particles.size());
-            particles.push_back(p);
-          }
-          slot = static_cast<int8_t>(local[p]);
-        }
-        slots.push_back(slot);
-        key.push_back(slot);
-      }
-      row.push_back(i);
-    }
-    for (int32_t q : particles) local[q] = -1;
-    key.push_back(static_cast<int8_t>(particles.size()));
-    const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(plan.shapes.size()));
-    if (fresh) {
-      IslandPlan::Shape shape;
-      shape.slots = static_cast<int32_t>(particles.size());
-      shape.steps = static_cast<int32_t>(list.size());
-      for (const auto& [kr, i] : list) shape.kind.push_back(kr);
-      shape.slot = slots;
-      plan.shapes.push_back(std::move(shape));
-    }
-    IslandPlan::Shape& shape = plan.shapes[it->second];
-    shape.particle.insert(shape.particle.end(), particles.begin(), particles.end());
-    shape.row.insert(shape.row.end(), row.begin(), row.end());
+  if (small) {
+    IslandPlan plan = plan_islands(g, particle_count, islands, {0, static_cast<int32_t>(islands.size())});
+    if (plan.active()) return plan;
   }
-  for (size_t sh = 0; sh < plan.shapes.size(); ++sh) {
-    const int32_t count = static_cast<int32_t>(plan.shapes[sh].islands());
-    for (int32_t first = 0; first < count; first += IslandPlan::kItemIslands)
-      plan.items.push_back({static_cast<int32_t>(sh), first, std::min(IslandPlan::kItemIslands, count - first)});
-  }
-  return plan;
+  std::vector<int32_t> colour_start;
+  if (!panel_islands(g, particle_count, layouts, islands, colour_start)) return {};
+  return plan_islands(g, particle_count, islands, colour_start);
 }
 
 }  // namespace
@@ -1429,7 +1539,15 @@ void World::rebuild_solver() {
       }
     }
     g.tethers = SolverArray{};
-    g.islands = build_islands(g, x_.size());
+    g.islands = build_islands(g, x_.size(), panel_layouts_);
+    if (g.islands.active()) {  // a panel mesh with shared corners: its panels, not its edges' runs
+      SolverArray& sa = g.solve[static_cast<int>(Kind::distance)];
+      sa.chain_start.clear();
+      sa.chain_edge.clear();
+      sa.chain_part.clear();
+      sa.chain_colour_start.clear();
+      sa.chain_shared_tail = false;
+    }
   }
   // Automatic long-range attachments: every particle of an inextensible body to its nearest
   // anchors (hard-pinned or immovable particles of the body), in the body's stretch group.

@@ -184,9 +184,11 @@ namespace {
 /// One projection of a face contact (hard, unilateral: C = gap >= 0, grad_k C = b_k n, corner k and
 /// its partner across the thickness moving as one particle of their joint mass, `weight`): lambda
 /// accumulates the push. Returns the push added (0: none) and, in `normal_force`, the force it adds on
-/// the movable corner pairs times h^2 (sum over them of b_k, times the push, along n).
+/// the movable corner pairs times h^2 (sum over them of b_k, times the push, along n). With
+/// `push_only`, a face that is not inside is left where it is.
 template <class Weight>
-double project_face(FaceContact& fc, const Collider& col, std::vector<Vec3>& x, Weight weight, Vec3& normal_force) {
+double project_face(FaceContact& fc, const Collider& col, std::vector<Vec3>& x, Weight weight, Vec3& normal_force,
+                    bool push_only = false) {
   const Vec3& a = x[fc.ids[0]];
   const Vec3& b = x[fc.ids[1]];
   const Vec3& c = x[fc.ids[2]];
@@ -197,6 +199,7 @@ double project_face(FaceContact& fc, const Collider& col, std::vector<Vec3>& x, 
   if (!(len > 1e-12)) return 0.0;
   const Vec3 n = d / len;
   const double gap = len - (col.desc.radius + col.desc.thickness);
+  if (push_only && !(gap < 0.0)) return 0.0;
   double ws[3], denom = 0.0, share = 0.0;
   for (int k = 0; k < 3; ++k) {
     ws[k] = weight(fc.ids[k], fc.partner[k]);
@@ -332,11 +335,14 @@ void World::settle_contacts_on_surface() {
     }
   }
   // Face contacts likewise: friction moves a face's corners by their weights in the contact point,
-  // and where panels share corners that tilts their other faces; each face is projected once more.
+  // and where panels share corners that tilts their other faces; each face inside is pushed out once
+  // more. Pushed only: a face outside with a multiplier left is not pulled back onto the surface
+  // here, as a projection would, since that pulls the corners it shares with faces already settled
+  // back into the sphere (by 1.7e-6 m on the 32 x 32 drape).
   const auto weight = [this](int32_t a, int32_t b) { return slab_weight(a, b); };
   for (FaceContact& fc : face_contacts_) {
     Vec3 push = Vec3::Zero();
-    if (project_face(fc, colliders_[fc.collider], x_, weight, push) != 0.0) fc.force_h2 += push;
+    if (project_face(fc, colliders_[fc.collider], x_, weight, push, true) != 0.0) fc.force_h2 += push;
   }
 }
 

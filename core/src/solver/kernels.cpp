@@ -233,62 +233,74 @@ EMBRA_ALWAYS_INLINE void offset_block(const int32_t* ids, const double* rest, co
   scatter4<T>(ids, ok, o.lam + dl, o.p, o.wk, dl, g, lambda, x);
 }
 
-/// Islands (IslandPlan) first .. first + lanes - 1 of one shape, one per lane: their particles
-/// loaded once, every row projected in turn on the particles in registers (distance_step and
-/// offset_step, as the passes project them), each row's new multiplier stored, the movable particles
-/// stored once at the end.
-template <class T>
+/// Islands (IslandPlan) first .. first + kBlocks * lanes - 1 of one shape, one per lane: their
+/// particles loaded once, every row projected in turn on the particles in registers (distance_step
+/// and offset_step, as the passes project them), each row's new multiplier stored, the movable
+/// particles stored once at the end. An island's rows depend each on the last (a chain of square
+/// roots and divisions): kBlocks blocks of lanes go step by step side by side, so that one block's
+/// latency hides behind the others' work.
+template <class T, int kBlocks>
 EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t first, SolverArray* const* rows,
                                       double inv_h2, double* x, const double* w) {
   using namespace lanes;
   using L = Lanes<T>;
   const int slots = shape.slots, steps = shape.steps;
-  V3<T> p[IslandPlan::kSlots];
-  T wp[IslandPlan::kSlots];
-  const int32_t* ids = &shape.particle[first * static_cast<size_t>(slots)];
-  for (int k = 0; k < slots; ++k) {
-    p[k] = load_point<T>(x, ids + k, slots);
-    wp[k] = load_value<T>(w, ids + k, slots);
+  V3<T> p[kBlocks][IslandPlan::kSlots];
+  T wp[kBlocks][IslandPlan::kSlots];
+  const int32_t* ids[kBlocks];
+  const int32_t* row[kBlocks];
+  for (int b = 0; b < kBlocks; ++b) {
+    const size_t at = first + static_cast<size_t>(b * L::count);
+    ids[b] = &shape.particle[at * static_cast<size_t>(slots)];
+    row[b] = &shape.row[at * static_cast<size_t>(steps)];
+    for (int k = 0; k < slots; ++k) {
+      p[b][k] = load_point<T>(x, ids[b] + k, slots);
+      wp[b][k] = load_value<T>(w, ids[b] + k, slots);
+    }
   }
-  const int32_t* row = &shape.row[first * static_cast<size_t>(steps)];
   for (int step = 0; step < steps; ++step) {
     SolverArray& a = *rows[shape.kind[step]];
-    const int32_t* at = row + step;  // lane l's row: at[l * steps]
-    const T r = load_value<T>(a.rest.data(), at, steps), lam = load_value<T>(a.lambda.data(), at, steps);
-    const T alpha = load_value<T>(a.compliance.data(), at, steps) * inv_h2;
     const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
-    T lam_new;
-    decltype(T{} > 0.0) ok;  // the lanes where the row applies
-    if (shape.kind[step] == 0) {
-      V3<T> d;
-      T s0, s1;
-      ok = distance_step<T, false>(p[sl[0]], p[sl[1]], wp[sl[0]], wp[sl[1]], r, lam, alpha, d, s0, s1, lam_new);
-      p[sl[0]] = select3(ok & (wp[sl[0]] != 0.0), p[sl[0]] + s0 * d, p[sl[0]]);
-      p[sl[1]] = select3(ok & (wp[sl[1]] != 0.0), p[sl[1]] - s1 * d, p[sl[1]]);
-    } else {
-      const V3<T> q[4] = {p[sl[0]], p[sl[1]], p[sl[2]], p[sl[3]]};
-      const T wk[4] = {wp[sl[0]], wp[sl[1]], wp[sl[2]], wp[sl[3]]};
-      V3<T> g[4];
-      T dl;
-      ok = shape.kind[step] == 1 ? offset_step<T, true>(q, wk, r, lam, alpha, g, dl)
-                                 : offset_step<T, false>(q, wk, r, lam, alpha, g, dl);
-      for (int k = 0; k < 4; ++k) p[sl[k]] = select3(ok & (wk[k] != 0.0), q[k] + (wk[k] * dl) * g[k], q[k]);
-      lam_new = lam + dl;
+    for (int b = 0; b < kBlocks; ++b) {
+      const int32_t* at = row[b] + step;  // lane l's row: at[l * steps]
+      const T r = load_value<T>(a.rest.data(), at, steps), lam = load_value<T>(a.lambda.data(), at, steps);
+      const T alpha = load_value<T>(a.compliance.data(), at, steps) * inv_h2;
+      V3<T>* q = p[b];
+      const T* wq = wp[b];
+      T lam_new;
+      decltype(T{} > 0.0) ok;  // the lanes where the row applies
+      if (shape.kind[step] == 0) {
+        V3<T> d;
+        T s0, s1;
+        ok = distance_step<T, false>(q[sl[0]], q[sl[1]], wq[sl[0]], wq[sl[1]], r, lam, alpha, d, s0, s1, lam_new);
+        q[sl[0]] = select3(ok & (wq[sl[0]] != 0.0), q[sl[0]] + s0 * d, q[sl[0]]);
+        q[sl[1]] = select3(ok & (wq[sl[1]] != 0.0), q[sl[1]] - s1 * d, q[sl[1]]);
+      } else {
+        const V3<T> o[4] = {q[sl[0]], q[sl[1]], q[sl[2]], q[sl[3]]};
+        const T wk[4] = {wq[sl[0]], wq[sl[1]], wq[sl[2]], wq[sl[3]]};
+        V3<T> g[4];
+        T dl;
+        ok = shape.kind[step] == 1 ? offset_step<T, true>(o, wk, r, lam, alpha, g, dl)
+                                   : offset_step<T, false>(o, wk, r, lam, alpha, g, dl);
+        for (int k = 0; k < 4; ++k) q[sl[k]] = select3(ok & (wk[k] != 0.0), o[k] + (wk[k] * dl) * g[k], o[k]);
+        lam_new = lam + dl;
+      }
+      for (int l = 0; l < L::count; ++l)
+        if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
     }
-    for (int l = 0; l < L::count; ++l)
-      if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
   }
-  for (int k = 0; k < slots; ++k) {
-    alignas(32) double to[L::count][4];
-    transpose(p[k], to);
-    for (int l = 0; l < L::count; ++l)  // an immovable particle is not written
-      if (L::get(wp[k], l) != 0.0)
-        std::memcpy(x + 3 * static_cast<int64_t>(ids[l * slots + k]), to[l], 3 * sizeof(double));
-  }
+  for (int b = 0; b < kBlocks; ++b)
+    for (int k = 0; k < slots; ++k) {
+      alignas(32) double to[L::count][4];
+      transpose(p[b][k], to);
+      for (int l = 0; l < L::count; ++l)  // an immovable particle is not written
+        if (L::get(wp[b][k], l) != 0.0)
+          std::memcpy(x + 3 * static_cast<int64_t>(ids[b][l * slots + k]), to[l], 3 * sizeof(double));
+    }
 }
 
-/// The islands of items [begin, end) (IslandPlan::items): in lanes of T while an item has that many
-/// left, then one at a time.
+/// The islands of items [begin, end) (IslandPlan::items): in two blocks of lanes of T side by side
+/// while an item has that many left, then one block, then one at a time.
 template <class T>
 EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows,
                                       double inv_h2, double* x, const double* w) {
@@ -297,9 +309,11 @@ EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size
     const IslandPlan::Item& item = plan.items[i];
     const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
     int k = 0;
+    for (; k + 2 * lanes_n <= item.count; k += 2 * lanes_n)
+      island_block<T, 2>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
     for (; k + lanes_n <= item.count; k += lanes_n)
-      island_block<T>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
-    for (; k < item.count; ++k) island_block<double>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
+      island_block<T, 1>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
+    for (; k < item.count; ++k) island_block<double, 1>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
   }
 }
 
@@ -838,14 +852,42 @@ Kernels pick_kernels() {
 #endif
 }
 
+/// EMBRA_ISLANDS=rows: the pass kernels islands_by_rows projects with (distance, planarity, plane
+/// offset), set once by kernels().
+Kernels::Pass row_kernels[IslandPlan::kRowKinds] = {};
+
+/// The islands of items [begin, end), their rows one at a time in the islands' order with the pass
+/// kernels (EMBRA_ISLANDS=rows): what the island kernels must match bit for bit.
+void islands_by_rows(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2,
+                     double* x, const double* w) {
+  for (size_t i = begin; i < end; ++i) {
+    const IslandPlan::Item& item = plan.items[i];
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    const size_t steps = static_cast<size_t>(shape.steps);
+    for (int32_t island = item.first; island < item.first + item.count; ++island)
+      for (size_t step = 0; step < steps; ++step) {
+        const int kind = shape.kind[step];
+        const size_t row = static_cast<size_t>(shape.row[static_cast<size_t>(island) * steps + step]);
+        row_kernels[kind](*rows[kind], row, row + 1, false, inv_h2, x, w);
+      }
+  }
+}
+
 }  // namespace
 
 const Kernels& kernels() {
   static const Kernels chosen = [] {
     Kernels k = pick_kernels();
-    // EMBRA_ISLANDS=off: the rows of islands in their passes instead (the same bits, to check that).
+    // EMBRA_ISLANDS=off: the rows of islands in their passes instead (the same bits for welded
+    // panels, to check that); =rows: the islands' rows one at a time with the pass kernels.
     const char* islands = std::getenv("EMBRA_ISLANDS");
     if (islands != nullptr && std::string(islands) == "off") k.islands = nullptr;
+    if (islands != nullptr && std::string(islands) == "rows") {
+      row_kernels[0] = k.distance;
+      row_kernels[1] = k.planarity;
+      row_kernels[2] = k.plane_offset;
+      k.islands = islands_by_rows;
+    }
     return k;
   }();
   return chosen;
@@ -858,8 +900,8 @@ using passes::kAlign;
 using passes::kChainGrain;
 using passes::kGrain;
 
-/// Island items (of four panels' rows, about 70 rows) per thread below which the loop is not split.
-constexpr size_t kIslandGrain = 8;
+/// Island items (eight panels each: 100-150 rows) per thread below which the loop is not split.
+constexpr size_t kIslandGrain = 4;
 
 }  // namespace
 
@@ -892,8 +934,9 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
 void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w) {
   const Kernels& k = kernels();
-  pool.run(0, plan.items.size(), 1, kIslandGrain,
-           [&](size_t b, size_t e, int) { k.islands(plan, b, e, rows, inv_h2, x, w); });
+  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c)
+    pool.run(static_cast<size_t>(plan.colour_start[c]), static_cast<size_t>(plan.colour_start[c + 1]), 1, kIslandGrain,
+             [&](size_t b, size_t e, int) { k.islands(plan, b, e, rows, inv_h2, x, w); });
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

@@ -131,8 +131,8 @@ void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, cons
                 std::vector<double>& scratch, ChainTrack* track = nullptr);
 /// Every automatic tether run of `t` (runs share no particle).
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
-/// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), the
-/// items split over the pool's threads (islands share no particle).
+/// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), colour
+/// by colour, each colour's items split over the pool's threads (its islands share no particle).
 void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w);
 /// The function values of every constraint of `a` into out[0 .. a.size()).

@@ -84,6 +84,47 @@ void kernel_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double 
       [&](size_t b, size_t e, bool in_lanes, int) { kernel(a, b, e, in_lanes, inv_h2, coords(x), w); }, track);
 }
 
+/// The tracked substep of islands in colours (IslandPlan: panels sharing their corners), whose order
+/// the passes would not keep: the islands' rows one at a time in the islands' order, on the caller,
+/// with the hard pins' shares tracked around each row that holds a pinned particle (PinTrack). The
+/// pass kernels give a row the bits the island kernels give it.
+void tracked_islands(const IslandPlan& plan, SolverArray* const* rows, double inv_h2, std::vector<Vec3>& x,
+                     const double* w, std::vector<Pin>& pins) {
+  const Kernels& k = kernels();
+  const Kernels::Pass pass[IslandPlan::kRowKinds] = {k.distance, k.planarity, k.plane_offset};
+  PinTrack<Kind::distance> distance(*rows[0], x, pins);
+  PinTrack<Kind::planarity> planarity(*rows[1], x, pins);
+  PinTrack<Kind::plane_offset> offset(*rows[2], x, pins);
+  std::vector<uint8_t> pinned[IslandPlan::kRowKinds];
+  for (int kind = 0; kind < IslandPlan::kRowKinds; ++kind) {
+    pinned[kind].assign(rows[kind]->size(), 0);
+    for (size_t j = 0; j < rows[kind]->pinned.size(); j += 3)
+      pinned[kind][static_cast<size_t>(rows[kind]->pinned[j])] = 1;
+  }
+  const auto project = [&](auto& track, int kind, size_t row) {
+    track.before(row, row + 1);
+    pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
+    track.after(row, row + 1);
+  };
+  for (const IslandPlan::Item& item : plan.items) {
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    const size_t steps = static_cast<size_t>(shape.steps);
+    for (int32_t island = item.first; island < item.first + item.count; ++island)
+      for (size_t step = 0; step < steps; ++step) {
+        const int kind = shape.kind[step];
+        const size_t row = static_cast<size_t>(shape.row[static_cast<size_t>(island) * steps + step]);
+        if (!pinned[kind][row])
+          pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
+        else if (kind == 0)
+          project(distance, kind, row);
+        else if (kind == 1)
+          project(planarity, kind, row);
+        else
+          project(offset, kind, row);
+      }
+  }
+}
+
 /// Welds x0 = x1 (three multipliers each), colour by colour over the pool's threads.
 void project_weld(ThreadPool& pool, SolverArray& a, double inv_h2, std::vector<Vec3>& x, const std::vector<double>& w,
                   std::vector<Pin>* pins) {
@@ -348,15 +389,20 @@ void World::project_group(Group& g, double h, bool first) {
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
   SolverArray* rows[IslandPlan::kRowKinds] = {&distance, &g.solve[static_cast<int>(Kind::planarity)],
                                               &g.solve[static_cast<int>(Kind::plane_offset)]};
-  // Islands (a panel mesh's panels): the three kinds' rows island by island, with the same bits, except
-  // where the hard pins' impulses are tracked (colour by colour). build_islands lists the kinds
-  // projected above: a group with rows of any other kind keeps the passes, as those come in between.
-  const bool islands =
-      g.islands.active() && k.islands != nullptr &&
-      (tracked == nullptr || (rows[0]->pinned.empty() && rows[1]->pinned.empty() && rows[2]->pinned.empty()));
+  // Islands (a panel mesh's panels, IslandPlan): the three kinds' rows island by island. Where the
+  // hard pins' impulses are tracked, islands in one colour (welded panels) go in the passes, with the
+  // same bits, and islands in colours one row at a time (tracked_islands). build_islands lists the
+  // kinds projected above: a group with rows of any other kind keeps the passes, as those come in
+  // between.
+  const bool pinned_rows =
+      tracked != nullptr && !(rows[0]->pinned.empty() && rows[1]->pinned.empty() && rows[2]->pinned.empty());
+  const bool coloured = g.islands.colour_start.size() > 2;
+  const bool islands = g.islands.active() && k.islands != nullptr && (!pinned_rows || coloured);
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
-  if (islands) {
+  if (islands && pinned_rows) {
+    tracked_islands(g.islands, rows, inv_h2, x_, w, *tracked);
+  } else if (islands) {
     islands_pass(*pool_, g.islands, rows, inv_h2, x, w);
   } else if (distance.chain_start.empty() || !first) {
     kernel_pass<Kind::distance>(*pool_, k.distance, distance, inv_h2, x_, w, tracked);

@@ -490,15 +490,23 @@ struct StaticsState {
   }
 };
 
-/// A group's distance, planarity and plane-offset rows as islands (World::rebuild_solver): the
-/// rows joined by shared particles, no island sharing a particle with another, each of at most
-/// kSlots particles and kSteps rows, in a group that projects no other kind between those three (a
-/// panel mesh's panels: the welds, which join them, are projected before). An island's rows are
-/// projected in the passes' order (distances, then planarity, then plane offsets, each in colour
-/// order) with its particles held in registers, islands of the same shape side by side in lanes:
-/// every particle sees the projections of the three passes in their order, so the bits are the
-/// passes' (tests/scenes/kernels_same_bits.sh, EMBRA_ISLANDS=off), loaded and stored once per
-/// island instead of once per row, and the three passes' colours are one parallel loop.
+/// A group's distance, planarity and plane-offset rows as islands (World::rebuild_solver), in a
+/// group that projects no other kind between those three; each island of at most kSlots particles
+/// and kSteps rows, its particles held in registers while its rows are projected in turn, islands
+/// of the same shape side by side in lanes. Two layouts:
+/// - welded panels: the rows joined by shared particles (a panel each: the welds, which join them,
+///   are projected before), no island sharing a particle with another, all in one colour. An
+///   island's rows go in the passes' order (distances, then planarity, then plane offsets, each in
+///   colour order), so every particle sees the three passes' projections in their order: the bits
+///   are the passes', loaded and stored once per island instead of once per row, and the passes'
+///   colours are one parallel loop.
+/// - panels sharing their corners: every row joins every panel, so each row goes to one panel that
+///   holds all its particles, and the panels are coloured so that none of a colour shares a
+///   particle (four colours on a grid, against the passes' 32). A panel's rows go by kind, in the
+///   order they were added: a Gauss-Seidel sweep panel by panel, not the passes' order.
+/// tests/scenes/kernels_same_bits.sh checks the bits: EMBRA_ISLANDS=rows projects the islands' rows
+/// in the same order one at a time with the pass kernels (either layout), EMBRA_ISLANDS=off the
+/// passes instead of islands (the welded layout's bits; the shared layout's differ).
 struct IslandPlan {
   static constexpr int kSlots = 8;     // particles of an island, at most
   static constexpr int kSteps = 32;    // rows of an island, at most
@@ -514,9 +522,12 @@ struct IslandPlan {
   struct Item {  // up to kItemIslands consecutive islands of one shape
     int32_t shape = 0, first = 0, count = 0;
   };
-  static constexpr int kItemIslands = 4;
+  static constexpr int kItemIslands = 8;  // two blocks of 4 lanes (the kernels run two side by side)
   std::vector<Shape> shapes;
   std::vector<Item> items;
+  /// Colour c: items [colour_start[c], colour_start[c + 1]), whose islands share no particle; the
+  /// colours in turn (one colour when no island shares a particle with another).
+  std::vector<int32_t> colour_start;
   bool active() const { return !items.empty(); }
 };
 
