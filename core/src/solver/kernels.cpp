@@ -860,17 +860,8 @@ Kernels::Pass row_kernels[IslandPlan::kRowKinds] = {};
 /// kernels (EMBRA_ISLANDS=rows): what the island kernels must match bit for bit.
 void islands_by_rows(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2,
                      double* x, const double* w) {
-  for (size_t i = begin; i < end; ++i) {
-    const IslandPlan::Item& item = plan.items[i];
-    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
-    const size_t steps = static_cast<size_t>(shape.steps);
-    for (int32_t island = item.first; island < item.first + item.count; ++island)
-      for (size_t step = 0; step < steps; ++step) {
-        const int kind = shape.kind[step];
-        const size_t row = static_cast<size_t>(shape.row[static_cast<size_t>(island) * steps + step]);
-        row_kernels[kind](*rows[kind], row, row + 1, false, inv_h2, x, w);
-      }
-  }
+  each_island_row(plan, begin, end,
+                  [&](int kind, size_t row) { row_kernels[kind](*rows[kind], row, row + 1, false, inv_h2, x, w); });
 }
 
 }  // namespace

@@ -47,6 +47,22 @@ struct Kernels {
   const char* name;
 };
 
+/// Calls f(kind, row) for each row of the island items [begin, end) of `plan`, island by island in
+/// the islands' order (kind: 0 distance, 1 planarity, 2 plane offset; row: the index into that
+/// kind's solver array).
+template <class F>
+void each_island_row(const IslandPlan& plan, size_t begin, size_t end, F&& f) {
+  for (size_t i = begin; i < end; ++i) {
+    const IslandPlan::Item& item = plan.items[i];
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    const size_t steps = static_cast<size_t>(shape.steps);
+    for (int32_t island = item.first; island < item.first + item.count; ++island)
+      for (size_t step = 0; step < steps; ++step)
+        f(static_cast<int>(shape.kind[step]),
+          static_cast<size_t>(shape.row[static_cast<size_t>(island) * steps + step]));
+  }
+}
+
 /// The kernels for this machine. Every set computes the same bits (lanes.hpp); EMBRA_KERNELS=scalar,
 /// vec2 or avx2 forces one, to check exactly that.
 const Kernels& kernels();

@@ -106,23 +106,16 @@ void tracked_islands(const IslandPlan& plan, SolverArray* const* rows, double in
     pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
     track.after(row, row + 1);
   };
-  for (const IslandPlan::Item& item : plan.items) {
-    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
-    const size_t steps = static_cast<size_t>(shape.steps);
-    for (int32_t island = item.first; island < item.first + item.count; ++island)
-      for (size_t step = 0; step < steps; ++step) {
-        const int kind = shape.kind[step];
-        const size_t row = static_cast<size_t>(shape.row[static_cast<size_t>(island) * steps + step]);
-        if (!pinned[kind][row])
-          pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
-        else if (kind == 0)
-          project(distance, kind, row);
-        else if (kind == 1)
-          project(planarity, kind, row);
-        else
-          project(offset, kind, row);
-      }
-  }
+  each_island_row(plan, 0, plan.items.size(), [&](int kind, size_t row) {
+    if (!pinned[kind][row])
+      pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
+    else if (kind == 0)
+      project(distance, kind, row);
+    else if (kind == 1)
+      project(planarity, kind, row);
+    else
+      project(offset, kind, row);
+  });
 }
 
 /// Welds x0 = x1 (three multipliers each), colour by colour over the pool's threads.
