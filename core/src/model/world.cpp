@@ -1088,6 +1088,15 @@ class RestSurface {
   std::vector<int32_t> nbr_start_, nbr_, tri_, vt_start_, vt_, across_;
 };
 
+/// Clears a solver array's chains (Settings::chain_solve): its distances run in their pass.
+void drop_chains(SolverArray& a) {
+  a.chain_start.clear();
+  a.chain_edge.clear();
+  a.chain_part.clear();
+  a.chain_colour_start.clear();
+  a.chain_shared_tail = false;
+}
+
 /// An island's rows in projection order: (row kind: 0 distance, 1 planarity, 2 plane offset; index
 /// into that kind's solver array).
 using IslandRows = std::vector<std::pair<int8_t, int32_t>>;
@@ -1528,26 +1537,14 @@ void World::rebuild_solver() {
         // Chains of one constraint each (a panel mesh's braced quads and slides: no straight run
         // goes on past a panel): the chain pass projects them as the plain pass does, at 2.5 times
         // its cost (4.5-8 % of the 32 x 32 drape's frame against 1.8 %), so the array keeps none.
-        if (own <= 1) {
-          sa.chain_start.clear();
-          sa.chain_edge.clear();
-          sa.chain_part.clear();
-          sa.chain_colour_start.clear();
-          sa.chain_shared_tail = false;
-        }
+        if (own <= 1) drop_chains(sa);
         longest = std::max(longest, own);
       }
     }
     g.tethers = SolverArray{};
     g.islands = build_islands(g, x_.size(), panel_layouts_);
-    if (g.islands.active()) {  // a panel mesh with shared corners: its panels, not its edges' runs
-      SolverArray& sa = g.solve[static_cast<int>(Kind::distance)];
-      sa.chain_start.clear();
-      sa.chain_edge.clear();
-      sa.chain_part.clear();
-      sa.chain_colour_start.clear();
-      sa.chain_shared_tail = false;
-    }
+    // A panel mesh with shared corners: its panels are the islands, not its edges' runs.
+    if (g.islands.active()) drop_chains(g.solve[static_cast<int>(Kind::distance)]);
   }
   // Automatic long-range attachments: every particle of an inextensible body to its nearest
   // anchors (hard-pinned or immovable particles of the body), in the body's stretch group.

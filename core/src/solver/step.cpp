@@ -95,21 +95,14 @@ void tracked_islands(const IslandPlan& plan, SolverArray* const* rows, double in
   PinTrack<Kind::distance> distance(*rows[0], x, pins);
   PinTrack<Kind::planarity> planarity(*rows[1], x, pins);
   PinTrack<Kind::plane_offset> offset(*rows[2], x, pins);
-  std::vector<uint8_t> pinned[IslandPlan::kRowKinds];
-  for (int kind = 0; kind < IslandPlan::kRowKinds; ++kind) {
-    pinned[kind].assign(rows[kind]->size(), 0);
-    for (size_t j = 0; j < rows[kind]->pinned.size(); j += 3)
-      pinned[kind][static_cast<size_t>(rows[kind]->pinned[j])] = 1;
-  }
   const auto project = [&](auto& track, int kind, size_t row) {
-    track.before(row, row + 1);
+    const bool held = track.next(row) == row;  // the row holds a hard-pinned particle
+    if (held) track.before(row, row + 1);
     pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
-    track.after(row, row + 1);
+    if (held) track.after(row, row + 1);
   };
   each_island_row(plan, 0, plan.items.size(), [&](int kind, size_t row) {
-    if (!pinned[kind][row])
-      pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
-    else if (kind == 0)
+    if (kind == 0)
       project(distance, kind, row);
     else if (kind == 1)
       project(planarity, kind, row);
