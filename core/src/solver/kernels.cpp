@@ -924,10 +924,24 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
 
 void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w) {
+  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr);
+}
+
+void islands_colour(ThreadPool& pool, const IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
+                    double* x, const double* w, const uint8_t* skip) {
   const Kernels& k = kernels();
-  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c)
-    pool.run(static_cast<size_t>(plan.colour_start[c]), static_cast<size_t>(plan.colour_start[c + 1]), 1, kIslandGrain,
-             [&](size_t b, size_t e, int) { k.islands(plan, b, e, rows, inv_h2, x, w); });
+  pool.run(static_cast<size_t>(plan.colour_start[colour]), static_cast<size_t>(plan.colour_start[colour + 1]), 1,
+           kIslandGrain, [&](size_t b, size_t e, int) {
+             if (skip == nullptr) return k.islands(plan, b, e, rows, inv_h2, x, w);
+             for (size_t i = b; i < e;) {  // the runs of items not skipped
+               for (; i < e && skip[i] != 0; ++i) {
+               }
+               const size_t run = i;
+               for (; i < e && skip[i] == 0; ++i) {
+               }
+               if (run < i) k.islands(plan, run, i, rows, inv_h2, x, w);
+             }
+           });
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

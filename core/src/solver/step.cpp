@@ -84,31 +84,46 @@ void kernel_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double 
       [&](size_t b, size_t e, bool in_lanes, int) { kernel(a, b, e, in_lanes, inv_h2, coords(x), w); }, track);
 }
 
-/// The tracked substep of islands in colours (IslandPlan: panels sharing their corners), whose order
-/// the passes would not keep: the islands' rows one at a time in the islands' order, on the caller,
-/// with the hard pins' shares tracked around each row that holds a pinned particle (PinTrack). The
-/// pass kernels give a row the bits the island kernels give it.
-void tracked_islands(const IslandPlan& plan, SolverArray* const* rows, double inv_h2, std::vector<Vec3>& x,
-                     const double* w, std::vector<Pin>& pins) {
+/// The tracked substep of islands in colours (IslandPlan: panels sharing their corners), colour by
+/// colour: the islands that hold no hard-pinned particle as islands_pass projects them (split over
+/// the threads), then those that do on the caller, their rows one at a time with the pass kernels
+/// (which give a row the bits the island kernels give it) and the hard pins' shares tracked around
+/// each row that holds a pinned particle (PinTrack). A colour's islands share no particle, so the
+/// split changes no bit.
+void tracked_islands(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2,
+                     std::vector<Vec3>& x, const double* w, std::vector<Pin>& pins) {
   const Kernels& k = kernels();
   const Kernels::Pass pass[IslandPlan::kRowKinds] = {k.distance, k.planarity, k.plane_offset};
   PinTrack<Kind::distance> distance(*rows[0], x, pins);
   PinTrack<Kind::planarity> planarity(*rows[1], x, pins);
   PinTrack<Kind::plane_offset> offset(*rows[2], x, pins);
+  // The items with a row that holds a hard-pinned particle (SolverArray::pinned: a few rows).
+  std::vector<uint8_t> held_row[IslandPlan::kRowKinds], held(plan.items.size(), 0);
+  for (int kind = 0; kind < IslandPlan::kRowKinds; ++kind) {
+    held_row[kind].assign(rows[kind]->size(), 0);
+    for (size_t j = 0; j < rows[kind]->pinned.size(); j += 3) held_row[kind][rows[kind]->pinned[j]] = 1;
+  }
+  for (size_t i = 0; i < plan.items.size(); ++i)
+    each_island_row(plan, i, i + 1, [&](int kind, size_t row) { held[i] |= held_row[kind][row]; });
   const auto project = [&](auto& track, int kind, size_t row) {
-    const bool held = track.next(row) == row;  // the row holds a hard-pinned particle
-    if (held) track.before(row, row + 1);
+    const bool tracked = held_row[kind][row] != 0;
+    if (tracked) track.before(row, row + 1);
     pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
-    if (held) track.after(row, row + 1);
+    if (tracked) track.after(row, row + 1);
   };
-  each_island_row(plan, 0, plan.items.size(), [&](int kind, size_t row) {
-    if (kind == 0)
-      project(distance, kind, row);
-    else if (kind == 1)
-      project(planarity, kind, row);
-    else
-      project(offset, kind, row);
-  });
+  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) {
+    islands_colour(pool, plan, c, rows, inv_h2, coords(x), w, held.data());
+    for (size_t i = static_cast<size_t>(plan.colour_start[c]); i < static_cast<size_t>(plan.colour_start[c + 1]); ++i)
+      if (held[i] != 0)
+        each_island_row(plan, i, i + 1, [&](int kind, size_t row) {
+          if (kind == 0)
+            project(distance, kind, row);
+          else if (kind == 1)
+            project(planarity, kind, row);
+          else
+            project(offset, kind, row);
+        });
+  }
 }
 
 /// Welds x0 = x1 (three multipliers each), colour by colour over the pool's threads.
@@ -387,7 +402,7 @@ void World::project_group(Group& g, double h, bool first) {
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
   if (islands && pinned_rows) {
-    tracked_islands(g.islands, rows, inv_h2, x_, w, *tracked);
+    tracked_islands(*pool_, g.islands, rows, inv_h2, x_, w, *tracked);
   } else if (islands) {
     islands_pass(*pool_, g.islands, rows, inv_h2, x, w);
   } else if (distance.chain_start.empty() || !first) {
