@@ -10,7 +10,9 @@
 #include <atomic>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace embra {
@@ -42,6 +44,36 @@ TEST(Threads, PoolCoversEveryItemOnceInAlignedParts) {
       if (n < 128) {
         EXPECT_LE(parts.load(), 1);  // under two grains: the caller alone
       }
+    }
+  }
+}
+
+/// run_parts calls each part of [0, parts) exactly once, each on its own thread, never more parts
+/// than the pool's threads, and throws what a part threw once all are done.
+TEST(Threads, RunPartsCallsEachPartOnceOnItsOwnThread) {
+  for (int threads : {1, 2, 3, 8}) {
+    ThreadPool pool(threads);
+    for (int parts : {0, 1, 2, 3, 8, 20}) {
+      std::vector<std::atomic<int>> called(static_cast<size_t>(std::max(parts, 1)));
+      std::vector<std::thread::id> on(called.size());
+      pool.run_parts(parts, [&](int part) {
+        ASSERT_GE(part, 0);
+        ASSERT_LT(part, std::min(std::max(parts, 1), threads));
+        called[static_cast<size_t>(part)].fetch_add(1);
+        on[static_cast<size_t>(part)] = std::this_thread::get_id();
+      });
+      const int expected = std::min(std::max(parts, 1), threads);
+      for (int p = 0; p < static_cast<int>(called.size()); ++p)
+        EXPECT_EQ(called[static_cast<size_t>(p)].load(), p < expected ? 1 : 0) << p << " of " << parts;
+      EXPECT_EQ(on[0], std::this_thread::get_id());  // part 0 on the caller
+      for (int a = 0; a < expected; ++a)
+        for (int b = a + 1; b < expected; ++b) EXPECT_NE(on[static_cast<size_t>(a)], on[static_cast<size_t>(b)]);
+    }
+    if (threads > 1) {
+      const auto throw_last = [&](int part) {
+        if (part == threads - 1) throw std::runtime_error("last part");
+      };
+      EXPECT_THROW(pool.run_parts(threads, throw_last), std::runtime_error);
     }
   }
 }

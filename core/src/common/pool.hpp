@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <exception>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace embra {
@@ -56,6 +57,18 @@ class ThreadPool {
     dispatch(&Job<F>::call, &job, static_cast<int>(parts));
   }
 
+  /// Calls fn(part) for part in [0, parts) (at most size()), each on its own thread, the caller's
+  /// part 0; returns when all are done, throwing what a part threw as run() does. For parts the
+  /// caller cuts itself.
+  template <class F>
+  void run_parts(int parts, F&& fn) {
+    parts = std::clamp(parts, 1, size());
+    if (parts == 1) return fn(0);
+    using Fn = std::remove_reference_t<F>;
+    Parts<Fn> job{&fn};
+    dispatch(&Parts<Fn>::call, &job, parts);
+  }
+
   /// run() over [begin, end) where each part appends what it finds to its own list
   /// (find(part_begin, part_end, list)), the lists then appended to `out` part after part: `out`
   /// gains the items in range order, as if found on one thread, at any thread count. `parts` is the
@@ -80,6 +93,12 @@ class ThreadPool {
       const size_t e = std::min(j.end, b + j.step);
       if (b < e) (*j.fn)(b, e, part);
     }
+  };
+
+  template <class F>
+  struct Parts {
+    F* fn;
+    static void call(void* self, int part) { (*static_cast<Parts*>(self)->fn)(part); }
   };
 
   /// Runs part `part` of the current job, keeping what it throws for dispatch to throw.

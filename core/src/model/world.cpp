@@ -1162,18 +1162,18 @@ IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector
     for (size_t sh = 0; sh < plan.shapes.size(); ++sh) {
       if (first[sh] < 0) continue;
       const int32_t count = static_cast<int32_t>(plan.shapes[sh].islands());
-      for (int32_t at = first[sh]; at < count; at += IslandPlan::kItemIslands)
-        plan.items.push_back({static_cast<int32_t>(sh), at, std::min(IslandPlan::kItemIslands, count - at)});
+      for (int32_t at = first[sh]; at < count; at += IslandPlan::kItemIslands) {
+        const int32_t is = order[sh][static_cast<size_t>(at)];
+        const double place = static_cast<double>(is - colour_start[c]) / (colour_start[c + 1] - colour_start[c]);
+        plan.items.push_back({static_cast<int32_t>(sh), at, std::min(IslandPlan::kItemIslands, count - at), place});
+      }
     }
-    // A colour's items in the order of their first islands: the threads' contiguous parts of a
-    // colour then cover the same stretch of the list (of a mesh) colour after colour, and share
-    // only the particles along their borders (each particle a core reads that another wrote
-    // crosses between their caches).
+    // A colour's items in the order of their first islands: the threads' parts of a colour, cut at
+    // the same places (islands_colour), then cover the same stretch of the list (of a mesh) colour
+    // after colour, and share only the particles along their borders (each particle a core reads
+    // that another wrote crosses between their caches).
     std::stable_sort(plan.items.begin() + static_cast<std::ptrdiff_t>(colour_first), plan.items.end(),
-                     [&](const IslandPlan::Item& a, const IslandPlan::Item& b) {
-                       return order[static_cast<size_t>(a.shape)][static_cast<size_t>(a.first)] <
-                              order[static_cast<size_t>(b.shape)][static_cast<size_t>(b.first)];
-                     });
+                     [](const IslandPlan::Item& a, const IslandPlan::Item& b) { return a.place < b.place; });
     plan.colour_start.push_back(static_cast<int32_t>(plan.items.size()));
   }
   return plan;
@@ -1325,8 +1325,8 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
 
 /// A coloured plan's rows in memory as its threads take them: within each colour of the three
 /// kinds' arrays (whose rows share no particle, so any order projects the same), the rows go in the
-/// order of their islands' places in their own colours, and the plan's row indices follow. A thread
-/// takes the same stretch of every colour's items (ThreadPool::run), so its rows' multipliers lie
+/// order of their items' places in their own colours, and the plan's row indices follow. A thread
+/// takes the same stretch of every colour's items (islands_colour), so its rows' multipliers lie
 /// together in each array colour and most cache lines of them are written by one core only. A line
 /// two cores write crosses between their caches at each colour: on the benchmarks' machine about
 /// 250 ns a crossing; on two threads the 32 x 32 drape's three arrays hold 43 such lines of 1,561
@@ -1336,29 +1336,23 @@ void order_island_rows(Group& g) {
   if (plan.colour_start.size() <= 2) return;  // one colour: the rows keep the passes' order
   for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
     SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
-    // Per row: its item's place in its colour, as a fraction (place, items in the colour).
-    std::vector<std::pair<int64_t, int64_t>> place(a.size(), {0, 1});
-    for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c)
-      for (int32_t i = plan.colour_start[c]; i < plan.colour_start[c + 1]; ++i) {
-        const IslandPlan::Item& item = plan.items[static_cast<size_t>(i)];
-        const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
-        for (int32_t is = item.first; is < item.first + item.count; ++is)
-          for (int32_t st = 0; st < shape.steps; ++st)
-            if (shape.kind[static_cast<size_t>(st)] == kr)
-              place[static_cast<size_t>(shape.row[static_cast<size_t>(is * shape.steps + st)])] = {
-                  i - plan.colour_start[c], plan.colour_start[c + 1] - plan.colour_start[c]};
-      }
+    // Per row: its item's place in its colour (IslandPlan::Item::place).
+    std::vector<double> place(a.size(), 0.0);
+    for (const IslandPlan::Item& item : plan.items) {
+      const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+      for (int32_t is = item.first; is < item.first + item.count; ++is)
+        for (int32_t st = 0; st < shape.steps; ++st)
+          if (shape.kind[static_cast<size_t>(st)] == kr)
+            place[static_cast<size_t>(shape.row[static_cast<size_t>(is * shape.steps + st)])] = item.place;
+    }
     std::vector<int32_t> order(a.size());
     std::iota(order.begin(), order.end(), 0);
     // The last colour keeps its order where its rows may share particles (projected in order).
     const size_t colours = a.colours() - (a.shared_tail ? 1 : 0);
     for (size_t c = 0; c < colours; ++c)
-      std::stable_sort(order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
-                       [&](int32_t u, int32_t v) {
-                         const auto& [pu, nu] = place[static_cast<size_t>(u)];
-                         const auto& [pv, nv] = place[static_cast<size_t>(v)];
-                         return pu * nv < pv * nu;
-                       });
+      std::stable_sort(
+          order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
+          [&](int32_t u, int32_t v) { return place[static_cast<size_t>(u)] < place[static_cast<size_t>(v)]; });
     const int n = arity(kIslandRowKinds[kr]), per = multipliers(kIslandRowKinds[kr]);
     SolverArray sorted = a;
     std::vector<int32_t> new_of(a.size());

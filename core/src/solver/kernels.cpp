@@ -930,18 +930,36 @@ void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* 
 void islands_colour(ThreadPool& pool, const IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
                     double* x, const double* w, const uint8_t* skip) {
   const Kernels& k = kernels();
-  pool.run(static_cast<size_t>(plan.colour_start[colour]), static_cast<size_t>(plan.colour_start[colour + 1]), 1,
-           kIslandGrain, [&](size_t b, size_t e, int) {
-             if (skip == nullptr) return k.islands(plan, b, e, rows, inv_h2, x, w);
-             for (size_t i = b; i < e;) {  // the runs of items not skipped
-               for (; i < e && skip[i] != 0; ++i) {
-               }
-               const size_t run = i;
-               for (; i < e && skip[i] == 0; ++i) {
-               }
-               if (run < i) k.islands(plan, run, i, rows, inv_h2, x, w);
-             }
-           });
+  const auto project = [&](size_t b, size_t e) {
+    if (skip == nullptr) return k.islands(plan, b, e, rows, inv_h2, x, w);
+    for (size_t i = b; i < e;) {  // the runs of items not skipped
+      for (; i < e && skip[i] != 0; ++i) {
+      }
+      const size_t run = i;
+      for (; i < e && skip[i] == 0; ++i) {
+      }
+      if (run < i) k.islands(plan, run, i, rows, inv_h2, x, w);
+    }
+  };
+  const size_t begin = static_cast<size_t>(plan.colour_start[colour]);
+  const size_t end = static_cast<size_t>(plan.colour_start[colour + 1]);
+  const size_t parts = std::min(static_cast<size_t>(pool.size()), (end - begin) / kIslandGrain);
+  if (parts <= 1) return project(begin, end);
+  // Part p from the first item placed at p / parts or later (the items go in their places' order):
+  // every colour cut at the same places, so that a thread keeps one stretch of the mesh.
+  const auto cut = [&](size_t p) {
+    if (p == 0) return begin;
+    if (p == parts) return end;
+    const double at = static_cast<double>(p) / static_cast<double>(parts);
+    return static_cast<size_t>(std::partition_point(plan.items.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                    plan.items.begin() + static_cast<std::ptrdiff_t>(end),
+                                                    [&](const IslandPlan::Item& item) { return item.place < at; }) -
+                               plan.items.begin());
+  };
+  pool.run_parts(static_cast<int>(parts), [&](int part) {
+    const size_t p = static_cast<size_t>(part);
+    project(cut(p), cut(p + 1));
+  });
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

@@ -521,6 +521,9 @@ struct IslandPlan {
   };
   struct Item {  // up to kItemIslands consecutive islands of one shape
     int32_t shape = 0, first = 0, count = 0;
+    // Where its first island lies among its colour's islands, from 0 to 1: the panels' order, so
+    // the same stretch of the mesh in every colour (the threads' parts are cut there).
+    double place = 0.0;
   };
   static constexpr int kItemIslands = 8;  // two blocks of 4 lanes (the kernels run two side by side)
   std::vector<Shape> shapes;
