@@ -302,7 +302,11 @@ typedef struct {
 
 static void* step_once(void* arg) {
   long_step* r = (long_step*)arg;
-  r->status = embra_world_step(r->world);
+  /* The other thread's get_report may hold the world for a moment as the step starts (the C ABI
+   * refuses a second call at once rather than waiting): try again until the step has it. */
+  do {
+    r->status = embra_world_step(r->world);
+  } while (r->status == EMBRA_ERROR_LOCKED);
   __atomic_store_n(&r->finished, 1, __ATOMIC_RELEASE);
   return NULL;
 }

@@ -1,4 +1,5 @@
-// ThreadPool (pool.hpp): threads that spin up to 1 ms for the next job, then sleep on an atomic.
+// ThreadPool (pool.hpp): threads that spin up to 1 ms for the next job, then sleep on a condition
+// variable.
 #include "common/pool.hpp"
 
 #include <chrono>
@@ -42,9 +43,10 @@ bool changed(const std::atomic<T>& a, T old, int looks, T& now) {
   return false;
 }
 
-/// Waits until `a` holds a value other than `old`; returns it.
+}  // namespace
+
 template <class T>
-T wait_change(const std::atomic<T>& a, T old) {
+T ThreadPool::wait_change(const std::atomic<T>& a, T old) {
   T now = old;
   if (changed(a, old, kPauses, now)) return now;
   const auto until = std::chrono::steady_clock::now() + kSpinTime;
@@ -52,14 +54,26 @@ T wait_change(const std::atomic<T>& a, T old) {
     if (changed(a, old, kPausesPerRound, now)) return now;
     std::this_thread::yield();
   } while (std::chrono::steady_clock::now() < until);
-  for (;;) {
-    a.wait(old, std::memory_order_acquire);
-    now = a.load(std::memory_order_acquire);
-    if (now != old) return now;
-  }
+  // Asleep on a condition variable, the value looked at under its mutex (which every change takes
+  // before notifying: wake), so no change is missed. Not std::atomic::wait: MinGW's libstdc++
+  // (GCC 12) implements it without futexes, and a worker there once slept through the pool's
+  // stop under wine (test_capi_threads hung at exit).
+  std::unique_lock<std::mutex> lock(sleep_mutex_);
+  sleepers_.fetch_add(1, std::memory_order_seq_cst);
+  std::atomic_thread_fence(std::memory_order_seq_cst);  // pairs with wake's: one of us sees the other
+  sleep_.wait(lock, [&] { return (now = a.load(std::memory_order_acquire)) != old; });
+  sleepers_.fetch_sub(1, std::memory_order_relaxed);
+  return now;
 }
 
-}  // namespace
+void ThreadPool::wake() {
+  // Either this sees the sleeper counted, or the sleeper (counted, then fenced) sees the change and
+  // does not sleep. The mutex only when someone sleeps: a busy pool's hand-overs never take it.
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  if (sleepers_.load(std::memory_order_relaxed) == 0) return;
+  { const std::lock_guard<std::mutex> lock(sleep_mutex_); }
+  sleep_.notify_all();
+}
 
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -76,7 +90,7 @@ ThreadPool::~ThreadPool() {
 void ThreadPool::publish(int parts) {
   const uint64_t number = (job_.load(std::memory_order_relaxed) >> 16) + 1;
   job_.store(number << 16 | static_cast<uint64_t>(parts), std::memory_order_release);
-  job_.notify_all();
+  wake();
 }
 
 void ThreadPool::run_part(int part) noexcept {
@@ -107,7 +121,7 @@ void ThreadPool::work(int index) {
     if (parts == 0) return;
     if (index + 1 < parts) {
       run_part(index + 1);
-      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
+      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) wake();
     }
   }
 }

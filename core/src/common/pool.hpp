@@ -8,16 +8,18 @@
 // result is the same at any thread count, bit for bit.
 //
 // The caller's thread runs part 0; a waiting thread spins for up to 1 ms (yielding its core between
-// rounds of pauses), then sleeps on an atomic (std::atomic::wait), so a busy pool hands work over in
+// rounds of pauses), then sleeps on a condition variable, so a busy pool hands work over in
 // microseconds and an idle one costs nothing after that millisecond. One pool serves one world, one
 // call at a time (the C ABI's one-call-at-a-time rule).
 #pragma once
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <mutex>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -108,6 +110,10 @@ class ThreadPool {
   void dispatch(void (*call)(void*, int), void* context, int parts);
   void publish(int parts);  // a new job number with `parts` parts (0: stop)
   void work(int index);
+  /// Waits until `a` holds a value other than `old` (spinning, then asleep); returns it.
+  template <class T>
+  T wait_change(const std::atomic<T>& a, T old);
+  void wake();  // after a change a sleeper may wait for: wakes every sleeper
 
   std::vector<std::thread> workers_;
   // The current job. call_ and context_ are written before job_ publishes them and read only by the
@@ -119,6 +125,9 @@ class ThreadPool {
   std::atomic<uint64_t> job_{0};
   std::atomic<int> pending_{0};             // worker parts of the current job not yet done
   std::vector<std::exception_ptr> errors_;  // per part: what it threw (a worker must never unwind)
+  std::mutex sleep_mutex_;                  // wait_change's sleep: job_ and pending_ looked at under it
+  std::condition_variable sleep_;
+  std::atomic<int> sleepers_{0};  // threads asleep in wait_change (or about to be)
 };
 
 }  // namespace embra
