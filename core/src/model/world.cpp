@@ -1100,7 +1100,6 @@ void drop_chains(SolverArray& a) {
 /// An island's rows in projection order: (row kind: 0 distance, 1 planarity, 2 plane offset; index
 /// into that kind's solver array).
 using IslandRows = std::vector<std::pair<int8_t, int32_t>>;
-constexpr Kind kIslandRowKinds[IslandPlan::kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
 
 /// The plan of `islands`, colour by colour: colour c holds islands [colour_start[c],
 /// colour_start[c + 1]), which share no particle. Islands of one shape (the rows' kinds on the
@@ -1120,8 +1119,8 @@ IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector
       std::vector<int8_t> key, slots;
       std::vector<int32_t> particles, row;
       for (const auto& [kr, i] : list) {
-        const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
-        const int n = arity(kIslandRowKinds[kr]);
+        const SolverArray& a = g.solve[static_cast<int>(IslandPlan::kRowKind[kr])];
+        const int n = arity(IslandPlan::kRowKind[kr]);
         key.push_back(kr);
         for (int j = 0; j < 4; ++j) {
           int8_t slot = 0;
@@ -1210,8 +1209,8 @@ bool panel_islands(const Group& g, size_t particle_count, const std::vector<Pane
   // Each row to its first cell; per cell (row kind, the row's constraint index, its solver index).
   std::vector<std::vector<std::array<int32_t, 3>>> rows_of(cells.size());
   for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
-    const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
-    const int n = arity(kIslandRowKinds[kr]);
+    const SolverArray& a = g.solve[static_cast<int>(IslandPlan::kRowKind[kr])];
+    const int n = arity(IslandPlan::kRowKind[kr]);
     for (size_t i = 0; i < a.size(); ++i) {
       const int32_t* ids = &a.ids[n * i];
       int32_t home = -1;
@@ -1286,7 +1285,7 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
     return r;
   };
   size_t rows = 0;
-  for (Kind kind : kIslandRowKinds) {
+  for (Kind kind : IslandPlan::kRowKind) {
     const SolverArray& a = g.solve[static_cast<int>(kind)];
     const int n = arity(kind);
     rows += a.size();
@@ -1302,8 +1301,8 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
   std::vector<IslandRows> islands;
   bool small = g.solve[static_cast<int>(Kind::distance)].chain_start.empty();
   for (int kr = 0; kr < IslandPlan::kRowKinds && small; ++kr) {
-    const SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
-    const int n = arity(kIslandRowKinds[kr]);
+    const SolverArray& a = g.solve[static_cast<int>(IslandPlan::kRowKind[kr])];
+    const int n = arity(IslandPlan::kRowKind[kr]);
     for (size_t i = 0; i < a.size() && small; ++i) {
       int32_t& island = island_of[find(a.ids[n * i])];
       if (island < 0) {
@@ -1335,7 +1334,7 @@ void order_island_rows(Group& g) {
   IslandPlan& plan = g.islands;
   if (plan.colour_start.size() <= 2) return;  // one colour: the rows keep the passes' order
   for (int kr = 0; kr < IslandPlan::kRowKinds; ++kr) {
-    SolverArray& a = g.solve[static_cast<int>(kIslandRowKinds[kr])];
+    SolverArray& a = g.solve[static_cast<int>(IslandPlan::kRowKind[kr])];
     // Per row: its item's place in its colour (IslandPlan::Item::place).
     std::vector<double> place(a.size(), 0.0);
     for (const IslandPlan::Item& item : plan.items) {
@@ -1353,7 +1352,7 @@ void order_island_rows(Group& g) {
       std::stable_sort(
           order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
           [&](int32_t u, int32_t v) { return place[static_cast<size_t>(u)] < place[static_cast<size_t>(v)]; });
-    const int n = arity(kIslandRowKinds[kr]), per = multipliers(kIslandRowKinds[kr]);
+    const int n = arity(IslandPlan::kRowKind[kr]), per = multipliers(IslandPlan::kRowKind[kr]);
     SolverArray sorted = a;
     std::vector<int32_t> new_of(a.size());
     for (size_t j = 0; j < order.size(); ++j) {

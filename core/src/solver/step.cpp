@@ -97,20 +97,13 @@ void tracked_islands(ThreadPool& pool, const IslandPlan& plan, SolverArray* cons
   PinTrack<Kind::distance> distance(*rows[0], x, pins);
   PinTrack<Kind::planarity> planarity(*rows[1], x, pins);
   PinTrack<Kind::plane_offset> offset(*rows[2], x, pins);
-  // The items with a row that holds a hard-pinned particle (SolverArray::pinned: a few rows).
-  std::vector<uint8_t> held_row[IslandPlan::kRowKinds], held(plan.items.size(), 0);
-  for (int kind = 0; kind < IslandPlan::kRowKinds; ++kind) {
-    held_row[kind].assign(rows[kind]->size(), 0);
-    for (size_t j = 0; j < rows[kind]->pinned.size(); j += 3) held_row[kind][rows[kind]->pinned[j]] = 1;
-  }
-  for (size_t i = 0; i < plan.items.size(); ++i)
-    each_island_row(plan, i, i + 1, [&](int kind, size_t row) { held[i] |= held_row[kind][row]; });
   const auto project = [&](auto& track, int kind, size_t row) {
-    const bool tracked = held_row[kind][row] != 0;
-    if (tracked) track.before(row, row + 1);
+    const bool held = track.next(row) == row;  // the row holds a hard-pinned particle
+    if (held) track.before(row, row + 1);
     pass[kind](*rows[kind], row, row + 1, false, inv_h2, coords(x), w);
-    if (tracked) track.after(row, row + 1);
+    if (held) track.after(row, row + 1);
   };
+  const std::vector<uint8_t>& held = plan.pinned_items;  // find_pinned_slots
   for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) {
     islands_colour(pool, plan, c, rows, inv_h2, coords(x), w, held.data());
     for (size_t i = static_cast<size_t>(plan.colour_start[c]); i < static_cast<size_t>(plan.colour_start[c + 1]); ++i)
@@ -253,6 +246,14 @@ void World::find_pinned_slots() {
     if (!g.alive) continue;
     for (const KindInfo& info : kKinds) find(g.solve[static_cast<int>(info.kind)], info.arity);
     find(g.tethers, arity(Kind::tether));
+    IslandPlan& plan = g.islands;
+    plan.pinned_items.assign(plan.items.size(), 0);
+    for (size_t i = 0; i < plan.items.size(); ++i)
+      each_island_row(plan, i, i + 1, [&](int kind, size_t row) {
+        const std::vector<int32_t>& pinned = g.solve[static_cast<int>(IslandPlan::kRowKind[kind])].pinned;
+        for (size_t j = 0; j < pinned.size(); j += 3)
+          if (static_cast<size_t>(pinned[j]) == row) plan.pinned_items[i] = 1;
+      });
   }
 }
 

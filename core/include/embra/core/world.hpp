@@ -511,7 +511,8 @@ struct IslandPlan {
   static constexpr int kSlots = 8;     // particles of an island, at most
   static constexpr int kSteps = 32;    // rows of an island, at most
   static constexpr int kRowKinds = 3;  // the kinds of its rows: distance, planarity, plane offset
-  struct Shape {                       // islands with the same rows on the same local particles
+  static constexpr Kind kRowKind[kRowKinds] = {Kind::distance, Kind::planarity, Kind::plane_offset};
+  struct Shape {  // islands with the same rows on the same local particles
     int32_t slots = 0, steps = 0;
     std::vector<int8_t> kind;       // per step: 0 distance, 1 planarity, 2 plane offset
     std::vector<int8_t> slot;       // per step: 4 local particles (a distance uses 2)
@@ -531,6 +532,9 @@ struct IslandPlan {
   /// Colour c: items [colour_start[c], colour_start[c + 1]), whose islands share no particle; the
   /// colours in turn (one colour when no island shares a particle with another).
   std::vector<int32_t> colour_start;
+  /// Per item: 1 when one of its rows holds a hard-pinned particle (World::find_pinned_slots, with
+  /// the arrays' `pinned` lists): the tracked substep projects those items row by row.
+  std::vector<uint8_t> pinned_items;
   bool active() const { return !items.empty(); }
 };
 
