@@ -3,6 +3,7 @@
 // Labelled "threads": the ThreadSanitizer stage of the test command runs these too.
 #include "common/pool.hpp"
 #include "embra/core/limits.hpp"
+#include "embra/core/panels.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -214,6 +215,64 @@ TEST(Threads, SelfCollidingClothIsBitIdenticalAtAnyThreadCount) {
       EXPECT_TRUE(same_bits(state(*w), one)) << threads << " threads";
   }
   EXPECT_GT(contacts, 0);  // contacts were found (the sphere, and the cloth on itself)
+}
+
+/// A panel mesh with shared corners projects its panels colour by colour, each colour cut over the
+/// threads at the same places of the mesh (IslandPlan::cut). The per-particle passes (prediction,
+/// Chebyshev steps, velocities) give each thread the particles its own panels hold, so a particle
+/// crosses between the cores' caches only along the border between their stretches: with equal
+/// ranges of particle indices, one thread would take the whole top layer and the other the bottom.
+TEST(Threads, ParticlePassesTakeTheParticlesOfTheirThreadsPanels) {
+  Settings s;
+  s.threads = 2;
+  World w(s);
+  std::vector<double> pos;
+  std::vector<int32_t> quads;
+  panel_grid(16, 16, 0.2, Vec3(-1.6, -1.6, 0.0), pos, quads);
+  PanelMeshDesc d;
+  d.positions = pos;
+  d.quads = quads;
+  d.thickness = 0.01;
+  d.corners = PanelCorners::shared;
+  d.pins = PanelPins::top_corners;
+  build_panel_mesh(w, d);
+  w.step();
+  const IslandPlan& plan = w.group(w.default_group()).islands;
+  ASSERT_GT(plan.colour_start.size(), 2u) << "the panels go as islands in colours";
+  // The cut: from 0 to 1, in order, one stretch per thread.
+  ASSERT_EQ(plan.cut.size(), (plan.colour_start.size() - 1) * 3);
+  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) {
+    EXPECT_EQ(plan.cut[3 * c], 0.0);
+    EXPECT_LE(plan.cut[3 * c], plan.cut[3 * c + 1]);
+    EXPECT_LE(plan.cut[3 * c + 1], plan.cut[3 * c + 2]);
+    EXPECT_EQ(plan.cut[3 * c + 2], 1.0);
+  }
+  // The runs cover every particle once, in order, each in one of the two parts.
+  const auto& runs = w.particle_runs();
+  ASSERT_FALSE(runs.empty());
+  const size_t n = w.positions().size();
+  std::vector<int> part(n, -1);
+  int32_t next = 0;
+  for (const auto& r : runs) {
+    EXPECT_EQ(r[0], next);
+    EXPECT_LT(r[0], r[1]);
+    EXPECT_TRUE(r[2] == 0 || r[2] == 1);
+    for (int32_t i = r[0]; i < r[1]; ++i) part[static_cast<size_t>(i)] = r[2];
+    next = r[1];
+  }
+  EXPECT_EQ(static_cast<size_t>(next), n);
+  // Each panel's particles in the part of the thread that projects it at the mesh's middle cut
+  // (items placed before 1/2 go to the first thread), but for the particles on the border.
+  size_t held = 0, elsewhere = 0;
+  for (const IslandPlan::Item& item : plan.items) {
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    const int thread = item.place < 0.5 ? 0 : 1;
+    for (int32_t is = item.first; is < item.first + item.count; ++is)
+      for (int32_t k = 0; k < shape.slots; ++k)
+        (part[static_cast<size_t>(shape.particle[static_cast<size_t>(is * shape.slots + k)])] == thread ? held
+                                                                                                        : elsewhere)++;
+  }
+  EXPECT_LT(static_cast<double>(elsewhere), 0.15 * static_cast<double>(held + elsewhere)) << held << " " << elsewhere;
 }
 
 TEST(Threads, CountIsValidated) {

@@ -1673,8 +1673,40 @@ void World::rebuild_solver() {
   }
   chain_scratch_.assign(kChainScratch * (longest + 1) * static_cast<size_t>(pool_->size()), 0.0);
   find_pinned_slots();
+  find_particle_parts();
   solver_dirty_ = false;
   refresh_rest();
+}
+
+void World::find_particle_parts() {
+  particle_runs_.clear();
+  const int parts = pool_->size();
+  if (parts <= 1) return;
+  std::vector<int32_t> part(x_.size(), -1);
+  bool any = false;
+  for (int32_t slot : order_) {
+    const IslandPlan& plan = groups_[static_cast<size_t>(slot)].islands;
+    if (plan.colour_start.size() <= 2) continue;  // one colour or none: cut by equal item counts
+    any = true;
+    // islands_colour's cut: an item placed at `place` goes to part floor(place * parts).
+    for (const IslandPlan::Item& item : plan.items) {
+      const int32_t p = std::min(parts - 1, static_cast<int32_t>(item.place * parts));
+      const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+      const size_t slots = static_cast<size_t>(shape.slots);
+      for (size_t at = static_cast<size_t>(item.first) * slots;
+           at < static_cast<size_t>(item.first + item.count) * slots; ++at)
+        if (int32_t& q = part[static_cast<size_t>(shape.particle[at])]; q < 0) q = p;
+    }
+  }
+  if (!any) return;
+  const size_t n = x_.size();
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t p = part[i] >= 0 ? part[i] : static_cast<int32_t>(i * static_cast<size_t>(parts) / n);
+    if (!particle_runs_.empty() && particle_runs_.back()[2] == p && particle_runs_.back()[1] == static_cast<int32_t>(i))
+      ++particle_runs_.back()[1];
+    else
+      particle_runs_.push_back({static_cast<int32_t>(i), static_cast<int32_t>(i + 1), p});
+  }
 }
 
 // --- pins --------------------------------------------------------------------------------------

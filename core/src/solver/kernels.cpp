@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -922,12 +923,12 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
   pool.run(0, t.other_runs.size(), 1, kGrain, [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, true, x, w); });
 }
 
-void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
+void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w) {
   for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr);
 }
 
-void islands_colour(ThreadPool& pool, const IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
+void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
                     double* x, const double* w, const uint8_t* skip) {
   const Kernels& k = kernels();
   const auto project = [&](size_t b, size_t e) {
@@ -945,21 +946,49 @@ void islands_colour(ThreadPool& pool, const IslandPlan& plan, size_t colour, Sol
   const size_t end = static_cast<size_t>(plan.colour_start[colour + 1]);
   const size_t parts = std::min(static_cast<size_t>(pool.size()), (end - begin) / kIslandGrain);
   if (parts <= 1) return project(begin, end);
-  // Part p from the first item placed at p / parts or later (the items go in their places' order):
+  const size_t colours = plan.colour_start.size() - 1;
+  if (plan.cut.size() != colours * (parts + 1)) {
+    plan.cut.resize(colours * (parts + 1));
+    for (size_t c = 0; c < colours; ++c)
+      for (size_t p = 0; p <= parts; ++p)
+        plan.cut[c * (parts + 1) + p] = static_cast<double>(p) / static_cast<double>(parts);
+  }
+  double* at = plan.cut.data() + colour * (parts + 1);  // IslandPlan::cut
+  // Part p from the first item placed at at[p] or later (the items go in their places' order):
   // every colour cut at the same places, so that a thread keeps one stretch of the mesh.
   const auto cut = [&](size_t p) {
     if (p == 0) return begin;
     if (p == parts) return end;
-    const double at = static_cast<double>(p) / static_cast<double>(parts);
     return static_cast<size_t>(std::partition_point(plan.items.begin() + static_cast<std::ptrdiff_t>(begin),
                                                     plan.items.begin() + static_cast<std::ptrdiff_t>(end),
-                                                    [&](const IslandPlan::Item& item) { return item.place < at; }) -
+                                                    [&](const IslandPlan::Item& item) { return item.place < at[p]; }) -
                                plan.items.begin());
   };
+  constexpr size_t kMaxParts = 64;  // timed parts; past this many threads the cut stays even
+  double seconds[kMaxParts] = {};
+  // Each part's time from the hand-over to its end: a worker's includes its waking.
+  const auto start = std::chrono::steady_clock::now();
   pool.run_parts(static_cast<int>(parts), [&](int part) {
     const size_t p = static_cast<size_t>(part);
     project(cut(p), cut(p + 1));
+    if (p < kMaxParts) seconds[p] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
+  if (parts > kMaxParts) return;
+  // The places where each part would take the same time, each part's time spread evenly over its
+  // stretch; the cut moved a quarter of the way there (a colour's time is noisy).
+  double total = 0.0;
+  for (size_t p = 0; p < parts; ++p) total += seconds[p];
+  if (!(total > 0.0)) return;
+  double target[kMaxParts + 1] = {};
+  double before = 0.0;  // time of the parts before p
+  size_t p = 0;
+  for (size_t q = 1; q < parts; ++q) {
+    const double want = total * static_cast<double>(q) / static_cast<double>(parts);
+    while (p + 1 < parts && before + seconds[p] < want) before += seconds[p++];
+    const double share = seconds[p] > 0.0 ? std::clamp((want - before) / seconds[p], 0.0, 1.0) : 0.0;
+    target[q] = at[p] + share * (at[p + 1] - at[p]);
+  }
+  for (size_t q = 1; q < parts; ++q) at[q] += 0.25 * (target[q] - at[q]);
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

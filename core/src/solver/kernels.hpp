@@ -149,11 +149,11 @@ void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, cons
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
 /// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), colour
 /// by colour, each colour's items split over the pool's threads (its islands share no particle).
-void islands_pass(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
+void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w);
 /// Colour `colour` of islands_pass alone, without the items flagged in `skip` (one flag per item of
 /// the plan; null: none skipped), which the caller projects itself.
-void islands_colour(ThreadPool& pool, const IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
+void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
                     double* x, const double* w, const uint8_t* skip);
 /// The function values of every constraint of `a` into out[0 .. a.size()).
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out);

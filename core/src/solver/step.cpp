@@ -43,11 +43,24 @@ namespace {
 /// Particles per thread below which a per-particle pass is not split (a particle costs nanoseconds).
 constexpr size_t kParticleGrain = 2048;
 
-/// Calls f(i) for every particle i of [0, n), the range split over the pool's threads: for passes
-/// where each particle reads and writes only its own state (the same bits at any split).
+/// Calls f(begin, end) over the particles [0, n) in parts over the pool's threads: with `runs`
+/// (World::particle_runs_), part p takes its runs, whatever their length; else equal ranges, none
+/// under kParticleGrain. For passes where each particle reads and writes only its own state (the
+/// same bits at any split).
 template <class F>
-void each_particle(ThreadPool& pool, size_t n, F&& f) {
-  pool.run(0, n, 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+void particle_ranges(ThreadPool& pool, const std::vector<std::array<int32_t, 3>>& runs, size_t n, F&& f) {
+  if (runs.empty() || static_cast<size_t>(runs.back()[1]) != n)
+    return pool.run(0, n, 1, kParticleGrain, [&](size_t begin, size_t end, int) { f(begin, end); });
+  pool.run_parts(pool.size(), [&](int part) {
+    for (const std::array<int32_t, 3>& r : runs)
+      if (r[2] == part) f(static_cast<size_t>(r[0]), static_cast<size_t>(r[1]));
+  });
+}
+
+/// Calls f(i) for every particle i of [0, n), over the threads as particle_ranges cuts them.
+template <class F>
+void each_particle(ThreadPool& pool, const std::vector<std::array<int32_t, 3>>& runs, size_t n, F&& f) {
+  particle_ranges(pool, runs, n, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) f(i);
   });
 }
@@ -90,8 +103,8 @@ void kernel_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double 
 /// (which give a row the bits the island kernels give it) and the hard pins' shares tracked around
 /// each row that holds a pinned particle (PinTrack). A colour's islands share no particle, so the
 /// split changes no bit.
-void tracked_islands(ThreadPool& pool, const IslandPlan& plan, SolverArray* const* rows, double inv_h2,
-                     std::vector<Vec3>& x, const double* w, std::vector<Pin>& pins) {
+void tracked_islands(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, std::vector<Vec3>& x,
+                     const double* w, std::vector<Pin>& pins) {
   const Kernels& k = kernels();
   const Kernels::Pass pass[IslandPlan::kRowKinds] = {k.distance, k.planarity, k.plane_offset};
   PinTrack<Kind::distance> distance(*rows[0], x, pins);
@@ -200,7 +213,7 @@ void World::predict(double h, double alpha) {
     add_distributed_loads(x_, load_now_);
   }
   const std::vector<Vec3>& load = distributed ? load_now_ : load_;
-  each_particle(*pool_, x_.size(), [&](size_t i) {
+  each_particle(*pool_, particle_runs_, x_.size(), [&](size_t i) {
     x_prev_[i] = x_[i];
     if (w_[i] == 0.0) return;
     v_[i] += dv;
@@ -325,7 +338,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
       corr[fc.partner[k]] += step;
     }
   }
-  each_particle(*pool_, x_.size(), [&](size_t i) {
+  each_particle(*pool_, particle_runs_, x_.size(), [&](size_t i) {
     if (w_[i] != 0.0) x_[i] = predicted[i] + corr[i];
   });
 }
@@ -466,7 +479,7 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
   double* x = coords(x_);
   double* start = coords(chebyshev_now_);  // where the iteration before this one started
   const double* w = w_.data();
-  pool_->run(0, x_.size(), 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+  particle_ranges(*pool_, particle_runs_, x_.size(), [&](size_t begin, size_t end) {
     if (extrapolate)
       for (size_t i = begin; i < end; ++i) {
         if (w[i] == 0.0) continue;
@@ -490,7 +503,7 @@ void World::chebyshev_step(int iteration, double rho, double& omega) {
 
 void World::update_velocities(double h) {
   const double inv_h = 1.0 / h;
-  pool_->run(0, x_.size(), 1, kParticleGrain, [&](size_t begin, size_t end, int) {
+  particle_ranges(*pool_, particle_runs_, x_.size(), [&](size_t begin, size_t end) {
     double rate_before = 0.0, decay = 1.0;  // exp(-rate h), computed again only when the rate changes
     for (size_t i = begin; i < end; ++i) {
       v_[i] = (x_[i] - x_prev_[i]) * inv_h;
@@ -510,7 +523,7 @@ void World::check_state_in_range() {
     return (x_[i].array().abs() <= limits::kMaxAbsValue).all() && (v_[i].array().abs() <= limits::kMaxAbsValue).all();
   };
   std::atomic<bool> bad_found{false};
-  each_particle(*pool_, x_.size(), [&](size_t i) {
+  each_particle(*pool_, particle_runs_, x_.size(), [&](size_t i) {
     if (!in_range(i)) bad_found.store(true, std::memory_order_relaxed);
   });
   if (!bad_found.load(std::memory_order_relaxed)) return;

@@ -532,6 +532,13 @@ struct IslandPlan {
   /// Colour c: items [colour_start[c], colour_start[c + 1]), whose islands share no particle; the
   /// colours in turn (one colour when no island shares a particle with another).
   std::vector<int32_t> colour_start;
+  /// Where a colour's items are cut into the threads' parts (islands_colour): part p takes the
+  /// items placed in [cut[p], cut[p + 1]), cut[0] = 0 and cut[parts] = 1. It starts at p / parts
+  /// and after each colour moves a quarter of the way to the places where the parts would have
+  /// taken equal time: a thread's stretch can cost more than its share of the items (the cache
+  /// lines it shares with another core, the particles the caller's serial stages touched). Which
+  /// thread projects an item changes no bit: this balances time only.
+  std::vector<double> cut;
   /// Per item: 1 when one of its rows holds a hard-pinned particle (World::find_pinned_slots, with
   /// the arrays' `pinned` lists): the tracked substep projects those items row by row.
   std::vector<uint8_t> pinned_items;
@@ -707,6 +714,10 @@ class World {
   void set_group_weight(Id id, int32_t weight);
   const Group& group(Id id) const;
   Id default_group() const { return default_group_; }
+  /// The per-particle passes' parts once the solver is built (find_particle_parts): runs of
+  /// particles (begin, end, part), in order; empty where the passes cut the particles into equal
+  /// ranges. For tests and diagnostics.
+  const std::vector<std::array<int32_t, 3>>& particle_runs() const { return particle_runs_; }
   Id contact_group() const { return settings_.contact_group; }
   size_t group_count() const;
 
@@ -1022,8 +1033,14 @@ class World {
   std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
   std::vector<std::vector<FaceContact>> face_parts_;  // find_face_contacts: one list per thread
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
-  std::vector<Vec3> predicted_, realign_;             // realignment scratch (Settings::realign_passes)
-  std::vector<double> shape_weights_;                 // project_shape_match's scratch
+  // The per-particle passes' parts, where a group's islands go in colours over several threads
+  // (find_particle_parts): (begin, end, part) runs of particles, each particle in the part of the
+  // thread that projects its first island, so that a thread's passes over its particles read what
+  // it wrote itself. Empty: the passes cut the particles into equal ranges.
+  std::vector<std::array<int32_t, 3>> particle_runs_;
+  void find_particle_parts();
+  std::vector<Vec3> predicted_, realign_;  // realignment scratch (Settings::realign_passes)
+  std::vector<double> shape_weights_;      // project_shape_match's scratch
   StepReport report_;
   Warning warning_;
   std::vector<Field> fields_;
