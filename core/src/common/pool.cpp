@@ -78,6 +78,7 @@ void ThreadPool::wake() {
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   errors_.resize(static_cast<size_t>(threads));
+  taken_ = std::make_unique<Taken[]>(static_cast<size_t>(threads));
   workers_.reserve(static_cast<size_t>(threads - 1));
   for (int i = 0; i + 1 < threads; ++i) workers_.emplace_back([this, i] { work(i); });
 }
@@ -107,7 +108,14 @@ void ThreadPool::dispatch(void (*call)(void*, int), void* context, int parts) {
   for (std::exception_ptr& e : errors_) e = nullptr;
   pending_.store(parts - 1, std::memory_order_relaxed);
   publish(parts);
+  const uint64_t job = job_.load(std::memory_order_relaxed) >> 16;
   run_part(0);
+  // The parts no worker has started yet, here (a worker the system has not run holds up nothing).
+  for (int part = 1; part < parts && pending_.load(std::memory_order_acquire) != 0; ++part)
+    if (take(part, job)) {
+      run_part(part);
+      pending_.fetch_sub(1, std::memory_order_acq_rel);
+    }
   for (int left = pending_.load(std::memory_order_acquire); left != 0;) left = wait_change(pending_, left);
   for (const std::exception_ptr& e : errors_)
     if (e) std::rethrow_exception(e);
@@ -119,7 +127,7 @@ void ThreadPool::work(int index) {
     seen = wait_change(job_, seen);
     const int parts = static_cast<int>(seen & 0xffff);
     if (parts == 0) return;
-    if (index + 1 < parts) {
+    if (index + 1 < parts && take(index + 1, seen >> 16)) {
       run_part(index + 1);
       if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) wake();
     }

@@ -9,7 +9,10 @@
 //
 // The caller's thread runs part 0; a waiting thread spins for up to 1 ms (yielding its core between
 // rounds of pauses), then sleeps on a condition variable, so a busy pool hands work over in
-// microseconds and an idle one costs nothing after that millisecond. One pool serves one world, one
+// microseconds and an idle one costs nothing after that millisecond. Whoever starts a part first
+// takes it: a worker its own, the caller, once its part 0 is done, any a worker has not started.
+// So a worker the system has not let run (a host's other threads, a browser drawing on the other
+// core) delays nothing: the caller does its part instead of waiting for its turn. One pool serves one world, one
 // call at a time (the C ABI's one-call-at-a-time rule).
 #pragma once
 
@@ -19,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <type_traits>
@@ -123,7 +127,20 @@ class ThreadPool {
   // (job number << 16) | parts: one word, so that a worker sees a job's number and part count
   // together. 0 parts: stop.
   std::atomic<uint64_t> job_{0};
-  std::atomic<int> pending_{0};             // worker parts of the current job not yet done
+  std::atomic<int> pending_{0};  // worker parts of the current job not yet done
+  // Per part: the number of the last job whose part someone took (take()); a line each.
+  struct alignas(64) Taken {
+    std::atomic<uint64_t> job{0};
+  };
+  std::unique_ptr<Taken[]> taken_;
+  /// True for whoever takes part `part` of job `job` first (its runner), false for the others, and
+  /// for a worker that sees a job only after the caller has moved on to a later one.
+  bool take(int part, uint64_t job) {
+    std::atomic<uint64_t>& taken = taken_[static_cast<size_t>(part)].job;
+    for (uint64_t last = taken.load(std::memory_order_acquire); last < job;)
+      if (taken.compare_exchange_weak(last, job, std::memory_order_acq_rel, std::memory_order_acquire)) return true;
+    return false;
+  }
   std::vector<std::exception_ptr> errors_;  // per part: what it threw (a worker must never unwind)
   std::mutex sleep_mutex_;                  // wait_change's sleep: job_ and pending_ looked at under it
   std::condition_variable sleep_;
