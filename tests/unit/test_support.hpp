@@ -121,8 +121,10 @@ inline int32_t add_net(World& w, int n, double dx, double z0, double mass, doubl
 }
 
 /// An n x m grid of square panels of side `size` in the plane z = 1 (panel_grid), `thickness` thick,
-/// hard-pinned at the top corners of the mesh's corners; returns the body.
-inline Id add_panel_grid(World& w, int32_t n, int32_t m, double size, double thickness = 0.01) {
+/// hard-pinned at the top corners of the mesh's corners, the panels' corners welded or shared;
+/// returns the body.
+inline Id add_panel_grid(World& w, int32_t n, int32_t m, double size, double thickness = 0.01,
+                         PanelCorners corners = PanelCorners::welded) {
   std::vector<double> positions;
   std::vector<int32_t> quads;
   panel_grid(n, m, size, Vec3(0.0, 0.0, 1.0), positions, quads);
@@ -131,6 +133,7 @@ inline Id add_panel_grid(World& w, int32_t n, int32_t m, double size, double thi
   d.quads = quads;
   d.thickness = thickness;
   d.pins = PanelPins::top_corners;
+  d.corners = corners;
   return build_panel_mesh(w, d);
 }
 

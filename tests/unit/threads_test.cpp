@@ -230,16 +230,7 @@ TEST(Threads, ParticlePassesTakeTheParticlesOfTheirThreadsPanels) {
   Settings s;
   s.threads = 2;
   World w(s);
-  std::vector<double> pos;
-  std::vector<int32_t> quads;
-  panel_grid(16, 16, 0.2, Vec3(-1.6, -1.6, 0.0), pos, quads);
-  PanelMeshDesc d;
-  d.positions = pos;
-  d.quads = quads;
-  d.thickness = 0.01;
-  d.corners = PanelCorners::shared;
-  d.pins = PanelPins::top_corners;
-  build_panel_mesh(w, d);
+  test::add_panel_grid(w, 16, 16, 0.2, 0.01, PanelCorners::shared);
   w.step();
   const IslandPlan& plan = w.group(w.default_group()).islands;
   ASSERT_GT(plan.colour_start.size(), 2u) << "the panels go as islands in colours";
