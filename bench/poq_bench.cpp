@@ -5,16 +5,18 @@
 // 4 x 4 welded at 60 substeps x 2 iterations (examples/poq_drape.json) and the welded 16 x 16 and
 // 32 x 32 at the settings they needed (30 x 10 and 60 x 10, Chebyshev rho 0.95), for comparison.
 // `drape_example` times the shared meshes of examples/large/poq_drape_{16,32}.json at the solver
-// settings read from those files (the settings that settle within every target of their tolerance
+// settings embra's scene loader reads from those files (the settings that settle within every target of their tolerance
 // documents), reported as counters. Times 20 frames of World::step after 40 frames of draping (the
 // mesh folding over the sphere: face contacts active). The 32 x 32 case is the interactive target
 // (33 ms per frame on 2 threads is the goal).
 #include "embra/core/panels.hpp"
+#include "embra/io/files.hpp"
+#include "embra/io/scene.hpp"
 
 #include <benchmark/benchmark.h>
-#include <nlohmann/json.hpp>
 
-#include <fstream>
+#include <cstdint>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -71,21 +73,25 @@ void drape(benchmark::State& state) {
   run_drape(state, static_cast<int>(state.range(0)), static_cast<embra::PanelCorners>(state.range(1)), s);
 }
 
-/// examples/large/poq_drape_<n>.json's mesh (shared corners) at its own solver settings.
+/// examples/large/poq_drape_<n>.json's mesh (shared corners) at its own solver settings, as
+/// embra's scene loader reads them from the file.
 void drape_example(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const std::string path = std::string(EMBRA_SOURCE_DIR) + "/examples/large/poq_drape_" + std::to_string(n) + ".json";
-  std::ifstream file(path);
-  const nlohmann::json scene = nlohmann::json::parse(file, nullptr, false);
-  if (scene.is_discarded() || !scene.contains("solver")) {
-    state.SkipWithError(("cannot read the solver settings of " + path).c_str());
+  const std::string dir = std::string(EMBRA_SOURCE_DIR) + "/examples/large";
+  const std::string path = dir + "/poq_drape_" + std::to_string(n) + ".json";
+  std::string text, error;
+  if (!embra::io::read_regular_file(path, int64_t{1} << 24, text, error)) {
+    state.SkipWithError((path + ": " + error).c_str());
     return;
   }
-  const nlohmann::json& solver = scene["solver"];
   embra::Settings s;
-  s.substeps = solver.value("substeps", s.substeps);
-  s.iterations = solver.value("iterations", s.iterations);
-  s.chebyshev_rho_milli = solver.value("chebyshev_rho_milli", s.chebyshev_rho_milli);
+  try {
+    embra::io::SceneMeta meta;
+    s = embra::io::load_scene(text, dir, meta)->settings();
+  } catch (const std::exception& e) {
+    state.SkipWithError((path + ": " + e.what()).c_str());
+    return;
+  }
   s.threads = static_cast<int32_t>(state.range(1));
   run_drape(state, n, embra::PanelCorners::shared, s);
 }

@@ -88,10 +88,11 @@ ThreadPool::~ThreadPool() {
   for (std::thread& t : workers_) t.join();
 }
 
-void ThreadPool::publish(int parts) {
+uint64_t ThreadPool::publish(int parts) {
   const uint64_t number = (job_.load(std::memory_order_relaxed) >> 16) + 1;
   job_.store(number << 16 | static_cast<uint64_t>(parts), std::memory_order_release);
   wake();
+  return number;
 }
 
 void ThreadPool::run_part(int part) noexcept {
@@ -107,8 +108,7 @@ void ThreadPool::dispatch(void (*call)(void*, int), void* context, int parts) {
   context_ = context;
   for (std::exception_ptr& e : errors_) e = nullptr;
   pending_.store(parts - 1, std::memory_order_relaxed);
-  publish(parts);
-  const uint64_t job = job_.load(std::memory_order_relaxed) >> 16;
+  const uint64_t job = publish(parts);
   run_part(0);
   // The parts no worker has started yet, here (a worker the system has not run holds up nothing).
   for (int part = 1; part < parts && pending_.load(std::memory_order_acquire) != 0; ++part)

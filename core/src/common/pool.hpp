@@ -112,7 +112,7 @@ class ThreadPool {
 
   /// Runs call(context, p) for p in [0, parts): parts 1 .. parts - 1 on workers, 0 here.
   void dispatch(void (*call)(void*, int), void* context, int parts);
-  void publish(int parts);  // a new job number with `parts` parts (0: stop)
+  uint64_t publish(int parts);  // a new job with `parts` parts (0: stop); returns its number
   void work(int index);
   /// Waits until `a` holds a value other than `old` (spinning, then asleep); returns it.
   template <class T>
