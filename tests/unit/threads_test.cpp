@@ -105,6 +105,67 @@ TEST(Threads, AThrowingPartReachesTheCaller) {
   EXPECT_EQ(items.load(), 3000);
 }
 
+/// run_lines runs every step of every line once, each line's steps in order, each step only once
+/// `ready` let it (here the islands' rule: an even step k > 0 of a line after step k - 2 of every
+/// other line has ended), and ends whatever the threads: with more threads than this machine has
+/// cores (a worker the system has not run yet), the others take its line.
+TEST(Threads, RunLinesKeepsEachLinesOrderAndWhatReadyAsks) {
+  for (int threads : {2, 3, 8}) {
+    ThreadPool pool(threads);
+    constexpr int kSteps = 40;
+    const int lines = threads;
+    std::atomic<int> clock{0};
+    std::vector<int> begun(static_cast<size_t>(lines * kSteps), -1), ended(begun.size(), -1);
+    std::vector<std::atomic<int>> runs(begun.size());
+    const auto at = [&](int line, int step) { return static_cast<size_t>(line * kSteps + step); };
+    const auto ready = [&](int line, int step, const auto& done) {
+      if (step % 2 != 0 || step == 0) return true;
+      for (int q = 0; q < lines; ++q)
+        if (q != line && done(q) < step - 1) return false;
+      return true;
+    };
+    for (int repeat = 0; repeat < 50; ++repeat) {
+      pool.run_lines(lines, kSteps, ready, [&](int line, int step) {
+        begun[at(line, step)] = clock.fetch_add(1);
+        runs[at(line, step)].fetch_add(1);
+        ended[at(line, step)] = clock.fetch_add(1);
+      });
+      for (int s = 0; s < lines; ++s)
+        for (int k = 0; k < kSteps; ++k) {
+          ASSERT_EQ(runs[at(s, k)].exchange(0), 1) << "line " << s << " step " << k;
+          if (k > 0) {
+            EXPECT_LT(ended[at(s, k - 1)], begun[at(s, k)]) << "line " << s << " step " << k;
+          }
+          for (int q = 0; k % 2 == 0 && k > 0 && q < lines; ++q) {
+            if (q != s) {
+              EXPECT_LT(ended[at(q, k - 2)], begun[at(s, k)]) << "line " << s << " step " << k;
+            }
+          }
+        }
+    }
+  }
+}
+
+/// A step that throws stops the lines: the caller gets the exception (no part waits for the line
+/// that stopped), and the pool works on afterwards.
+TEST(Threads, AThrowingStepOfRunLinesReachesTheCaller) {
+  ThreadPool pool(3);
+  const auto always = [](int, int, const auto&) { return true; };
+  for (int thrower : {0, 1, 2}) {
+    try {
+      pool.run_lines(3, 10, always, [&](int line, int step) {
+        if (line == thrower && step == 5) throw Error(ErrorCode::internal, "line " + std::to_string(line));
+      });
+      ADD_FAILURE() << "no exception from line " << thrower;
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), "line " + std::to_string(thrower));
+    }
+  }
+  std::atomic<int> steps{0};
+  pool.run_lines(3, 10, always, [&](int, int) { steps.fetch_add(1); });
+  EXPECT_EQ(steps.load(), 30);
+}
+
 /// A 128 x 128 cloth pinned at two corners at the default settings (chain solve, automatic tethers
 /// in lanes, bending) falling onto a sphere: big enough that every colour of every kind is split
 /// over the threads.

@@ -75,10 +75,16 @@ void ThreadPool::wake() {
   sleep_.notify_all();
 }
 
+void ThreadPool::idle(int round) {
+  relax();
+  if (round % kPausesPerRound == 0) std::this_thread::yield();
+}
+
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   errors_.resize(static_cast<size_t>(threads));
   taken_ = std::make_unique<Taken[]>(static_cast<size_t>(threads));
+  lines_ = std::make_unique<Line[]>(static_cast<size_t>(threads));
   workers_.reserve(static_cast<size_t>(threads - 1));
   for (int i = 0; i + 1 < threads; ++i) workers_.emplace_back([this, i] { work(i); });
 }

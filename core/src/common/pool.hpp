@@ -75,6 +75,62 @@ class ThreadPool {
     dispatch(&Parts<Fn>::call, &job, parts);
   }
 
+  /// Runs `lines` sequences of `steps` steps each (lines at most size()): step k of line s once step
+  /// k - 1 of line s has ended and ready(s, k, done) holds, where done(q) is the number of line q's
+  /// steps ended so far (read with acquire: what they wrote is visible to the caller of done). Part s
+  /// runs line s's steps in turn, and while its own line cannot go on it takes the next step of
+  /// another line whose part has not started yet (a worker the system has not run), or of any line
+  /// once it has waited kStealRounds rounds; so whichever threads run, the lines end. step(s, k) runs
+  /// each step once, on whichever thread took it; it may throw, as run()'s parts may.
+  ///
+  /// `ready` must hold for the line with the fewest steps ended (while any is left), whatever the
+  /// others have done: else no step could run. Steps of different lines that `ready` lets overlap
+  /// must share no data; that is the caller's to ensure.
+  template <class Ready, class Step>
+  void run_lines(int lines, int steps, Ready&& ready, Step&& step) {
+    lines = std::clamp(lines, 1, size());
+    if (lines == 1) {
+      for (int k = 0; k < steps; ++k) step(0, k);
+      return;
+    }
+    for (int s = 0; s < lines; ++s) {
+      Line& l = lines_[static_cast<size_t>(s)];
+      l.claimed.store(0, std::memory_order_relaxed);
+      l.done.store(0, std::memory_order_relaxed);
+      l.started.store(false, std::memory_order_relaxed);
+    }
+    stopped_.store(false, std::memory_order_relaxed);  // the job's publication releases these
+    const auto done = [this](int q) { return lines_[static_cast<size_t>(q)].done.load(std::memory_order_acquire); };
+    const auto part = [&](int me) {
+      lines_[static_cast<size_t>(me)].started.store(true, std::memory_order_relaxed);
+      for (int waited = 0;;) {
+        bool left = false, ran = false;
+        for (int k = 0; k < lines && !ran; ++k) {
+          const int s = (me + k) % lines;  // its own line first
+          Line& l = lines_[static_cast<size_t>(s)];
+          int next = l.claimed.load(std::memory_order_acquire);
+          if (next >= steps) continue;
+          left = true;
+          if (k > 0 && waited < kStealRounds && l.started.load(std::memory_order_relaxed)) continue;
+          if (l.done.load(std::memory_order_acquire) != next || !ready(s, next, done)) continue;
+          if (!l.claimed.compare_exchange_strong(next, next + 1, std::memory_order_acq_rel)) continue;
+          try {
+            step(s, next);
+          } catch (...) {
+            stopped_.store(true, std::memory_order_relaxed);  // the other parts stop waiting for it
+            throw;
+          }
+          l.done.store(next + 1, std::memory_order_release);
+          ran = true;
+        }
+        if (!left || stopped_.load(std::memory_order_relaxed)) return;
+        waited = ran ? 0 : waited + 1;
+        if (!ran) idle(waited);
+      }
+    };
+    run_parts(lines, part);
+  }
+
   /// run() over [begin, end) where each part appends what it finds to its own list
   /// (find(part_begin, part_end, list)), the lists then appended to `out` part after part: `out`
   /// gains the items in range order, as if found on one thread, at any thread count. `parts` is the
@@ -89,6 +145,18 @@ class ThreadPool {
   }
 
  private:
+  /// run_lines: rounds a part waits on its own line before it takes steps of lines whose parts run
+  /// (about 10 us: a step of the islands is a few to twenty).
+  static constexpr int kStealRounds = 256;
+  /// A waiting round of run_lines (`round` of them so far): a pause, and the core given up now and then.
+  static void idle(int round);
+  struct alignas(64) Line {  // run_lines: one line's steps taken and ended, and whether its part started
+    std::atomic<int> claimed{0}, done{0};
+    std::atomic<bool> started{false};
+  };
+  std::unique_ptr<Line[]> lines_;
+  std::atomic<bool> stopped_{false};  // a step of run_lines threw
+
   template <class F>
   struct Job {
     F* fn;

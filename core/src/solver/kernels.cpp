@@ -923,9 +923,157 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
   pool.run(0, t.other_runs.size(), 1, kGrain, [&](size_t b, size_t e, int) { k.tether_runs(t, b, e, true, x, w); });
 }
 
+namespace {
+
+constexpr int kFlowCalls = 32;    // islands_pass: calls between moves of its parts' items
+constexpr size_t kMaxParts = 64;  // timed parts (one bit each in Flow::parts_of); past this the cut stays even
+
+/// IslandPlan::cut for `parts` parts: even cuts when the part count changes.
+void start_cut(IslandPlan& plan, size_t colours, size_t parts) {
+  if (plan.cut.size() == colours * (parts + 1)) return;
+  plan.cut.resize(colours * (parts + 1));
+  for (size_t c = 0; c < colours; ++c)
+    for (size_t p = 0; p <= parts; ++p)
+      plan.cut[c * (parts + 1) + p] = static_cast<double>(p) / static_cast<double>(parts);
+}
+
+/// Part p of a colour's items [begin, end) from the first item placed at at[p] or later (the items go
+/// in their places' order): every colour cut at the same places, so that a thread keeps one stretch
+/// of the mesh.
+size_t cut_item(const IslandPlan& plan, size_t begin, size_t end, const double* at, size_t p, size_t parts) {
+  if (p == 0) return begin;
+  if (p == parts) return end;
+  return static_cast<size_t>(std::partition_point(plan.items.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                  plan.items.begin() + static_cast<std::ptrdiff_t>(end),
+                                                  [&](const IslandPlan::Item& item) { return item.place < at[p]; }) -
+                             plan.items.begin());
+}
+
+/// Moves a colour's cut `at` a quarter of the way to the places where its parts would have taken the
+/// same time, each part's time (`seconds`) spread evenly over its stretch (a colour's time is noisy).
+void move_cut(double* at, const double* seconds, size_t parts) {
+  double total = 0.0;
+  for (size_t p = 0; p < parts; ++p) total += seconds[p];
+  if (!(total > 0.0)) return;
+  double target[kMaxParts + 1] = {};
+  double before = 0.0;  // time of the parts before p
+  size_t p = 0;
+  for (size_t q = 1; q < parts; ++q) {
+    const double want = total * static_cast<double>(q) / static_cast<double>(parts);
+    while (p + 1 < parts && before + seconds[p] < want) before += seconds[p++];
+    const double share = seconds[p] > 0.0 ? std::clamp((want - before) / seconds[p], 0.0, 1.0) : 0.0;
+    target[q] = at[p] + share * (at[p + 1] - at[p]);
+  }
+  for (size_t q = 1; q < parts; ++q) at[q] += 0.25 * (target[q] - at[q]);
+}
+
+template <class F>
+void each_item_particle(const IslandPlan& plan, size_t item, F&& f) {
+  const IslandPlan::Item& it = plan.items[item];
+  const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(it.shape)];
+  const size_t slots = static_cast<size_t>(shape.slots);
+  for (size_t at = static_cast<size_t>(it.first) * slots; at < static_cast<size_t>(it.first + it.count) * slots; ++at)
+    f(static_cast<size_t>(shape.particle[at]));
+}
+
+/// IslandPlan::Flow's borders for its `start`: each part's first and last items that hold a
+/// particle another part's items hold too (an item between two such counts as one).
+void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
+  IslandPlan::Flow& f = plan.flow;
+  size_t particles = 0;
+  for (const IslandPlan::Shape& shape : plan.shapes)
+    for (int32_t i : shape.particle) particles = std::max(particles, static_cast<size_t>(i) + 1);
+  f.parts_of.assign(particles, 0);
+  for (size_t c = 0; c < colours; ++c)
+    for (size_t p = 0; p < parts; ++p)
+      for (auto i = f.start[c * (parts + 1) + p]; i < f.start[c * (parts + 1) + p + 1]; ++i)
+        each_item_particle(plan, static_cast<size_t>(i), [&](size_t k) { f.parts_of[k] |= uint64_t{1} << p; });
+  f.lead.assign(colours * parts, 0);
+  f.trail.assign(colours * parts, 0);
+  for (size_t c = 0; c < colours; ++c)
+    for (size_t p = 0; p < parts; ++p) {
+      const int32_t b = f.start[c * (parts + 1) + p], e = f.start[c * (parts + 1) + p + 1];
+      const int32_t middle = b + (e - b) / 2;
+      int32_t lead = 0, trail = 0;
+      for (int32_t i = b; i < e; ++i) {
+        bool shared = false;
+        each_item_particle(plan, static_cast<size_t>(i),
+                           [&](size_t k) { shared = shared || (f.parts_of[k] & ~(uint64_t{1} << p)) != 0; });
+        if (!shared) continue;
+        if (i < middle)
+          lead = i - b + 1;
+        else if (trail == 0)
+          trail = e - i;
+      }
+      f.lead[c * parts + p] = lead;
+      f.trail[c * parts + p] = trail;
+    }
+}
+
+}  // namespace
+
 void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
                   const double* w) {
-  for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr);
+  const size_t colours = plan.colour_start.size() - 1;
+  size_t parts = static_cast<size_t>(pool.size());
+  for (size_t c = 0; c < colours; ++c)
+    parts = std::min(parts, static_cast<size_t>(plan.colour_start[c + 1] - plan.colour_start[c]) / kIslandGrain);
+  if (colours < 2 || parts <= 1 || parts > kMaxParts) {
+    for (size_t c = 0; c < colours; ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr);
+    return;
+  }
+  // One line of steps per part: a colour's border, then the rest of its items, colour after colour.
+  // A border of colour c waits for the other parts' borders of colour c - 1, whose items hold the
+  // particles it shares with them; the other items of a part share particles with its own items
+  // only, which its line has projected before. So every particle sees the projections of the items
+  // that hold it in the colours' order, as on one thread, and no step waits for a whole colour.
+  start_cut(plan, colours, parts);
+  IslandPlan::Flow& f = plan.flow;
+  // The parts' items follow the cut every kFlowCalls calls (finding the borders costs about a third
+  // of a pass on the 32 x 32 drape, and the cut moves a little in every call).
+  const bool fresh = f.start.size() != colours * (parts + 1);
+  if (fresh || ++f.calls >= kFlowCalls) {
+    f.calls = 0;
+    if (!fresh)  // the times of the items the parts took since the last move
+      for (size_t c = 0; c < colours; ++c)
+        move_cut(plan.cut.data() + c * (parts + 1), f.seconds.data() + c * parts, parts);
+    f.seconds.assign(colours * parts, 0.0);
+    bool moved = fresh;
+    f.start.resize(colours * (parts + 1));
+    for (size_t c = 0; c < colours; ++c) {
+      const size_t begin = static_cast<size_t>(plan.colour_start[c]);
+      const size_t end = static_cast<size_t>(plan.colour_start[c + 1]);
+      for (size_t p = 0; p <= parts; ++p) {
+        const auto item = static_cast<int32_t>(cut_item(plan, begin, end, plan.cut.data() + c * (parts + 1), p, parts));
+        moved = moved || f.start[c * (parts + 1) + p] != item;
+        f.start[c * (parts + 1) + p] = item;
+      }
+    }
+    if (moved) find_borders(plan, colours, parts);
+  }
+  const Kernels& k = kernels();
+  const int n = static_cast<int>(parts);
+  const auto ready = [&](int line, int step, const auto& done) {
+    if (step % 2 != 0 || step == 0) return true;  // a part's own items, or the first colour's border
+    for (int q = 0; q < n; ++q)
+      if (q != line && done(q) < step - 1) return false;  // q's border of the colour before not ended
+    return true;
+  };
+  pool.run_lines(n, static_cast<int>(2 * colours), ready, [&](int line, int step) {
+    const size_t c = static_cast<size_t>(step / 2), p = static_cast<size_t>(line);
+    const size_t b = static_cast<size_t>(f.start[c * (parts + 1) + p]);
+    const size_t e = static_cast<size_t>(f.start[c * (parts + 1) + p + 1]);
+    const size_t lead = static_cast<size_t>(f.lead[c * parts + p]);
+    const size_t trail = std::min(static_cast<size_t>(f.trail[c * parts + p]), e - b - lead);
+    const auto start = std::chrono::steady_clock::now();
+    if (step % 2 == 0) {
+      k.islands(plan, b, b + lead, rows, inv_h2, x, w);
+      k.islands(plan, e - trail, e, rows, inv_h2, x, w);
+    } else {
+      k.islands(plan, b + lead, e - trail, rows, inv_h2, x, w);
+    }
+    f.seconds[c * parts + p] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
 }
 
 void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
@@ -946,49 +1094,17 @@ void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArr
   const size_t end = static_cast<size_t>(plan.colour_start[colour + 1]);
   const size_t parts = std::min(static_cast<size_t>(pool.size()), (end - begin) / kIslandGrain);
   if (parts <= 1) return project(begin, end);
-  const size_t colours = plan.colour_start.size() - 1;
-  if (plan.cut.size() != colours * (parts + 1)) {
-    plan.cut.resize(colours * (parts + 1));
-    for (size_t c = 0; c < colours; ++c)
-      for (size_t p = 0; p <= parts; ++p)
-        plan.cut[c * (parts + 1) + p] = static_cast<double>(p) / static_cast<double>(parts);
-  }
+  start_cut(plan, plan.colour_start.size() - 1, parts);
   double* at = plan.cut.data() + colour * (parts + 1);  // IslandPlan::cut
-  // Part p from the first item placed at at[p] or later (the items go in their places' order):
-  // every colour cut at the same places, so that a thread keeps one stretch of the mesh.
-  const auto cut = [&](size_t p) {
-    if (p == 0) return begin;
-    if (p == parts) return end;
-    return static_cast<size_t>(std::partition_point(plan.items.begin() + static_cast<std::ptrdiff_t>(begin),
-                                                    plan.items.begin() + static_cast<std::ptrdiff_t>(end),
-                                                    [&](const IslandPlan::Item& item) { return item.place < at[p]; }) -
-                               plan.items.begin());
-  };
-  constexpr size_t kMaxParts = 64;  // timed parts; past this many threads the cut stays even
   double seconds[kMaxParts] = {};
   // Each part's time from the hand-over to its end: a worker's includes its waking.
   const auto start = std::chrono::steady_clock::now();
   pool.run_parts(static_cast<int>(parts), [&](int part) {
     const size_t p = static_cast<size_t>(part);
-    project(cut(p), cut(p + 1));
+    project(cut_item(plan, begin, end, at, p, parts), cut_item(plan, begin, end, at, p + 1, parts));
     if (p < kMaxParts) seconds[p] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
-  if (parts > kMaxParts) return;
-  // The places where each part would take the same time, each part's time spread evenly over its
-  // stretch; the cut moved a quarter of the way there (a colour's time is noisy).
-  double total = 0.0;
-  for (size_t p = 0; p < parts; ++p) total += seconds[p];
-  if (!(total > 0.0)) return;
-  double target[kMaxParts + 1] = {};
-  double before = 0.0;  // time of the parts before p
-  size_t p = 0;
-  for (size_t q = 1; q < parts; ++q) {
-    const double want = total * static_cast<double>(q) / static_cast<double>(parts);
-    while (p + 1 < parts && before + seconds[p] < want) before += seconds[p++];
-    const double share = seconds[p] > 0.0 ? std::clamp((want - before) / seconds[p], 0.0, 1.0) : 0.0;
-    target[q] = at[p] + share * (at[p + 1] - at[p]);
-  }
-  for (size_t q = 1; q < parts; ++q) at[q] += 0.25 * (target[q] - at[q]);
+  if (parts <= kMaxParts) move_cut(at, seconds, parts);
 }
 
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out) {

@@ -539,6 +539,20 @@ struct IslandPlan {
   /// lines it shares with another core, the particles the caller's serial stages touched). Which
   /// thread projects an item changes no bit: this balances time only.
   std::vector<double> cut;
+  /// How islands_pass runs the colours of one iteration on its threads' parts without a hand-over
+  /// between colours (ThreadPool::run_lines): per colour c and part p, the first item of the part
+  /// (`start`, parts + 1 a colour, from `cut`), and how many of the part's first and last items
+  /// (`lead`, `trail`) hold a particle that an item of another part also holds: its border. A part
+  /// projects its border first and the rest after; another part's border of the next colour waits
+  /// only for that, its own items for nothing. Found again when the cut has moved an item to another
+  /// part, looked at every few calls.
+  struct Flow {
+    std::vector<int32_t> start, lead, trail;
+    std::vector<uint64_t> parts_of;  // scratch: per particle, a bit for each part holding it
+    std::vector<double> seconds;     // per colour and part: the time its items took
+    int calls = 0;                   // calls since `start` last followed the cut
+  };
+  Flow flow;
   /// Per item: 1 when one of its rows holds a hard-pinned particle (World::find_pinned_slots, with
   /// the arrays' `pinned` lists): the tracked substep projects those items row by row.
   std::vector<uint8_t> pinned_items;
