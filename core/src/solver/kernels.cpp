@@ -1032,12 +1032,16 @@ void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, 
   // The parts' items follow the cut every kFlowCalls calls (finding the borders costs about a third
   // of a pass on the 32 x 32 drape, and the cut moves a little in every call).
   const bool fresh = f.start.size() != colours * (parts + 1);
+  const size_t stride = (colours + 7) / 8 * 8;  // a part's times on cache lines of their own
   if (fresh || ++f.calls >= kFlowCalls) {
     f.calls = 0;
     if (!fresh)  // the times of the items the parts took since the last move
-      for (size_t c = 0; c < colours; ++c)
-        move_cut(plan.cut.data() + c * (parts + 1), f.seconds.data() + c * parts, parts);
-    f.seconds.assign(colours * parts, 0.0);
+      for (size_t c = 0; c < colours; ++c) {
+        double seconds[kMaxParts];
+        for (size_t p = 0; p < parts; ++p) seconds[p] = f.seconds[p * stride + c];
+        move_cut(plan.cut.data() + c * (parts + 1), seconds, parts);
+      }
+    f.seconds.assign(parts * stride, 0.0);
     bool moved = fresh;
     f.start.resize(colours * (parts + 1));
     for (size_t c = 0; c < colours; ++c) {
@@ -1072,7 +1076,7 @@ void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, 
     } else {
       k.islands(plan, b + lead, e - trail, rows, inv_h2, x, w);
     }
-    f.seconds[c * parts + p] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    f.seconds[p * stride + c] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
 }
 

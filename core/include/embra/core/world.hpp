@@ -549,7 +549,7 @@ struct IslandPlan {
   struct Flow {
     std::vector<int32_t> start, lead, trail;
     std::vector<uint64_t> parts_of;  // scratch: per particle, a bit for each part holding it
-    std::vector<double> seconds;     // per colour and part: the time its items took
+    std::vector<double> seconds;     // per part and colour: the time its items took
     int calls = 0;                   // calls since `start` last followed the cut
   };
   Flow flow;
