@@ -532,12 +532,15 @@ struct IslandPlan {
   /// Colour c: items [colour_start[c], colour_start[c + 1]), whose islands share no particle; the
   /// colours in turn (one colour when no island shares a particle with another).
   std::vector<int32_t> colour_start;
-  /// Where a colour's items are cut into the threads' parts (islands_colour): part p takes the
-  /// items placed in [cut[p], cut[p + 1]), cut[0] = 0 and cut[parts] = 1. It starts at p / parts
-  /// and after each colour moves a quarter of the way to the places where the parts would have
-  /// taken equal time: a thread's stretch can cost more than its share of the items (the cache
-  /// lines it shares with another core, the particles the caller's serial stages touched). Which
-  /// thread projects an item changes no bit: this balances time only.
+  /// Where each colour's items are cut into the threads' parts: part p takes the items placed in
+  /// [cut[p], cut[p + 1]), cut[0] = 0 and cut[parts] = 1 (parts + 1 a colour). It starts at
+  /// p / parts and moves a quarter of the way to the places where the parts would have taken equal
+  /// time: a thread's stretch can cost more than its share of the items (the cache lines it shares
+  /// with another core, the particles the caller's serial stages touched). islands_pass keeps one
+  /// cut for every colour (Flow), moved every few calls from the parts' times over all colours;
+  /// islands_colour, where the colours go one at a time (one colour, or too few items to split
+  /// every colour), moves each colour's own after it. Which thread projects an item changes no
+  /// bit: this balances time only.
   std::vector<double> cut;
   /// How islands_pass runs the colours of one iteration on its threads' parts without a hand-over
   /// between colours (ThreadPool::run_lines): per colour c and part p, the first item of the part
@@ -549,7 +552,7 @@ struct IslandPlan {
   struct Flow {
     std::vector<int32_t> start, lead, trail;
     std::vector<uint64_t> parts_of;  // scratch: per particle, a bit for each part holding it
-    std::vector<double> seconds;     // per part and colour: the time its items took
+    std::vector<double> seconds;     // per part (8 apart): the time its items took
     int calls = 0;                   // calls since `start` last followed the cut
   };
   Flow flow;
