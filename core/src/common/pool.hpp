@@ -1,6 +1,8 @@
 // The solver's threads: a fixed pool that splits one range of independent items (the constraints of
 // one colour, the chains of one colour, the particles of a pass) into one contiguous part per
-// thread, runs the parts at once and returns when all are done.
+// thread, runs the parts at once and returns when all are done; or runs one line of steps per
+// thread whose steps wait only for the steps of other lines they need (run_lines: the colours of a
+// panel mesh's islands, each waiting for the borders of the colour before).
 //
 // What a part computes never depends on how the range was split: every item reads and writes only
 // its own particles (a colour's constraints share no movable particle), and the kernels give the
