@@ -250,10 +250,12 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
   T wp[kBlocks][IslandPlan::kSlots];
   const int32_t* ids[kBlocks];
   const int32_t* row[kBlocks];
+  double* lam_at[kBlocks];
   for (int b = 0; b < kBlocks; ++b) {
     const size_t at = first + static_cast<size_t>(b * L::count);
     ids[b] = &shape.particle[at * static_cast<size_t>(slots)];
     row[b] = &shape.row[at * static_cast<size_t>(steps)];
+    lam_at[b] = &shape.lambda[at * static_cast<size_t>(steps)];
     for (int k = 0; k < slots; ++k) {
       p[b][k] = load_point<T>(x, ids[b] + k, slots);
       wp[b][k] = load_value<T>(w, ids[b] + k, slots);
@@ -264,7 +266,10 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
     const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
     for (int b = 0; b < kBlocks; ++b) {
       const int32_t* at = row[b] + step;  // lane l's row: at[l * steps]
-      const T r = load_value<T>(a.rest.data(), at, steps), lam = load_value<T>(a.lambda.data(), at, steps);
+      double* own = lam_at[b] + step;     // lane l's multiplier: own[l * steps]
+      double lams[L::count];
+      for (int l = 0; l < L::count; ++l) lams[l] = own[l * steps];
+      const T r = load_value<T>(a.rest.data(), at, steps), lam = L::make(lams);
       const T alpha = load_value<T>(a.compliance.data(), at, steps) * inv_h2;
       V3<T>* q = p[b];
       const T* wq = wp[b];
@@ -287,7 +292,7 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
         lam_new = lam + dl;
       }
       for (int l = 0; l < L::count; ++l)
-        if (L::on(ok, l)) a.lambda[at[l * steps]] = L::get(lam_new, l);
+        if (L::on(ok, l)) own[l * steps] = L::get(lam_new, l);
     }
   }
   for (int b = 0; b < kBlocks; ++b)
@@ -300,21 +305,39 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
     }
 }
 
+/// An item's rows' multipliers from the arrays into its islands' own (`take`), or back.
+inline void own_lambda(const IslandPlan::Shape& shape, const IslandPlan::Item& item, SolverArray* const* rows,
+                       bool take) {
+  const size_t steps = static_cast<size_t>(shape.steps);
+  double* own = shape.lambda.data() + static_cast<size_t>(item.first) * steps;
+  const int32_t* row = shape.row.data() + static_cast<size_t>(item.first) * steps;
+  for (int32_t island = 0; island < item.count; ++island, own += steps, row += steps)
+    for (size_t step = 0; step < steps; ++step) {
+      double& in_array = rows[shape.kind[step]]->lambda[static_cast<size_t>(row[step])];
+      if (take)
+        own[step] = in_array;
+      else
+        in_array = own[step];
+    }
+}
+
 /// The islands of items [begin, end) (IslandPlan::items): in two blocks of lanes of T side by side
 /// while an item has that many left, then one block, then one at a time.
 template <class T>
 EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows,
-                                      double inv_h2, double* x, const double* w) {
+                                      double inv_h2, double* x, const double* w, int ends) {
   constexpr int lanes_n = lanes::Lanes<T>::count;
   for (size_t i = begin; i < end; ++i) {
     const IslandPlan::Item& item = plan.items[i];
     const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    if (ends & kIslandsTake) own_lambda(shape, item, rows, true);
     int k = 0;
     for (; k + 2 * lanes_n <= item.count; k += 2 * lanes_n)
       island_block<T, 2>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
     for (; k + lanes_n <= item.count; k += lanes_n)
       island_block<T, 1>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
     for (; k < item.count; ++k) island_block<double, 1>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
+    if (ends & kIslandsGive) own_lambda(shape, item, rows, false);
   }
 }
 
@@ -804,8 +827,8 @@ EMBRA_ALWAYS_INLINE void values(const SolverArray& a, size_t i, size_t end, cons
     tether_runs<T>(t, begin, end, others, x, w);                                                                      \
   }                                                                                                                   \
   ATTR void NAME##_islands(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2, \
-                           double* x, const double* w) {                                                              \
-    island_items<T>(plan, begin, end, rows, inv_h2, x, w);                                                            \
+                           double* x, const double* w, int ends) {                                                    \
+    island_items<T>(plan, begin, end, rows, inv_h2, x, w, ends);                                                      \
   }                                                                                                                   \
   ATTR void NAME##_chain(SolverArray& a, size_t begin, size_t end, bool in_lanes, double inv_h2, double* x,           \
                          const double* w, double* scratch) {                                                          \
@@ -860,7 +883,7 @@ Kernels::Pass row_kernels[IslandPlan::kRowKinds] = {};
 /// The islands of items [begin, end), their rows one at a time in the islands' order with the pass
 /// kernels (EMBRA_ISLANDS=rows): what the island kernels must match bit for bit.
 void islands_by_rows(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2,
-                     double* x, const double* w) {
+                     double* x, const double* w, int /*ends: the rows' multipliers stay in the arrays*/) {
   each_island_row(plan, begin, end,
                   [&](int kind, size_t row) { row_kernels[kind](*rows[kind], row, row + 1, false, inv_h2, x, w); });
 }
@@ -1012,14 +1035,19 @@ void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
 
 }  // namespace
 
+void own_multipliers(const IslandPlan& plan) {
+  for (const IslandPlan::Shape& shape : plan.shapes) shape.lambda.resize(shape.row.size());
+}
+
 void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
-                  const double* w) {
+                  const double* w, int ends) {
+  own_multipliers(plan);
   const size_t colours = plan.colour_start.size() - 1;
   size_t parts = static_cast<size_t>(pool.size());
   for (size_t c = 0; c < colours; ++c)
     parts = std::min(parts, static_cast<size_t>(plan.colour_start[c + 1] - plan.colour_start[c]) / kIslandGrain);
   if (colours < 2 || parts <= 1 || parts > kMaxParts) {
-    for (size_t c = 0; c < colours; ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr);
+    for (size_t c = 0; c < colours; ++c) islands_colour(pool, plan, c, rows, inv_h2, x, w, nullptr, ends);
     return;
   }
   // One line of steps per part: a colour's border, then the rest of its items, colour after colour.
@@ -1076,27 +1104,28 @@ void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, 
     const size_t trail = std::min(static_cast<size_t>(f.trail[c * parts + p]), e - b - lead);
     const auto start = std::chrono::steady_clock::now();
     if (step % 2 == 0) {
-      k.islands(plan, b, b + lead, rows, inv_h2, x, w);
-      k.islands(plan, e - trail, e, rows, inv_h2, x, w);
+      k.islands(plan, b, b + lead, rows, inv_h2, x, w, ends);
+      k.islands(plan, e - trail, e, rows, inv_h2, x, w, ends);
     } else {
-      k.islands(plan, b + lead, e - trail, rows, inv_h2, x, w);
+      k.islands(plan, b + lead, e - trail, rows, inv_h2, x, w, ends);
     }
     f.seconds[p * stride] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
 }
 
 void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
-                    double* x, const double* w, const uint8_t* skip) {
+                    double* x, const double* w, const uint8_t* skip, int ends) {
+  own_multipliers(plan);
   const Kernels& k = kernels();
   const auto project = [&](size_t b, size_t e) {
-    if (skip == nullptr) return k.islands(plan, b, e, rows, inv_h2, x, w);
+    if (skip == nullptr) return k.islands(plan, b, e, rows, inv_h2, x, w, ends);
     for (size_t i = b; i < e;) {  // the runs of items not skipped
       for (; i < e && skip[i] != 0; ++i) {
       }
       const size_t run = i;
       for (; i < e && skip[i] == 0; ++i) {
       }
-      if (run < i) k.islands(plan, run, i, rows, inv_h2, x, w);
+      if (run < i) k.islands(plan, run, i, rows, inv_h2, x, w, ends);
     }
   };
   const size_t begin = static_cast<size_t>(plan.colour_start[colour]);

@@ -41,11 +41,19 @@ struct Kernels {
   /// The automatic tethers' runs pair_runs[begin .. end), or other_runs[begin .. end) with `others`.
   void (*tether_runs)(const SolverArray&, size_t begin, size_t end, bool others, double* x, const double* w);
   /// The island items [begin, end) of `plan`; rows: the group's distance, planarity and plane-offset
-  /// arrays.
+  /// arrays. `ends` (IslandEnds): whether the rows' multipliers are first taken from the arrays into
+  /// the islands' own (IslandPlan::Shape::lambda), and afterwards given back.
   void (*islands)(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows, double inv_h2, double* x,
-                  const double* w);
+                  const double* w, int ends);
   const char* name;
 };
+
+/// Kernels::islands' `ends`: a pass's first projection of a group takes the islands' multipliers
+/// from the arrays (where a global solve or an earlier pass set them; World::reset_multipliers
+/// zeroes both), its last gives them back, so between them each thread writes the multipliers
+/// of its own items only, on cache lines of their own (a row's place in its array colour does not
+/// follow the threads' cut). Every other reader of the arrays comes after a pass's last projection.
+enum IslandEnds : int { kIslandsTake = 1, kIslandsGive = 2 };
 
 /// Calls f(kind, row) for each row of the island items [begin, end) of `plan`, island by island in
 /// the islands' order (kind: 0 distance, 1 planarity, 2 plane offset; row: the index into that
@@ -150,11 +158,11 @@ void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const d
 /// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), colour
 /// by colour, each colour's items split over the pool's threads (its islands share no particle).
 void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,
-                  const double* w);
+                  const double* w, int ends);
 /// Colour `colour` of islands_pass alone, without the items flagged in `skip` (one flag per item of
 /// the plan; null: none skipped), which the caller projects itself.
 void islands_colour(ThreadPool& pool, IslandPlan& plan, size_t colour, SolverArray* const* rows, double inv_h2,
-                    double* x, const double* w, const uint8_t* skip);
+                    double* x, const double* w, const uint8_t* skip, int ends);
 /// The function values of every constraint of `a` into out[0 .. a.size()).
 void values_pass(ThreadPool& pool, Kernels::Values kernel, const SolverArray& a, const double* x, double* out);
 

@@ -104,7 +104,7 @@ void kernel_pass(ThreadPool& pool, Kernels::Pass kernel, SolverArray& a, double 
 /// each row that holds a pinned particle (PinTrack). A colour's islands share no particle, so the
 /// split changes no bit.
 void tracked_islands(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, std::vector<Vec3>& x,
-                     const double* w, std::vector<Pin>& pins) {
+                     const double* w, std::vector<Pin>& pins, int ends) {
   const Kernels& k = kernels();
   const Kernels::Pass pass[IslandPlan::kRowKinds] = {k.distance, k.planarity, k.plane_offset};
   PinTrack<Kind::distance> distance(*rows[0], x, pins);
@@ -118,7 +118,7 @@ void tracked_islands(ThreadPool& pool, IslandPlan& plan, SolverArray* const* row
   };
   const std::vector<uint8_t>& held = plan.pinned_items;  // find_pinned_slots
   for (size_t c = 0; c + 1 < plan.colour_start.size(); ++c) {
-    islands_colour(pool, plan, c, rows, inv_h2, coords(x), w, held.data());
+    islands_colour(pool, plan, c, rows, inv_h2, coords(x), w, held.data(), ends);
     for (size_t i = static_cast<size_t>(plan.colour_start[c]); i < static_cast<size_t>(plan.colour_start[c + 1]); ++i)
       if (held[i] != 0)
         each_island_row(plan, i, i + 1, [&](int kind, size_t row) {
@@ -239,6 +239,7 @@ void World::reset_multipliers() {
   for (int32_t slot : order_) {
     Group& g = groups_[slot];
     for (SolverArray& a : g.solve) std::fill(a.lambda.begin(), a.lambda.end(), 0.0);
+    for (const IslandPlan::Shape& shape : g.islands.shapes) std::fill(shape.lambda.begin(), shape.lambda.end(), 0.0);
     std::fill(g.tethers.lambda.begin(), g.tethers.lambda.end(), 0.0);
     for (int32_t pi : g.soft_pins) pins_[pi].lambda.setZero();
     for (ShapeMatch& sm : g.shapes) std::fill(sm.lambda.begin(), sm.lambda.end(), Vec3::Zero());
@@ -343,7 +344,7 @@ void World::realign(const std::vector<Vec3>& predicted) {
   });
 }
 
-void World::project_group(Group& g, double h, bool first) {
+void World::project_group(Group& g, double h, bool first, int ends) {
   const double inv_h2 = 1.0 / (h * h);
   for (int32_t pi : g.soft_pins) {
     Pin& p = pins_[pi];
@@ -416,9 +417,9 @@ void World::project_group(Group& g, double h, bool first) {
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
   if (islands && pinned_rows) {
-    tracked_islands(*pool_, g.islands, rows, inv_h2, x_, w, *tracked);
+    tracked_islands(*pool_, g.islands, rows, inv_h2, x_, w, *tracked, ends);
   } else if (islands) {
-    islands_pass(*pool_, g.islands, rows, inv_h2, x, w);
+    islands_pass(*pool_, g.islands, rows, inv_h2, x, w, ends);
   } else if (distance.chain_start.empty() || !first) {
     kernel_pass<Kind::distance>(*pool_, k.distance, distance, inv_h2, x_, w, tracked);
   } else if (tracked == nullptr || distance.pinned.empty()) {
@@ -787,7 +788,14 @@ void World::solve(double h, const StepControl& control) {
       for (int32_t slot : order_) {
         Group& g = groups_[slot];
         // The group's first projection in the substep takes the chain solve's turn (chain_pass).
-        for (int k = 0; k < g.desc.weight; ++k) project_group(g, h, pass == 0 && it == 0 && k == 0);
+        for (int k = 0; k < g.desc.weight; ++k) {
+          // The islands take the arrays' multipliers only where a global solve or a pass before set
+          // them: after reset_multipliers both are zero.
+          const bool set = settings_.global_solve != 0 || pass > 0;
+          const int ends = (set && it == 0 && k == 0 ? kIslandsTake : 0) |
+                           (it + 1 == settings_.iterations && k + 1 == g.desc.weight ? kIslandsGive : 0);
+          project_group(g, h, pass == 0 && it == 0 && k == 0, ends);
+        }
       }
       if (rho > 0.0) chebyshev_step(it, rho, omega);
     }

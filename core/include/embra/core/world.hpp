@@ -518,6 +518,9 @@ struct IslandPlan {
     std::vector<int8_t> slot;       // per step: 4 local particles (a distance uses 2)
     std::vector<int32_t> particle;  // per island: its `slots` particles
     std::vector<int32_t> row;       // per island: its `steps` rows (indices into that kind's array)
+    /// Per island: its rows' multipliers while a pass projects the islands (IslandEnds: taken from
+    /// the arrays at its first projection, given back at its last); scratch the kernels write.
+    mutable std::vector<double> lambda;
     size_t islands() const { return slots == 0 ? 0 : particle.size() / static_cast<size_t>(slots); }
   };
   struct Item {  // up to kItemIslands consecutive islands of one shape
@@ -964,7 +967,8 @@ class World {
   bool pinned_any_ = false, track_pins_ = false;
   std::vector<Vec3> pin_chebyshev_prev_, pin_chebyshev_now_;
   /// Projects a group once; `first`: its first projection in the substep (the chain solve's turn).
-  void project_group(Group& g, double h, bool first);
+  /// `ends`: IslandEnds, the group's first and last projection in a pass of the iterations.
+  void project_group(Group& g, double h, bool first, int ends);
   void project_contacts(Group& g, double h);
   /// Settings::global_solve: the substep's implicit problem solved by Newton's method, the
   /// multipliers set from it (solver/global_solve.cpp).
