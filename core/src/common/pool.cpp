@@ -21,6 +21,8 @@ constexpr std::chrono::microseconds kSpinTime{1000};
 /// hand-over), then in rounds of kPausesPerRound with a yield after each, so that on a machine with
 /// fewer cores than threads a waiting thread gives its core to one with work.
 constexpr int kPauses = 4096;
+/// A sleeping thread looks at what it waits for at least this often.
+constexpr std::chrono::milliseconds kSleepLook{50};
 constexpr int kPausesPerRound = 64;
 
 inline void relax() {
@@ -61,7 +63,11 @@ T ThreadPool::wait_change(const std::atomic<T>& a, T old) {
   std::unique_lock<std::mutex> lock(sleep_mutex_);
   sleepers_.fetch_add(1, std::memory_order_seq_cst);
   std::atomic_thread_fence(std::memory_order_seq_cst);  // pairs with wake's: one of us sees the other
-  sleep_.wait(lock, [&] { return (now = a.load(std::memory_order_acquire)) != old; });
+  // Looked at again every kSleepLook even without a notification: a wake-up lost to the platform
+  // (capi.test_capi_threads once never exited under wine after every check passed, a worker asleep
+  // through the pool's stop) then costs that long, never a hang.
+  while (!sleep_.wait_for(lock, kSleepLook, [&] { return (now = a.load(std::memory_order_acquire)) != old; })) {
+  }
   sleepers_.fetch_sub(1, std::memory_order_relaxed);
   return now;
 }
