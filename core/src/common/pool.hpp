@@ -10,12 +10,12 @@
 // result is the same at any thread count, bit for bit.
 //
 // The caller's thread runs part 0; a waiting thread spins for up to 1 ms (yielding its core between
-// rounds of pauses), then sleeps on a condition variable (looking again every 50 ms), so a busy pool hands work over in
-// microseconds and an idle one costs nothing after that millisecond. Whoever starts a part first
-// takes it: a worker its own, the caller, once its part 0 is done, any a worker has not started.
-// So a worker the system has not let run (a host's other threads, a browser drawing on the other
-// core) delays nothing: the caller does its part instead of waiting for its turn. One pool serves one world, one
-// call at a time (the C ABI's one-call-at-a-time rule).
+// rounds of pauses), then sleeps on a condition variable (looking again every 50 ms), so a busy
+// pool hands work over in microseconds and an idle one costs next to nothing after that millisecond. Whoever starts a
+// part first takes it: a worker its own, the caller, once its part 0 is done, any a worker has not started. So a worker
+// the system has not let run (a host's other threads, a browser drawing on the other core) delays nothing: the caller
+// does its part instead of waiting for its turn. One pool serves one world, one call at a time (the C ABI's
+// one-call-at-a-time rule).
 #pragma once
 
 #include <algorithm>
