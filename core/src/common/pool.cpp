@@ -21,9 +21,9 @@ constexpr std::chrono::microseconds kSpinTime{1000};
 /// hand-over), then in rounds of kPausesPerRound with a yield after each, so that on a machine with
 /// fewer cores than threads a waiting thread gives its core to one with work.
 constexpr int kPauses = 4096;
+constexpr int kPausesPerRound = 64;
 /// A sleeping thread looks at what it waits for at least this often.
 constexpr std::chrono::milliseconds kSleepLook{50};
-constexpr int kPausesPerRound = 64;
 
 inline void relax() {
 #if defined(__x86_64__) || defined(__i386__)
