@@ -1689,13 +1689,11 @@ void World::find_particle_parts() {
     if (plan.colour_start.size() <= 2) continue;  // one colour or none: cut by equal item counts
     any = true;
     // islands_colour's cut: an item placed at `place` goes to part floor(place * parts).
-    for (const IslandPlan::Item& item : plan.items) {
-      const int32_t p = std::min(parts - 1, static_cast<int32_t>(item.place * parts));
-      const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
-      const size_t slots = static_cast<size_t>(shape.slots);
-      for (size_t at = static_cast<size_t>(item.first) * slots;
-           at < static_cast<size_t>(item.first + item.count) * slots; ++at)
-        if (int32_t& q = part[static_cast<size_t>(shape.particle[at])]; q < 0) q = p;
+    for (size_t i = 0; i < plan.items.size(); ++i) {
+      const int32_t p = std::min(parts - 1, static_cast<int32_t>(plan.items[i].place * parts));
+      plan.each_particle(i, [&](size_t k) {
+        if (part[k] < 0) part[k] = p;
+      });
     }
   }
   if (!any) return;

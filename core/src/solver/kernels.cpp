@@ -990,15 +990,6 @@ void move_cut(double* at, const double* seconds, size_t parts) {
   for (size_t q = 1; q < parts; ++q) at[q] += 0.25 * (target[q] - at[q]);
 }
 
-template <class F>
-void each_item_particle(const IslandPlan& plan, size_t item, F&& f) {
-  const IslandPlan::Item& it = plan.items[item];
-  const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(it.shape)];
-  const size_t slots = static_cast<size_t>(shape.slots);
-  for (size_t at = static_cast<size_t>(it.first) * slots; at < static_cast<size_t>(it.first + it.count) * slots; ++at)
-    f(static_cast<size_t>(shape.particle[at]));
-}
-
 /// IslandPlan::Flow's borders for its `start`: each part's first and last items that hold a
 /// particle another part's items hold too (an item between two such counts as one).
 void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
@@ -1010,7 +1001,7 @@ void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
   for (size_t c = 0; c < colours; ++c)
     for (size_t p = 0; p < parts; ++p)
       for (auto i = f.start[c * (parts + 1) + p]; i < f.start[c * (parts + 1) + p + 1]; ++i)
-        each_item_particle(plan, static_cast<size_t>(i), [&](size_t k) { f.parts_of[k] |= uint64_t{1} << p; });
+        plan.each_particle(static_cast<size_t>(i), [&](size_t k) { f.parts_of[k] |= uint64_t{1} << p; });
   f.lead.assign(colours * parts, 0);
   f.trail.assign(colours * parts, 0);
   for (size_t c = 0; c < colours; ++c)
@@ -1020,7 +1011,7 @@ void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
       int32_t lead = 0, trail = 0;
       for (int32_t i = b; i < e; ++i) {
         bool shared = false;
-        each_item_particle(plan, static_cast<size_t>(i),
+        plan.each_particle(static_cast<size_t>(i),
                            [&](size_t k) { shared = shared || (f.parts_of[k] & ~(uint64_t{1} << p)) != 0; });
         if (!shared) continue;
         if (i < middle)

@@ -563,6 +563,15 @@ struct IslandPlan {
   /// the arrays' `pinned` lists): the tracked substep projects those items row by row.
   std::vector<uint8_t> pinned_items;
   bool active() const { return !items.empty(); }
+  /// Calls f(particle) for each particle slot of each island of item `i`, in their order.
+  template <class F>
+  void each_particle(size_t i, F&& f) const {
+    const Item& it = items[i];
+    const Shape& shape = shapes[static_cast<size_t>(it.shape)];
+    const size_t slots = static_cast<size_t>(shape.slots);
+    for (size_t at = static_cast<size_t>(it.first) * slots; at < static_cast<size_t>(it.first + it.count) * slots; ++at)
+      f(static_cast<size_t>(shape.particle[at]));
+  }
 };
 
 struct Group {
