@@ -497,6 +497,10 @@ struct SelfCollisionIndex {
   std::vector<self_collision::FloatBox> item_box;  // per item: its primitives' region boxes
   std::vector<Vec3> start;                         // the positions at the start of the last substep
   std::vector<double> radius;                      // the half thicknesses the pairs' gaps were measured with
+  std::vector<Vec3> rest;                          // the bodies' rest shapes (points order) near_at_rest was found in
+  // The same body's pairs within their thickness in its rest shape (neighbours on the surface,
+  // never kept), sorted: point p and triangle t as p nt + t, edges ea < eb as ea ne + eb.
+  std::vector<uint64_t> near_at_rest_pt, near_at_rest_ee;
 };
 
 }  // namespace embra
@@ -909,6 +913,82 @@ void query_hierarchy(const SelfCollisionIndex& ix, const FloatBox& q, F&& visit)
   }
 }
 
+/// Half the smallest separation kept, for a particle of half thickness r: what its boxes grow by.
+double grow_of(double r) {
+  return std::max(r, 0.5 * kMinGap);
+}
+
+/// Finds ix.near_at_rest_pt and near_at_rest_ee for the primitives of `s` and the bodies' rest
+/// shapes, with the half thicknesses r: the pairs of one body that share no particle and lie
+/// within their thickness at rest (their rest boxes, grown by their particles' half thicknesses,
+/// overlap, in a uniform grid; then the exact distance).
+void find_near_at_rest(SelfCollisionIndex& ix, const Scratch& s, std::span<const BodyInfo> bodies,
+                       std::span<const double> r) {
+  const size_t nt = s.tris.size() / 3, ne = s.edges.size() / 2;
+  ix.near_at_rest_pt.clear();
+  ix.near_at_rest_ee.clear();
+  std::vector<int32_t> body_of(r.size(), -1);
+  for (size_t bi = 0; bi < bodies.size(); ++bi)
+    if (!bodies[bi].triangles.empty())
+      std::fill_n(body_of.begin() + bodies[bi].first_particle, bodies[bi].particle_count, static_cast<int32_t>(bi));
+  auto rest = [&](int32_t i) -> const Vec3& { return rest_of(bodies[static_cast<size_t>(body_of[i])], i); };
+  auto rest_box = [&](std::initializer_list<int32_t> ids) {
+    Box b = Box::empty();
+    double g = 0.0;
+    for (int32_t i : ids) {
+      b.unite({rest(i), rest(i)});
+      g = std::max(g, grow_of(r[i]));
+    }
+    b.lo.array() -= g;
+    b.hi.array() += g;
+    return b;
+  };
+  std::vector<int32_t> found;
+  Grid grid;
+  std::vector<Box> boxes(nt);
+  for (size_t t = 0; t < nt; ++t) boxes[t] = rest_box({s.tris[3 * t], s.tris[3 * t + 1], s.tris[3 * t + 2]});
+  grid.build(boxes, mean_extent(boxes));
+  double bary[3];
+  for (int32_t p : s.points) {
+    found.clear();
+    grid.query(rest_box({p}), found);
+    for (int32_t t : found) {
+      const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
+      if (v[0] == p || v[1] == p || v[2] == p || body_of[p] != s.tri_body[t]) continue;
+      const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
+      if (!apart<1, 3>({&rest(p)}, {&rest(v[0]), &rest(v[1]), &rest(v[2])}, thk) &&
+          point_triangle_distance(rest(p), rest(v[0]), rest(v[1]), rest(v[2]), bary) < thk)
+        ix.near_at_rest_pt.push_back(static_cast<uint64_t>(p) * nt + static_cast<uint64_t>(t));
+    }
+  }
+  boxes.resize(ne);
+  for (size_t e = 0; e < ne; ++e) boxes[e] = rest_box({s.edges[2 * e], s.edges[2 * e + 1]});
+  grid.build(boxes, mean_extent(boxes));
+  for (size_t ea = 0; ea < ne; ++ea) {
+    found.clear();
+    grid.query(boxes[ea], found);
+    const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1];
+    for (int32_t e : found) {
+      const size_t eb = static_cast<size_t>(e);
+      if (eb <= ea || s.edge_body[ea] != s.edge_body[eb]) continue;
+      const int32_t b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
+      if (b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1) continue;
+      const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
+      double ps, pt;
+      if (!apart<2, 2>({&rest(a0), &rest(a1)}, {&rest(b0), &rest(b1)}, thk) &&
+          edge_edge_distance(rest(a0), rest(a1), rest(b0), rest(b1), ps, pt) < thk)
+        ix.near_at_rest_ee.push_back(static_cast<uint64_t>(ea) * ne + static_cast<uint64_t>(eb));
+    }
+  }
+  std::ranges::sort(ix.near_at_rest_pt);
+  std::ranges::sort(ix.near_at_rest_ee);
+}
+
+/// Whether `key` is one of the sorted `keys`.
+bool listed(const std::vector<uint64_t>& keys, uint64_t key) {
+  return !keys.empty() && std::ranges::binary_search(keys, key);
+}
+
 }  // namespace
 
 void find_contacts(const Input& in, std::vector<SelfContact>& out) {
@@ -932,7 +1012,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const auto& x0 = in.x_prev;
   const auto& x1 = in.x;
   const auto& r = in.radius;
-  auto grow_of = [&](int32_t i) { return std::max(r[i], 0.5 * kMinGap); };
+  auto grow_of = [&](int32_t i) { return self_collision::grow_of(r[i]); };
   const size_t nt = s.tris.size() / 3, ne = s.edges.size() / 2;
   SelfCollisionCache& cache = *in.cache;
 
@@ -954,8 +1034,21 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   if (!cache.index) cache.index = std::make_shared<SelfCollisionIndex>();
   SelfCollisionIndex& ix = *cache.index;
   const size_t np = s.points.size();
+  // (the rest shapes in points order, as near_at_rest was found in)
+  auto same_rest = [&] {
+    size_t at = 0;
+    for (const BodyInfo& b : in.bodies) {
+      if (b.triangles.empty()) continue;
+      if (at + b.rest_positions.size() > ix.rest.size() ||
+          !std::equal(b.rest_positions.begin(), b.rest_positions.end(),
+                      ix.rest.begin() + static_cast<std::ptrdiff_t>(at)))
+        return false;
+      at += b.rest_positions.size();
+    }
+    return at == ix.rest.size();
+  };
   const bool cached = cache.lo.size() == x1.size() && cache.triangles == s.tris && cache.edges == s.edges &&
-                      ix.point_boxes.size() == np && std::ranges::equal(ix.radius, r);
+                      ix.point_boxes.size() == np && std::ranges::equal(ix.radius, r) && same_rest();
   auto inside = [&](const Vec3& p, int32_t i) {
     return (p.array() >= cache.lo[i].array()).all() && (p.array() <= cache.hi[i].array()).all();
   };
@@ -983,6 +1076,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       ix = SelfCollisionIndex{};
       ix.radius.assign(r.begin(), r.end());
       build_hierarchy(ix, s, x1);
+      for (const BodyInfo& b : in.bodies)
+        if (!b.triangles.empty()) ix.rest.insert(ix.rest.end(), b.rest_positions.begin(), b.rest_positions.end());
+      find_near_at_rest(ix, s, in.bodies, r);
       ix.reach.assign(x1.size(), 0.0);
       ix.tri_boxes.resize(nt);
       ix.edge_boxes.resize(ne);
@@ -1098,11 +1194,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (!near_any(x1[p], {x1[v[0]], x1[v[1]], x1[v[2]]}, limit) &&
           point_triangle_distance(x1[p], x1[v[0]], x1[v[1]], x1[v[2]], bary) >= limit)
         return;
-      const BodyInfo& b = in.bodies[s.tri_body[t]];
-      if (p >= b.first_particle && p < b.first_particle + b.particle_count &&
-          !apart<1, 3>({&rest_of(b, p)}, {&rest_of(b, v[0]), &rest_of(b, v[1]), &rest_of(b, v[2])}, thk) &&
-          point_triangle_distance(rest_of(b, p), rest_of(b, v[0]), rest_of(b, v[1]), rest_of(b, v[2]), bary) < thk)
-        return;
+      if (listed(ix.near_at_rest_pt, static_cast<uint64_t>(p) * nt + static_cast<uint64_t>(t))) return;
       pairs.insert(pairs.end(), {p, t});
     };
     auto edge_edge_pair = [&](int32_t ea, int32_t eb, std::vector<int32_t>& pairs) {
@@ -1116,12 +1208,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       if (!near_any(x1[a0], {x1[b0], x1[b1]}, limit) && !near_any(x1[a1], {x1[b0], x1[b1]}, limit) &&
           edge_edge_distance(x1[a0], x1[a1], x1[b0], x1[b1], ps, pt) >= limit)
         return;
-      if (s.edge_body[ea] == s.edge_body[eb]) {
-        const BodyInfo& b = in.bodies[s.edge_body[ea]];
-        if (!apart<2, 2>({&rest_of(b, a0), &rest_of(b, a1)}, {&rest_of(b, b0), &rest_of(b, b1)}, thk) &&
-            edge_edge_distance(rest_of(b, a0), rest_of(b, a1), rest_of(b, b0), rest_of(b, b1), ps, pt) < thk)
-          return;
-      }
+      if (listed(ix.near_at_rest_ee, static_cast<uint64_t>(ea) * ne + static_cast<uint64_t>(eb))) return;
       pairs.insert(pairs.end(), {ea, eb});
     };
     // The queries, a group of kQueryGroup consecutive items (neighbours in the hierarchy's leaf
