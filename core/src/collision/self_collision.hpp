@@ -16,7 +16,9 @@
 //                 (each particle and edge owned by the first triangle holding it), or a particle or
 //                 edge held by no triangle, so a query meets each primitive once. Pairs
 //                 that cannot come within their thickness while the regions hold (their distance,
-//                 less what the regions let them move) are dropped when the pairs are found. The
+//                 less what the regions let them move) are dropped when the pairs are found, as are
+//                 the same body's pairs within their thickness in its rest shape (neighbours on the
+//                 surface, listed once for the topology from a grid over the rest shape). The
 //                 loops over particles, primitives, items and pairs are split over the pool's
 //                 threads and their lists appended in part order; the contacts are sorted by their
 //                 particles, so they do not depend on the hierarchy's splits or on history.
