@@ -490,7 +490,15 @@ struct SelfCollisionIndex {
     int32_t first = 0, count = 0;  // a leaf's items [first, first + count); count 0: internal
     int32_t right = 0;             // internal: the right child (the left is the next node)
   };
-  std::vector<Node> nodes;                         // pre-order: a child after its parent
+  std::vector<Node> nodes;  // pre-order: a child after its parent
+  /// The walks' view of `nodes`: an internal node's children, an internal child replaced by its own
+  /// two while there are fewer than four, their boxes side by side (one test for the four).
+  struct Wide {
+    float lo[3][4], hi[3][4];  // per coordinate, per slot (an unused slot holds the empty box)
+    int32_t node[4];           // the slots' nodes (-1: unused)
+    int32_t wide[4];           // an internal slot's own Wide (-1: a leaf or unused)
+  };
+  std::vector<Wide> wide;                          // the root's first (none when the root is a leaf)
   std::vector<int32_t> item_tri;                   // per item: its triangle, or -1
   std::vector<int32_t> point_begin, owned_points;  // per item: the particles it owns (points order)
   std::vector<int32_t> edge_begin, owned_edges;    // per item: the edges it owns
@@ -844,6 +852,41 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
     return at;
   };
   build(build, 0, static_cast<int32_t>(items));
+  ix.wide.clear();
+  auto widen = [&](auto&& self, int32_t at) -> int32_t {
+    const auto w = static_cast<int32_t>(ix.wide.size());
+    ix.wide.emplace_back();
+    std::array<int32_t, 4> slots{at + 1, ix.nodes[static_cast<size_t>(at)].right, -1, -1};
+    size_t used = 2;
+    for (size_t k = 0; k < used && used < 4;) {  // an internal slot's children take its place
+      const SelfCollisionIndex::Node& node = ix.nodes[static_cast<size_t>(slots[k])];
+      if (node.count > 0) {
+        ++k;
+        continue;
+      }
+      const int32_t left = slots[k] + 1, right = node.right;
+      std::copy_backward(slots.begin() + static_cast<std::ptrdiff_t>(k) + 1,
+                         slots.begin() + static_cast<std::ptrdiff_t>(used),
+                         slots.begin() + static_cast<std::ptrdiff_t>(used) + 1);
+      slots[k] = left;
+      slots[k + 1] = right;
+      ++used;
+      k += 2;  // breadth first: a Wide spans two levels where it can
+    }
+    for (size_t k = 0; k < 4; ++k) {
+      const int32_t child =
+          slots[k] >= 0 && ix.nodes[static_cast<size_t>(slots[k])].count == 0 ? self(self, slots[k]) : -1;
+      SelfCollisionIndex::Wide& wn = ix.wide[static_cast<size_t>(w)];
+      wn.node[k] = slots[k];
+      wn.wide[k] = child;
+      for (int a = 0; a < 3; ++a) {
+        wn.lo[a][k] = std::numeric_limits<float>::infinity();
+        wn.hi[a][k] = -std::numeric_limits<float>::infinity();
+      }
+    }
+    return w;
+  };
+  if (ix.nodes[0].count == 0) widen(widen, 0);
   ix.item_tri.resize(items);
   ix.point_begin.assign(1, 0);
   ix.edge_begin.assign(1, 0);
@@ -888,28 +931,62 @@ void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_chang
       node.box.unite(ix.nodes[static_cast<size_t>(node.right)].box);
     }
   }
+  for (SelfCollisionIndex::Wide& w : ix.wide)
+    for (size_t k = 0; k < 4 && w.node[k] >= 0; ++k) {
+      const FloatBox& b = ix.nodes[static_cast<size_t>(w.node[k])].box;
+      for (int a = 0; a < 3; ++a) {
+        w.lo[a][k] = b.lo[a];
+        w.hi[a][k] = b.hi[a];
+      }
+    }
 }
 
-/// Calls visit(item) for every item whose box overlaps q, depth first. The stack is on the calling
-/// thread's own stack (a shared vector's end, written at every step, would bounce between the
-/// threads' caches): the median splits halve every node, so the hierarchy is at most 31 deep below
-/// its root and the walk holds at most one pending right child a level.
+/// Bit k set where slot k's box of `w` overlaps q (never for an unused slot, whose box is empty).
+uint32_t overlapping_slots(const SelfCollisionIndex::Wide& w, const FloatBox& q) {
+#if defined(__SSE2__)
+  __m128 hit = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(w.lo[0]), _mm_set1_ps(q.hi[0])),
+                          _mm_cmple_ps(_mm_set1_ps(q.lo[0]), _mm_loadu_ps(w.hi[0])));
+  hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(w.lo[1]), _mm_set1_ps(q.hi[1])),
+                                   _mm_cmple_ps(_mm_set1_ps(q.lo[1]), _mm_loadu_ps(w.hi[1]))));
+  hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(w.lo[2]), _mm_set1_ps(q.hi[2])),
+                                   _mm_cmple_ps(_mm_set1_ps(q.lo[2]), _mm_loadu_ps(w.hi[2]))));
+  return static_cast<uint32_t>(_mm_movemask_ps(hit));
+#else
+  uint32_t mask = 0;
+  for (int k = 0; k < 4; ++k) {
+    const FloatBox b{{w.lo[0][k], w.lo[1][k], w.lo[2][k]}, {w.hi[0][k], w.hi[1][k], w.hi[2][k]}};
+    mask |= static_cast<uint32_t>(b.overlaps(q)) << k;
+  }
+  return mask;
+#endif
+}
+
+/// Calls visit(item) for every item whose box overlaps q, in leaf order (depth first). The stack is
+/// on the calling thread's own stack (a shared vector's end, written at every step, would bounce
+/// between the threads' caches): the median splits halve every node, so the hierarchy is at most 31
+/// deep below its root, and a Wide spans two levels with at most three slots pending.
 template <class F>
 void query_hierarchy(const SelfCollisionIndex& ix, const FloatBox& q, F&& visit) {
-  std::array<int32_t, 64> stack;
+  const auto leaf = [&](const SelfCollisionIndex::Node& node) {
+    for (int32_t k = node.first; k < node.first + node.count; ++k)
+      if (ix.item_box[static_cast<size_t>(k)].overlaps(q)) visit(k);
+  };
+  if (!ix.nodes[0].box.overlaps(q)) return;
+  if (ix.wide.empty()) return leaf(ix.nodes[0]);
+  std::array<int32_t, 64> stack;  // a Wide's index, or ~node for a leaf
   size_t top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const int32_t at = stack[--top];
-    const SelfCollisionIndex::Node& node = ix.nodes[static_cast<size_t>(at)];
-    if (!node.box.overlaps(q)) continue;
-    if (node.count == 0) {
-      stack[top++] = node.right;
-      stack[top++] = at + 1;
+    if (at < 0) {
+      leaf(ix.nodes[static_cast<size_t>(~at)]);
       continue;
     }
-    for (int32_t k = node.first; k < node.first + node.count; ++k)
-      if (ix.item_box[static_cast<size_t>(k)].overlaps(q)) visit(k);
+    const SelfCollisionIndex::Wide& w = ix.wide[static_cast<size_t>(at)];
+    for (uint32_t hits = overlapping_slots(w, q); hits != 0; hits &= ~(1u << (31 - std::countl_zero(hits)))) {
+      const int k = 31 - std::countl_zero(hits);  // the last slot first, so the first is walked first
+      stack[top++] = w.wide[k] >= 0 ? w.wide[k] : ~w.node[k];
+    }
   }
 }
 
