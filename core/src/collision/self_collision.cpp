@@ -503,9 +503,12 @@ struct SelfCollisionIndex {
   std::vector<int32_t> point_begin, owned_points;  // per item: the particles it owns (points order)
   std::vector<int32_t> edge_begin, owned_edges;    // per item: the edges it owns
   std::vector<self_collision::FloatBox> item_box;  // per item: its primitives' region boxes
-  std::vector<Vec3> start;                         // the positions at the start of the last substep
-  std::vector<double> radius;                      // the half thicknesses the pairs' gaps were measured with
-  std::vector<Vec3> rest;                          // the bodies' rest shapes (points order) near_at_rest was found in
+  // The owned particles' and edges' region boxes as FloatBoxes, in the order of owned_points and
+  // owned_edges (a walk reads them in turn).
+  std::vector<self_collision::FloatBox> owned_point_box, owned_edge_box;
+  std::vector<Vec3> start;     // the positions at the start of the last substep
+  std::vector<double> radius;  // the half thicknesses the pairs' gaps were measured with
+  std::vector<Vec3> rest;      // the bodies' rest shapes (points order) near_at_rest was found in
   // The same body's pairs within their thickness in its rest shape (neighbours on the surface,
   // never kept), sorted: point p and triangle t as p nt + t, edges ea < eb as ea ne + eb.
   std::vector<uint64_t> near_at_rest_pt, near_at_rest_ee;
@@ -901,6 +904,8 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
     ix.edge_begin.push_back(static_cast<int32_t>(ix.owned_edges.size()));
   }
   ix.item_box.resize(items);
+  ix.owned_point_box.resize(ix.owned_points.size());
+  ix.owned_edge_box.resize(ix.owned_edges.size());
 }
 
 /// The hierarchy refitted to the primitives' region boxes: a changed item's box holds its triangle's
@@ -910,15 +915,12 @@ void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_chang
     for (size_t k = begin; k < end; ++k) {
       if (!item_changed[k]) continue;
       FloatBox& b = ix.item_box[k];
-      if (ix.item_tri[k] >= 0) {
-        b = FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]);
-        continue;
-      }
       b = FloatBox::empty();
       for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
-        b.unite(FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
+        b.unite(ix.owned_point_box[j] = FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
       for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j)
-        b.unite(FloatBox::outward(ix.edge_boxes[ix.owned_edges[j]]));
+        b.unite(ix.owned_edge_box[j] = FloatBox::outward(ix.edge_boxes[ix.owned_edges[j]]));
+      if (ix.item_tri[k] >= 0) b = FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]);
     }
   });
   for (size_t k = ix.nodes.size(); k-- > 0;) {
@@ -1339,12 +1341,13 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                    if (ix.tri_boxes[static_cast<size_t>(t)].overlaps(ix.point_boxes[p]))
                      point_triangle_pair(s.points[p], t, pairs);
                  }
-               for (uint32_t hits = tri_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
-                 const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
-                 const Box& box = ix.tri_boxes[static_cast<size_t>(tc)];
-                 for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
-                   const int32_t p = ix.owned_points[j];
-                   if (!s.changed[s.points[p]] && ix.point_boxes[p].overlaps(box))
+               if (tri_boxes.size() == 0) return;
+               for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                 const int32_t p = ix.owned_points[j];
+                 if (s.changed[s.points[p]]) continue;
+                 for (uint32_t hits = tri_boxes.may_overlap(ix.owned_point_box[j]); hits != 0; hits &= hits - 1) {
+                   const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
+                   if (ix.point_boxes[p].overlaps(ix.tri_boxes[static_cast<size_t>(tc)]))
                      point_triangle_pair(s.points[p], tc, pairs);
                  }
                }
@@ -1366,14 +1369,12 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                }
              if (boxes.size() == 0) return;
              query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
-               for (uint32_t hits = boxes.may_overlap(ix.item_box[static_cast<size_t>(item)]); hits != 0;
-                    hits &= hits - 1) {
-                 const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
-                 const Box& box = ix.edge_boxes[ea];
-                 for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
-                   const int32_t eb = ix.owned_edges[j];
+               for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
+                 const int32_t eb = ix.owned_edges[j];
+                 for (uint32_t hits = boxes.may_overlap(ix.owned_edge_box[j]); hits != 0; hits &= hits - 1) {
+                   const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
                    if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
-                   if (!ix.edge_boxes[eb].overlaps(box)) continue;
+                   if (!ix.edge_boxes[eb].overlaps(ix.edge_boxes[ea])) continue;
                    if (ea < eb)
                      edge_edge_pair(ea, eb, pairs);
                    else
