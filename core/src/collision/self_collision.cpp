@@ -999,6 +999,18 @@ void query_hierarchy(const SelfCollisionIndex& ix, const FloatBox& q, F&& visit)
   }
 }
 
+/// Whether two swept bounds do not overlap: then the pair is no contact in this substep. Each bound
+/// holds its vertices' start and end positions grown by their largest half thickness, so the start
+/// positions are apart along the most separating axis by at least that separation plus the two
+/// growths; `gap` (the distance less the thickness) is raised to that less the thickness, `slack`
+/// being the two growths less the thickness.
+bool apart_by(const Box& a, const Box& b, double slack, double& gap) {
+  const double along = (b.lo - a.hi).cwiseMax(a.lo - b.hi).maxCoeff();
+  if (!(along > 0.0)) return false;
+  gap = std::max(gap, along + slack);
+  return true;
+}
+
 /// Half the smallest separation kept, for a particle of half thickness r: what its boxes grow by.
 double grow_of(double r) {
   return std::max(r, 0.5 * kMinGap);
@@ -1396,8 +1408,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     cache.edge_edge_gap.resize(cache.edge_edge.size() / 2, unknown);
   }
 
-  // This substep's swept bounds, grown by the half thicknesses: a pair whose bounds do not overlap
-  // stays more than its thickness apart throughout the substep.
+  // This substep's swept bounds, grown by the largest half thickness of each primitive's particles:
+  // a pair whose bounds do not overlap stays more than its thickness apart throughout the substep.
   // Each particle's shift since the last substep's start lowers its pairs' gaps (a distance moves no
   // more than the two sides' largest shifts).
   s.swept_point.resize(x1.size());
@@ -1426,9 +1438,17 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       for (size_t k = begin; k < end; ++k) f(k);
     });
   };
+  // A primitive's: its vertices' start and end positions, grown by their largest half thickness, so
+  // that two primitives within their thickness (its vertices' mean on each side) overlap.
   auto swept = [&](std::initializer_list<int32_t> ids) {
-    Box b = s.swept_point[*ids.begin()];
-    for (int32_t i : ids) b.unite(s.swept_point[i]);
+    Box b = Box::empty();
+    double g = 0.0;
+    for (int32_t i : ids) {
+      b.unite(box_of({x0[i], x1[i]}, 0.0));
+      g = std::max(g, grow_of(i));
+    }
+    b.lo.array() -= g;
+    b.hi.array() += g;
     return b;
   };
   auto moves = [&](std::initializer_list<int32_t> ids) {
@@ -1480,10 +1500,13 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
     const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
     double bary[3];
+    if (apart_by(s.swept_point[p], s.swept_tri[t],
+                 grow_of(p) + std::min({grow_of(v[0]), grow_of(v[1]), grow_of(v[2])}) - thk, gap))
+      return;
     const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
     gap = d0 - thk;
     if (d0 >= thk + motion) return;
-    if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;
+    if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;  // (non-finite bounds)
     double toi;
     const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
     Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
@@ -1521,10 +1544,13 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
     const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
     double sa, tb;
+    if (apart_by(s.swept_edge[ea], s.swept_edge[eb],
+                 std::min(grow_of(a0), grow_of(a1)) + std::min(grow_of(b0), grow_of(b1)) - thk, gap))
+      return;
     const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
     gap = d0 - thk;
     if (d0 >= thk + motion) return;
-    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;
+    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;  // (non-finite bounds)
     const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
     Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
     Vec3 primary = side;

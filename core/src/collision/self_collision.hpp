@@ -22,15 +22,18 @@
 //                 loops over particles, primitives, items and pairs are split over the pool's
 //                 threads and their lists appended in part order; the contacts are sorted by their
 //                 particles, so they do not depend on the hierarchy's splits or on history.
-//   narrow phase  a kept pair becomes a contact when its swept bounds in this substep, grown by the
-//                 half thicknesses, overlap and it could come within the thickness during the
-//                 substep: its distance at the start is below thickness + how far its vertices move.
+//   narrow phase  a kept pair becomes a contact when its swept bounds in this substep, each grown by
+//                 the largest half thickness of its particles, overlap and it could come within the
+//                 thickness during the substep: its distance at the start is below thickness + how
+//                 far its vertices move.
 //                 The contacts are the same as a broad phase rebuilt every substep would give.
 //                 Each kept pair carries a gap, a lower bound of its distance less its thickness:
 //                 set where its distance is measured, lowered in every later substep by the largest
 //                 shift of each side's vertices since the last (a distance moves no more than that).
 //                 A pair whose gap still clears its motion cannot be a contact, and is not measured;
-//                 the others are measured (exact distance first, then the swept bounds).
+//                 the others are measured: the swept bounds first (bounds apart raise the gap to
+//                 their separation, less the thickness and plus the two growths), then the exact
+//                 distance.
 //                 Space-time: the first time in the substep at which the four points become coplanar
 //                 with the point inside the triangle (or the two edges crossing) is found from the
 //                 roots of the cubic coplanarity condition; the contact then acts at the barycentric
