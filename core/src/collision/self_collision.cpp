@@ -693,6 +693,7 @@ struct Scratch {
   std::vector<uint8_t> item_changed;                    // per item: holds a changed primitive
   std::vector<int32_t> groups;                          // the groups of kQueryGroup items holding a changed item
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
+  std::vector<Box> moved;                               // per particle: its start and end, not grown
   std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
   std::vector<double> shift;  // per particle: how far x_prev is from the last substep's (inf: unknown)
   // Per triangle and edge: the largest motion and shift of its vertices.
@@ -1413,6 +1414,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // Each particle's shift since the last substep's start lowers its pairs' gaps (a distance moves no
   // more than the two sides' largest shifts).
   s.swept_point.resize(x1.size());
+  s.moved.resize(x1.size());
   s.motion.resize(x1.size());
   s.shift.resize(x1.size());
   const bool started = ix.start.size() == x0.size();
@@ -1421,7 +1423,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     double scale = 0.0;
     for (size_t k = begin; k < end; ++k) {
       const int32_t i = s.points[k];
-      s.swept_point[i] = box_of({x0[i], x1[i]}, grow_of(i));
+      s.moved[i] = box_of({x0[i], x1[i]}, 0.0);
+      s.swept_point[i] = {s.moved[i].lo.array() - grow_of(i), s.moved[i].hi.array() + grow_of(i)};
       s.motion[i] = (x1[i] - x0[i]).norm();
       s.shift[i] = started ? (x0[i] - ix.start[i]).norm() : std::numeric_limits<double>::infinity();
       scale = std::max({scale, x0[i].cwiseAbs().maxCoeff(), x1[i].cwiseAbs().maxCoeff()});
@@ -1441,10 +1444,10 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   // A primitive's: its vertices' start and end positions, grown by their largest half thickness, so
   // that two primitives within their thickness (its vertices' mean on each side) overlap.
   auto swept = [&](std::initializer_list<int32_t> ids) {
-    Box b = Box::empty();
+    Box b = s.moved[*ids.begin()];
     double g = 0.0;
     for (int32_t i : ids) {
-      b.unite(box_of({x0[i], x1[i]}, 0.0));
+      b.unite(s.moved[i]);
       g = std::max(g, grow_of(i));
     }
     b.lo.array() -= g;
