@@ -922,13 +922,14 @@ void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_chang
   pool.run(0, ix.item_tri.size(), 1, grain, [&](size_t begin, size_t end, int) {
     for (size_t k = begin; k < end; ++k) {
       if (!item_changed[k]) continue;
-      FloatBox& b = ix.item_box[k];
-      b = FloatBox::empty();
+      FloatBox owned = FloatBox::empty();
       for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
-        b.unite(ix.owned_point_box[j] = FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
+        owned.unite(ix.owned_point_box[j] = FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
       for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j)
-        b.unite(ix.owned_edge_box[j] = FloatBox::outward(ix.edge_boxes[ix.owned_edges[j]]));
-      if (ix.item_tri[k] >= 0) b = FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]);
+        owned.unite(ix.owned_edge_box[j] = FloatBox::outward(ix.edge_boxes[ix.owned_edges[j]]));
+      // (a triangle's box holds its vertices' and edges')
+      ix.item_box[k] =
+          ix.item_tri[k] >= 0 ? FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]) : owned;
     }
   });
   for (size_t k = ix.nodes.size(); k-- > 0;) {
@@ -993,11 +994,32 @@ void query_hierarchy(const SelfCollisionIndex& ix, const FloatBox& q, F&& visit)
       continue;
     }
     const SelfCollisionIndex::Wide& w = ix.wide[static_cast<size_t>(at)];
-    for (uint32_t hits = overlapping_slots(w, q); hits != 0; hits &= ~(1u << (31 - std::countl_zero(hits)))) {
+    for (uint32_t hits = overlapping_slots(w, q); hits != 0;) {
       const int k = 31 - std::countl_zero(hits);  // the last slot first, so the first is walked first
+      hits &= ~(1u << k);
       stack[top++] = w.wide[k] >= 0 ? w.wide[k] : ~w.node[k];
     }
   }
+}
+
+/// Half the smallest separation kept, for a particle of half thickness r: what its boxes grow by.
+double grow_of(double r) {
+  return std::max(r, 0.5 * kMinGap);
+}
+
+/// A primitive's box: the union of its particles' boxes box(i), grown by their largest half
+/// thickness (of r), so that two primitives within their thickness (each side's mean) overlap.
+template <class F>
+[[gnu::always_inline]] inline Box grown_union(std::initializer_list<int32_t> ids, std::span<const double> r, F&& box) {
+  Box b = box(*ids.begin());
+  double g = 0.0;
+  for (int32_t i : ids) {
+    b.unite(box(i));
+    g = std::max(g, grow_of(r[i]));
+  }
+  b.lo.array() -= g;
+  b.hi.array() += g;
+  return b;
 }
 
 /// Whether two swept bounds do not overlap: then the pair is no contact in this substep. Each bound
@@ -1010,11 +1032,6 @@ bool apart_by(const Box& a, const Box& b, double slack, double& gap) {
   if (!(along > 0.0)) return false;
   gap = std::max(gap, along + slack);
   return true;
-}
-
-/// Half the smallest separation kept, for a particle of half thickness r: what its boxes grow by.
-double grow_of(double r) {
-  return std::max(r, 0.5 * kMinGap);
 }
 
 /// Finds ix.near_at_rest_pt and near_at_rest_ee for the primitives of `s` and the bodies' rest
@@ -1032,15 +1049,7 @@ void find_near_at_rest(SelfCollisionIndex& ix, const Scratch& s, std::span<const
       std::fill_n(body_of.begin() + bodies[bi].first_particle, bodies[bi].particle_count, static_cast<int32_t>(bi));
   auto rest = [&](int32_t i) -> const Vec3& { return rest_of(bodies[static_cast<size_t>(body_of[i])], i); };
   auto rest_box = [&](std::initializer_list<int32_t> ids) {
-    Box b = Box::empty();
-    double g = 0.0;
-    for (int32_t i : ids) {
-      b.unite({rest(i), rest(i)});
-      g = std::max(g, grow_of(r[i]));
-    }
-    b.lo.array() -= g;
-    b.hi.array() += g;
-    return b;
+    return grown_union(ids, r, [&](int32_t i) { return Box{rest(i), rest(i)}; });
   };
   std::vector<int32_t> found;
   Grid grid;
@@ -1085,7 +1094,7 @@ void find_near_at_rest(SelfCollisionIndex& ix, const Scratch& s, std::span<const
 
 /// Whether `key` is one of the sorted `keys`.
 bool listed(const std::vector<uint64_t>& keys, uint64_t key) {
-  return !keys.empty() && std::ranges::binary_search(keys, key);
+  return std::ranges::binary_search(keys, key);
 }
 
 }  // namespace
@@ -1195,15 +1204,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       s.changed[i] = 1;
     }
     auto region = [&](std::initializer_list<int32_t> ids) {
-      Box b = Box::empty();
-      double g = 0.0;
-      for (int32_t i : ids) {
-        b.unite({cache.lo[i], cache.hi[i]});
-        g = std::max(g, grow_of(i));
-      }
-      b.lo.array() -= g;
-      b.hi.array() += g;
-      return b;
+      return grown_union(ids, r, [&](int32_t i) { return Box{cache.lo[i], cache.hi[i]}; });
     };
     auto reach = [&](std::initializer_list<int32_t> ids) {
       double d = 0.0;
@@ -1441,18 +1442,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       for (size_t k = begin; k < end; ++k) f(k);
     });
   };
-  // A primitive's: its vertices' start and end positions, grown by their largest half thickness, so
-  // that two primitives within their thickness (its vertices' mean on each side) overlap.
   auto swept = [&](std::initializer_list<int32_t> ids) {
-    Box b = s.moved[*ids.begin()];
-    double g = 0.0;
-    for (int32_t i : ids) {
-      b.unite(s.moved[i]);
-      g = std::max(g, grow_of(i));
-    }
-    b.lo.array() -= g;
-    b.hi.array() += g;
-    return b;
+    return grown_union(ids, r, [&](int32_t i) -> const Box& { return s.moved[i]; });
   };
   auto moves = [&](std::initializer_list<int32_t> ids) {
     Scratch::Moves mv{0.0, 0.0};
@@ -1504,7 +1495,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
     double bary[3];
     if (apart_by(s.swept_point[p], s.swept_tri[t],
-                 grow_of(p) + std::min({grow_of(v[0]), grow_of(v[1]), grow_of(v[2])}) - thk, gap))
+                 grow_of(p) + std::max({grow_of(v[0]), grow_of(v[1]), grow_of(v[2])}) - thk, gap))
       return;
     const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
     gap = d0 - thk;
@@ -1548,7 +1539,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
     double sa, tb;
     if (apart_by(s.swept_edge[ea], s.swept_edge[eb],
-                 std::min(grow_of(a0), grow_of(a1)) + std::min(grow_of(b0), grow_of(b1)) - thk, gap))
+                 std::max(grow_of(a0), grow_of(a1)) + std::max(grow_of(b0), grow_of(b1)) - thk, gap))
       return;
     const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
     gap = d0 - thk;
