@@ -1467,22 +1467,29 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
 
   // s.near: the pairs whose gap, lowered by their two sides' shifts, does not clear their motion
   // (the others have d0 >= thk + motion below); first(id) and second(id) are a side's moves.
+  // (a range at a time, the arrays read through local pointers: a kept pair is a few instructions)
   auto near_pairs = [&](const std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& first, auto&& second) {
     s.near.clear();
-    gather(*in.pool, gaps.size(), kContactGrain, s.part_pairs, s.near, [&](size_t pair, std::vector<int32_t>& near) {
-      const Scratch::Moves a = first(pairs[2 * pair]), b = second(pairs[2 * pair + 1]);
-      gaps[pair] -= a.shift + b.shift;
-      if (gaps[pair] < a.motion + b.motion + tolerance) near.push_back(static_cast<int32_t>(pair));
-    });
+    in.pool->collect(0, gaps.size(), kContactGrain, s.part_pairs, s.near,
+                     [&, first, second](size_t begin, size_t end, std::vector<int32_t>& near) {
+                       const int32_t* ids = pairs.data();
+                       double* gap = gaps.data();
+                       const double tol = tolerance;
+                       for (size_t pair = begin; pair < end; ++pair) {
+                         const Scratch::Moves a = first(ids[2 * pair]), b = second(ids[2 * pair + 1]);
+                         gap[pair] -= a.shift + b.shift;
+                         if (gap[pair] < a.motion + b.motion + tol) near.push_back(static_cast<int32_t>(pair));
+                       }
+                     });
   };
-  auto tri_moves = [&](int32_t t) { return s.tri_moves[static_cast<size_t>(t)]; };
-  auto edge_moves = [&](int32_t e) { return s.edge_moves[static_cast<size_t>(e)]; };
+  auto tri_moves = [tm = s.tri_moves.data()](int32_t t) { return tm[t]; };
+  auto edge_moves = [em = s.edge_moves.data()](int32_t e) { return em[e]; };
 
   // Point against triangle: the pairs near enough, then their contacts.
   near_pairs(
       cache.point_triangle, cache.point_triangle_gap,
-      [&](int32_t p) {
-        return Scratch::Moves{m[p], s.shift[p]};
+      [motion = m.data(), shift = s.shift.data()](int32_t p) {
+        return Scratch::Moves{motion[p], shift[p]};
       },
       tri_moves);
   gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
