@@ -77,9 +77,10 @@ const Kernels& kernels();
 
 namespace passes {
 
-// Items per thread below which a range is not split: a part must outweigh the hand-over (a few
-// microseconds). A constraint costs tens of nanoseconds, a chain a few links' worth each.
-inline constexpr size_t kGrain = 512;
+// Items per thread below which a range is not split: a part must outweigh the hand-over (about a
+// microsecond where the cores share a cache, a few where they do not). A constraint costs tens of
+// nanoseconds, a chain a few links' worth each.
+inline constexpr size_t kGrain = 256;
 inline constexpr size_t kChainGrain = 16;
 inline constexpr size_t kAlign = 4;  // parts start on a block of the widest lanes
 
