@@ -1253,13 +1253,17 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     auto keep = [&](std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& stays) {
       s.part_kept.assign(static_cast<size_t>(in.pool->size()), {0, 0});
       in.pool->run(0, gaps.size(), 1, kContactGrain, [&](size_t begin, size_t end, int part) {
+        int32_t* ids = pairs.data();
+        double* gap = gaps.data();
         size_t kept = begin;
-        for (size_t k = begin; k < end; ++k)
-          if (stays(pairs[2 * k], pairs[2 * k + 1])) {
-            pairs[2 * kept] = pairs[2 * k];
-            pairs[2 * kept + 1] = pairs[2 * k + 1];
-            gaps[kept++] = gaps[k];
+        for (size_t k = begin; k < end; ++k) {
+          const int32_t a = ids[2 * k], b = ids[2 * k + 1];
+          if (stays(a, b)) {
+            ids[2 * kept] = a;
+            ids[2 * kept + 1] = b;
+            gap[kept++] = gap[k];
           }
+        }
         s.part_kept[static_cast<size_t>(part)] = {begin, kept};
       });
       size_t kept = 0;
@@ -1277,9 +1281,12 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       gaps.resize(kept);
     };
     keep(cache.point_triangle, cache.point_triangle_gap,
-         [&](int32_t p, int32_t t) { return !s.changed[p] && !s.tri_changed[t]; });
-    keep(cache.edge_edge, cache.edge_edge_gap,
-         [&](int32_t a, int32_t b) { return !s.edge_changed[a] && !s.edge_changed[b]; });
+         [changed = s.changed.data(), tri_changed = s.tri_changed.data()](int32_t p, int32_t t) {
+           return !(changed[p] | tri_changed[t]);
+         });
+    keep(cache.edge_edge, cache.edge_edge_gap, [changed = s.edge_changed.data()](int32_t a, int32_t b) {
+      return !(changed[a] | changed[b]);
+    });
     // A pair is kept when the two can come within their thickness while their particles stay in
     // their regions (see above), and they are not neighbours on the surface at rest.
     auto point_triangle_pair = [&](int32_t p, int32_t t, std::vector<int32_t>& pairs) {
