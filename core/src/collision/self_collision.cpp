@@ -1284,9 +1284,8 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
          [changed = s.changed.data(), tri_changed = s.tri_changed.data()](int32_t p, int32_t t) {
            return !(changed[p] | tri_changed[t]);
          });
-    keep(cache.edge_edge, cache.edge_edge_gap, [changed = s.edge_changed.data()](int32_t a, int32_t b) {
-      return !(changed[a] | changed[b]);
-    });
+    keep(cache.edge_edge, cache.edge_edge_gap,
+         [changed = s.edge_changed.data()](int32_t a, int32_t b) { return !(changed[a] | changed[b]); });
     // A pair is kept when the two can come within their thickness while their particles stay in
     // their regions (see above), and they are not neighbours on the surface at rest.
     auto point_triangle_pair = [&](int32_t p, int32_t t, std::vector<int32_t>& pairs) {
@@ -1599,11 +1598,16 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const auto by_particles = [](const Scratch::Order& a, const Scratch::Order& b) {
     return a.first < b.first || (a.first == b.first && a.second < b.second);
   };
+  // (the two kinds sorted side by side on the pool's threads, then moved in parallel)
   const auto split = s.order.begin() + static_cast<std::ptrdiff_t>(point_triangle_contacts);
-  std::sort(s.order.begin(), split, by_particles);
-  std::sort(split, s.order.end(), by_particles);
+  in.pool->run_parts(2, [&](int part) {
+    if (part == 0) std::sort(s.order.begin(), split, by_particles);
+    if (part == 1 || in.pool->size() == 1) std::sort(split, s.order.end(), by_particles);
+  });
   s.sorted.resize(out.size());
-  for (size_t k = 0; k < out.size(); ++k) s.sorted[k] = out[s.order[k].at];
+  in.pool->run(0, out.size(), 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) s.sorted[k] = out[s.order[k].at];
+  });
   out.swap(s.sorted);
   ix.start.assign(x0.begin(), x0.end());
 }

@@ -357,28 +357,41 @@ void World::settle_contacts_on_surface() {
   }
 }
 
+void World::apply_collider_friction(Contact& ct, double h) {
+  if (ct.lambda <= 0.0) return;
+  const Collider& c = colliders_[ct.collider];
+  const int32_t i = ct.particle;
+  Vec3 n;
+  contact_gap(c, ct, x_[i], x_prev_[i], 0.0, n);
+  // The push as the solve left it, along the normal where it left the particle (the reactions).
+  ct.force_h2 = (ct.lambda / w_[i]) * n;
+  const Vec3 slip = (x_[i] - x_prev_[i]) - (x_[i] - collider_point_before(c, x_[i]));
+  const Vec3 tangential = slip - slip.dot(n) * n;
+  const double len = tangential.norm();
+  const double mu_s = std::sqrt(mu_s_[i] * c.desc.friction_static);
+  const double mu_k = std::sqrt(mu_k_[i] * c.desc.friction_dynamic);
+  const Vec3 moved = -friction_fraction(len, ct.lambda, mu_s, mu_k, h) * tangential;
+  x_[i] += moved;
+  ct.force_h2 += moved / w_[i];
+}
+
 void World::apply_friction(double h) {
   // Friction (friction_fraction): the tangential slip relative to the collider is removed while it
   // is below mu times the normal push, else reduced by mu times it; mu falls from mu_s to mu_k with
   // the slip speed.
+  // A particle's collider contacts lie side by side (found particle by particle) and are taken in
+  // order by one thread; different particles' are independent, so the parts, each moved on to a
+  // particle's first contact, give the same bits at any thread count.
   Group& g = groups_[settings_.contact_group.index];
-  for (Contact& ct : g.contacts) {
-    if (ct.lambda <= 0.0) continue;
-    const Collider& c = colliders_[ct.collider];
-    const int32_t i = ct.particle;
-    Vec3 n;
-    contact_gap(c, ct, x_[i], x_prev_[i], 0.0, n);
-    // The push as the solve left it, along the normal where it left the particle (the reactions).
-    ct.force_h2 = (ct.lambda / w_[i]) * n;
-    const Vec3 slip = (x_[i] - x_prev_[i]) - (x_[i] - collider_point_before(c, x_[i]));
-    const Vec3 tangential = slip - slip.dot(n) * n;
-    const double len = tangential.norm();
-    const double mu_s = std::sqrt(mu_s_[i] * c.desc.friction_static);
-    const double mu_k = std::sqrt(mu_k_[i] * c.desc.friction_dynamic);
-    const Vec3 moved = -friction_fraction(len, ct.lambda, mu_s, mu_k, h) * tangential;
-    x_[i] += moved;
-    ct.force_h2 += moved / w_[i];
-  }
+  std::vector<Contact>& contacts = g.contacts;
+  const auto first_of_particle = [&](size_t k) {
+    while (k > 0 && k < contacts.size() && contacts[k].particle == contacts[k - 1].particle) ++k;
+    return k;
+  };
+  pool_->run(0, contacts.size(), 1, kContactGrain, [&](size_t begin, size_t end, int) {
+    end = end == contacts.size() ? end : first_of_particle(end);
+    for (size_t k = first_of_particle(begin); k < end; ++k) apply_collider_friction(contacts[k], h);
+  });
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_, h);
   // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
   // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the

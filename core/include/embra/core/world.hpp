@@ -988,6 +988,7 @@ class World {
   void begin_frame(const StepControl& control);
   void solve(double h, const StepControl& control);
   void apply_friction(double h);
+  void apply_collider_friction(Contact& contact, double h);  // one collider contact's (apply_friction)
   void update_velocities(double h);
   // Throws Error(numerical), with a Warning, at the first particle whose position or velocity is
   // non-finite or beyond limits::kMaxAbsValue.
