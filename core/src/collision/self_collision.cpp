@@ -68,8 +68,9 @@ struct Box {
   }
 };
 
-/// v as a float rounded toward `dir` (-1 down, 1 up); NaN stays NaN.
-float to_float(double v, float dir) {
+/// v as a float rounded toward `dir` (-1 down, 1 up); NaN stays NaN. FloatBox::outward's values
+/// (its SSE2 path gives the same bits, three coordinates at a time).
+[[maybe_unused]] float to_float(double v, float dir) {
   constexpr float big = std::numeric_limits<float>::max(), inf = std::numeric_limits<float>::infinity();
   if (std::isnan(v)) return std::numeric_limits<float>::quiet_NaN();
   if (v > big) return dir < 0.0f ? big : inf;
@@ -81,19 +82,53 @@ float to_float(double v, float dir) {
   const uint32_t bits = std::bit_cast<uint32_t>(f);
   return std::bit_cast<float>((f > 0.0f) == (dir > 0.0f) ? bits + 1 : bits - 1);
 }
+#if defined(__SSE2__)
+/// v's three coordinates as floats rounded down (up when `up`), in lanes 0-2 (FloatBox::outward).
+inline __m128 step_outward(const Vec3& v, bool up) {
+  const __m128d v01 = _mm_loadu_pd(v.data()), v2 = _mm_set1_pd(v.z());
+  const __m128 f = _mm_movelh_ps(_mm_cvtpd_ps(v01), _mm_cvtpd_ps(v2));
+  const __m128d b01 = _mm_cvtps_pd(f), b2 = _mm_cvtps_pd(_mm_movehl_ps(f, f));
+  const __m128d w01 = up ? _mm_cmplt_pd(b01, v01) : _mm_cmpgt_pd(b01, v01);
+  const __m128d w2 = up ? _mm_cmplt_pd(b2, v2) : _mm_cmpgt_pd(b2, v2);
+  // (an infinite v too: to_float gives the largest float toward the inside)
+  const __m128 inf = _mm_set1_ps(up ? -std::numeric_limits<float>::infinity() : std::numeric_limits<float>::infinity());
+  const __m128i wrong = _mm_castps_si128(
+      _mm_or_ps(_mm_shuffle_ps(_mm_castpd_ps(w01), _mm_castpd_ps(w2), _MM_SHUFFLE(2, 0, 2, 0)), _mm_cmpeq_ps(f, inf)));
+  const __m128i bits = _mm_castps_si128(f), sign = _mm_srai_epi32(bits, 31);  // 0 or -1
+  // down: +1 where negative, -1 where not; up: the opposite
+  const __m128i twice = _mm_add_epi32(sign, sign);
+  const __m128i delta = up ? _mm_add_epi32(_mm_set1_epi32(1), twice) : _mm_sub_epi32(_mm_set1_epi32(-1), twice);
+  return _mm_castsi128_ps(_mm_add_epi32(bits, _mm_and_si128(delta, wrong)));
+}
+#endif
+
 /// A box's bounds rounded outward to floats: a filter for Box::overlaps that half the bytes feed
 /// (what overlaps as Box overlaps as FloatBox).
 struct FloatBox {
   float lo[3], hi[3];
   static FloatBox outward(const Box& b) {
+#if defined(__SSE2__)
+    // to_float's values, four lanes at a time: each coordinate rounded to the nearest float, and
+    // where that lies on the wrong side, moved one step outward by its bits (a negative float's
+    // bits grow away from zero, a positive one's toward it; -0 steps down to -denorm_min, +0 up to
+    // +denorm_min; an infinity on the wrong side steps back to the largest float; NaN stays).
+    const __m128 lo = step_outward(b.lo, false), hi = step_outward(b.hi, true);
+    alignas(16) float out[8];
+    _mm_store_ps(out, lo);
+    _mm_store_ps(out + 4, hi);
+    return {{out[0], out[1], out[2]}, {out[4], out[5], out[6]}};
+#else
     return {{to_float(b.lo.x(), -1.0f), to_float(b.lo.y(), -1.0f), to_float(b.lo.z(), -1.0f)},
             {to_float(b.hi.x(), 1.0f), to_float(b.hi.y(), 1.0f), to_float(b.hi.z(), 1.0f)}};
+#endif
   }
   static FloatBox empty() {
     constexpr float inf = std::numeric_limits<float>::infinity();
     return {{inf, inf, inf}, {-inf, -inf, -inf}};
   }
-  bool overlaps(const FloatBox& o) const { return overlap(*this, o); }
+  bool overlaps(const FloatBox& o) const {
+    return overlap(*this, o);
+  }
   void unite(const FloatBox& o) {
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], o.lo[a]);
