@@ -42,7 +42,7 @@ constexpr double kRegionThickness = 0.25;
 /// Items per leaf of the broad phase's hierarchy.
 constexpr int32_t kLeafItems = 4;
 /// Consecutive items (in leaf order) whose changed primitives share one walk of the hierarchy.
-constexpr size_t kQueryGroup = 8;
+constexpr size_t kQueryGroup = 16;
 
 /// Whether boxes a and b (lo and hi indexed 0-2) overlap: all six compared, one branch for the
 /// caller, seldom mispredicted.
@@ -142,7 +142,7 @@ struct FloatBox {
 template <size_t N>
 class FloatBoxes {
  public:
-  static_assert(N % 4 == 0 && N <= 32);
+  static_assert(N % 4 == 0 && N <= 64);
   void add(const Box& b) {
     const FloatBox f = FloatBox::outward(b);
     for (int a = 0; a < 3; ++a) {
@@ -153,8 +153,8 @@ class FloatBoxes {
   }
   size_t size() const { return size_; }
   /// Bit c set where box c may overlap q: set for every box that overlaps it.
-  uint32_t may_overlap(const FloatBox& q) const {
-    uint32_t mask = 0;
+  uint64_t may_overlap(const FloatBox& q) const {
+    uint64_t mask = 0;
 #if defined(__SSE2__)
     const __m128 qlx = _mm_set1_ps(q.lo[0]), qly = _mm_set1_ps(q.lo[1]), qlz = _mm_set1_ps(q.lo[2]);
     const __m128 qhx = _mm_set1_ps(q.hi[0]), qhy = _mm_set1_ps(q.hi[1]), qhz = _mm_set1_ps(q.hi[2]);
@@ -164,15 +164,15 @@ class FloatBoxes {
           hit, _mm_and_ps(_mm_cmple_ps(_mm_load_ps(&lo_[1][c]), qhy), _mm_cmple_ps(qly, _mm_load_ps(&hi_[1][c]))));
       hit = _mm_and_ps(
           hit, _mm_and_ps(_mm_cmple_ps(_mm_load_ps(&lo_[2][c]), qhz), _mm_cmple_ps(qlz, _mm_load_ps(&hi_[2][c]))));
-      mask |= static_cast<uint32_t>(_mm_movemask_ps(hit)) << c;
+      mask |= static_cast<uint64_t>(_mm_movemask_ps(hit)) << c;
     }
 #else
     for (size_t c = 0; c < size_; ++c) {
       const FloatBox b{{lo_[0][c], lo_[1][c], lo_[2][c]}, {hi_[0][c], hi_[1][c], hi_[2][c]}};
-      mask |= static_cast<uint32_t>(b.overlaps(q)) << c;
+      mask |= static_cast<uint64_t>(b.overlaps(q)) << c;
     }
 #endif
-    return size_ == 32 ? mask : mask & ((1u << size_) - 1u);
+    return size_ == 64 ? mask : mask & ((uint64_t{1} << size_) - 1u);
   }
 
  private:
@@ -1398,7 +1398,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                const FloatBox& item_box = ix.item_box[static_cast<size_t>(item)];
                const int32_t t = ix.item_tri[static_cast<size_t>(item)];
                if (t >= 0)
-                 for (uint32_t hits = left_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
+                 for (uint64_t hits = left_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
                    const int32_t p = left[static_cast<size_t>(std::countr_zero(hits))];
                    if (ix.tri_boxes[static_cast<size_t>(t)].overlaps(ix.point_boxes[p]))
                      point_triangle_pair(s.points[p], t, pairs);
@@ -1407,7 +1407,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
                for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
                  const int32_t p = ix.owned_points[j];
                  if (s.changed[s.points[p]]) continue;
-                 for (uint32_t hits = tri_boxes.may_overlap(ix.owned_point_box[j]); hits != 0; hits &= hits - 1) {
+                 for (uint64_t hits = tri_boxes.may_overlap(ix.owned_point_box[j]); hits != 0; hits &= hits - 1) {
                    const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
                    if (ix.point_boxes[p].overlaps(ix.tri_boxes[static_cast<size_t>(tc)]))
                      point_triangle_pair(s.points[p], tc, pairs);
@@ -1433,7 +1433,7 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
              query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
                for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
                  const int32_t eb = ix.owned_edges[j];
-                 for (uint32_t hits = boxes.may_overlap(ix.owned_edge_box[j]); hits != 0; hits &= hits - 1) {
+                 for (uint64_t hits = boxes.may_overlap(ix.owned_edge_box[j]); hits != 0; hits &= hits - 1) {
                    const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
                    if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
                    if (!ix.edge_boxes[eb].overlaps(ix.edge_boxes[ea])) continue;

@@ -11,9 +11,9 @@
 //                 hierarchy over the primitives' region boxes (rounded outward to floats), built once
 //                 for their topology (median splits of the items' centres along the widest axis, four
 //                 items a leaf) and refitted where regions changed, and walked four boxes at a time
-//                 (a node's children, or grandchildren, side by side); eight neighbouring items'
-//                 changed primitives share a walk, made with their united box, each primitive an
-//                 item met owns then tested against each of them. An item is a triangle with the
+//                 (a node's children, or grandchildren, side by side); the changed primitives of a
+//                 group of neighbouring items (kQueryGroup, in leaf order) share a walk, made with their united box,
+//                 each primitive an item met owns then tested against each of them. An item is a triangle with the
 //                 particles and edges it owns
 //                 (each particle and edge owned by the first triangle holding it), or a particle or
 //                 edge held by no triangle, so a query meets each primitive once. Pairs
