@@ -379,19 +379,20 @@ void World::apply_friction(double h) {
   // Friction (friction_fraction): the tangential slip relative to the collider is removed while it
   // is below mu times the normal push, else reduced by mu times it; mu falls from mu_s to mu_k with
   // the slip speed.
-  // A particle's collider contacts lie side by side (found particle by particle) and are taken in
-  // order by one thread; different particles' are independent, so the parts, each moved on to a
-  // particle's first contact, give the same bits at any thread count.
+  // Different particles' contacts are independent. A particle's own (one a collider, listed
+  // collider by collider, late ones after) are taken in the list's order by the one thread whose
+  // range of particles holds it, so the bits do not depend on the thread count.
   Group& g = groups_[settings_.contact_group.index];
   std::vector<Contact>& contacts = g.contacts;
-  const auto first_of_particle = [&](size_t k) {
-    while (k > 0 && k < contacts.size() && contacts[k].particle == contacts[k - 1].particle) ++k;
-    return k;
-  };
-  pool_->run(0, contacts.size(), 1, kContactGrain, [&](size_t begin, size_t end, int) {
-    end = end == contacts.size() ? end : first_of_particle(end);
-    for (size_t k = first_of_particle(begin); k < end; ++k) apply_collider_friction(contacts[k], h);
-  });
+  if (contacts.size() < 2 * kContactGrain) {
+    for (Contact& ct : contacts) apply_collider_friction(ct, h);
+  } else {
+    pool_->run(0, x_.size(), 1, 1, [&](size_t begin, size_t end, int) {
+      for (Contact& ct : contacts)
+        if (static_cast<size_t>(ct.particle) >= begin && static_cast<size_t>(ct.particle) < end)
+          apply_collider_friction(ct, h);
+    });
+  }
   self_collision::apply_friction(self_contacts_, x_, x_prev_, w_, h);
   // Face contacts: the same rule at the contact point sum_k b_k x_k, the correction shared out as a
   // projection shares it (corner k and its partner move w_k b_k / sum_j w_j b_j^2 of it, w_k the
