@@ -384,7 +384,7 @@ void World::apply_friction(double h) {
   // range of particles holds it, so the bits do not depend on the thread count.
   Group& g = groups_[settings_.contact_group.index];
   std::vector<Contact>& contacts = g.contacts;
-  if (contacts.size() < 2 * kContactGrain) {
+  if (contacts.size() < 2 * kContactGrain) {  // (too few to outweigh a hand-over)
     for (Contact& ct : contacts) apply_collider_friction(ct, h);
   } else {
     pool_->run(0, x_.size(), 1, 1, [&](size_t begin, size_t end, int) {
