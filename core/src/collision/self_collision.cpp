@@ -1047,10 +1047,10 @@ double grow_of(double r) {
 template <class F>
 [[gnu::always_inline]] inline Box grown_union(std::initializer_list<int32_t> ids, std::span<const double> r, F&& box) {
   Box b = box(*ids.begin());
-  double g = 0.0;
-  for (int32_t i : ids) {
-    b.unite(box(i));
-    g = std::max(g, grow_of(r[i]));
+  double g = grow_of(r[*ids.begin()]);
+  for (auto i = ids.begin() + 1; i != ids.end(); ++i) {
+    b.unite(box(*i));
+    g = std::max(g, grow_of(r[*i]));
   }
   b.lo.array() -= g;
   b.hi.array() += g;
