@@ -739,7 +739,7 @@ struct Scratch {
   std::vector<double> part_scale;  // per part of the pool: the largest coordinate magnitude seen
   std::vector<int32_t> near;       // the kept pairs whose distance is measured in this substep
   // One list per thread of the pool: candidate pairs, contacts (gather).
-  std::vector<std::vector<int32_t>> part_pairs;
+  std::vector<std::vector<int32_t>> part_pairs, part_ee_pairs;
   std::vector<std::vector<SelfContact>> part_contacts;
   std::vector<std::pair<size_t, size_t>> part_kept;  // keep(): the kept pairs' range of each part
   // The contacts' sort: each contact's particles as one key and its place, and the sorted contacts.
@@ -774,6 +774,27 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
 constexpr size_t kPairGrain = 4;       // groups of items queried against the hierarchy
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
 constexpr size_t kBoxGrain = 1024;     // particles or primitives boxed
+
+/// gather() with two lists: body(k, first, second) for every k of [0, n), split over the pool's
+/// threads as the queries are (kPairGrain), each part appending to lists of its own; the lists are
+/// then appended to `first_out` and `second_out` in part order.
+template <class F>
+void pair_lists(ThreadPool& pool, size_t n, std::vector<std::vector<int32_t>>& first_parts,
+                std::vector<std::vector<int32_t>>& second_parts, std::vector<int32_t>& first_out,
+                std::vector<int32_t>& second_out, F&& body) {
+  const size_t parts = static_cast<size_t>(pool.size());
+  first_parts.resize(parts);
+  second_parts.resize(parts);
+  for (size_t part = 0; part < parts; ++part) first_parts[part].clear(), second_parts[part].clear();
+  pool.run(0, n, 1, kPairGrain, [&](size_t begin, size_t end, int part) {
+    const size_t at = static_cast<size_t>(part);
+    for (size_t k = begin; k < end; ++k) body(k, first_parts[at], second_parts[at]);
+  });
+  for (size_t part = 0; part < parts; ++part) {
+    first_out.insert(first_out.end(), first_parts[part].begin(), first_parts[part].end());
+    second_out.insert(second_out.end(), second_parts[part].begin(), second_parts[part].end());
+  }
+}
 
 /// A unit normal: `primary` if it has a length, else `fallback`, turned toward `side` (the vector
 /// from the second primitive to the first at the start of the substep).
@@ -1370,81 +1391,78 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       const size_t first = static_cast<size_t>(s.groups[k]) * kQueryGroup;
       return std::pair{first, std::min(items, first + kQueryGroup)};
     };
-    gather(*in.pool, s.groups.size(), kPairGrain, s.part_pairs, cache.point_triangle,
-           [&](size_t k, std::vector<int32_t>& pairs) {
-             std::array<int32_t, 3 * kQueryGroup> left;  // points order
-             std::array<int32_t, kQueryGroup> tris;
-             FloatBoxes<3 * kQueryGroup> left_boxes;
-             FloatBoxes<kQueryGroup> tri_boxes;
-             Box q = Box::empty();
-             const auto [first, last] = group_items(k);
-             for (size_t item = first; item < last; ++item) {
-               for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
-                 const int32_t p = ix.owned_points[j];
-                 if (!s.changed[s.points[p]]) continue;
-                 left[left_boxes.size()] = p;
-                 left_boxes.add(ix.point_boxes[p]);
-                 q.unite(ix.point_boxes[p]);
-               }
-               const int32_t t = ix.item_tri[item];
-               if (kept_some && t >= 0 && s.tri_changed[static_cast<size_t>(t)]) {
-                 tris[tri_boxes.size()] = t;
-                 tri_boxes.add(ix.tri_boxes[static_cast<size_t>(t)]);
-                 q.unite(ix.tri_boxes[static_cast<size_t>(t)]);
-               }
-             }
-             if (left_boxes.size() + tri_boxes.size() == 0) return;
-             query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
-               const FloatBox& item_box = ix.item_box[static_cast<size_t>(item)];
-               const int32_t t = ix.item_tri[static_cast<size_t>(item)];
-               if (t >= 0)
-                 for (uint64_t hits = left_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
-                   const int32_t p = left[static_cast<size_t>(std::countr_zero(hits))];
-                   if (ix.tri_boxes[static_cast<size_t>(t)].overlaps(ix.point_boxes[p]))
-                     point_triangle_pair(s.points[p], t, pairs);
+    // One walk a group for both kinds: the union of the boxes of its changed points, triangles
+    // and edges.
+    s.part_ee_pairs.resize(s.part_pairs.size());
+    pair_lists(*in.pool, s.groups.size(), s.part_pairs, s.part_ee_pairs, cache.point_triangle, cache.edge_edge,
+               [&](size_t k, std::vector<int32_t>& pt_pairs, std::vector<int32_t>& ee_pairs) {
+                 std::array<int32_t, 3 * kQueryGroup> left;  // points order
+                 std::array<int32_t, kQueryGroup> tris;
+                 std::array<int32_t, 3 * kQueryGroup> changed;  // edges
+                 FloatBoxes<3 * kQueryGroup> left_boxes;
+                 FloatBoxes<kQueryGroup> tri_boxes;
+                 FloatBoxes<3 * kQueryGroup> edge_boxes;
+                 Box q = Box::empty();
+                 const auto [first, last] = group_items(k);
+                 for (size_t item = first; item < last; ++item) {
+                   for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                     const int32_t p = ix.owned_points[j];
+                     if (!s.changed[s.points[p]]) continue;
+                     left[left_boxes.size()] = p;
+                     left_boxes.add(ix.point_boxes[p]);
+                     q.unite(ix.point_boxes[p]);
+                   }
+                   const int32_t t = ix.item_tri[item];
+                   if (kept_some && t >= 0 && s.tri_changed[static_cast<size_t>(t)]) {
+                     tris[tri_boxes.size()] = t;
+                     tri_boxes.add(ix.tri_boxes[static_cast<size_t>(t)]);
+                     q.unite(ix.tri_boxes[static_cast<size_t>(t)]);
+                   }
+                   for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
+                     const int32_t e = ix.owned_edges[j];
+                     if (!s.edge_changed[e]) continue;
+                     changed[edge_boxes.size()] = e;
+                     edge_boxes.add(ix.edge_boxes[e]);
+                     q.unite(ix.edge_boxes[e]);
+                   }
                  }
-               if (tri_boxes.size() == 0) return;
-               for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
-                 const int32_t p = ix.owned_points[j];
-                 if (s.changed[s.points[p]]) continue;
-                 for (uint64_t hits = tri_boxes.may_overlap(ix.owned_point_box[j]); hits != 0; hits &= hits - 1) {
-                   const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
-                   if (ix.point_boxes[p].overlaps(ix.tri_boxes[static_cast<size_t>(tc)]))
-                     point_triangle_pair(s.points[p], tc, pairs);
-                 }
-               }
-             });
-           });
-    gather(*in.pool, s.groups.size(), kPairGrain, s.part_pairs, cache.edge_edge,
-           [&](size_t k, std::vector<int32_t>& pairs) {
-             std::array<int32_t, 3 * kQueryGroup> changed;
-             FloatBoxes<3 * kQueryGroup> boxes;
-             Box q = Box::empty();
-             const auto [first, last] = group_items(k);
-             for (size_t item = first; item < last; ++item)
-               for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
-                 const int32_t e = ix.owned_edges[j];
-                 if (!s.edge_changed[e]) continue;
-                 changed[boxes.size()] = e;
-                 boxes.add(ix.edge_boxes[e]);
-                 q.unite(ix.edge_boxes[e]);
-               }
-             if (boxes.size() == 0) return;
-             query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
-               for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
-                 const int32_t eb = ix.owned_edges[j];
-                 for (uint64_t hits = boxes.may_overlap(ix.owned_edge_box[j]); hits != 0; hits &= hits - 1) {
-                   const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
-                   if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
-                   if (!ix.edge_boxes[eb].overlaps(ix.edge_boxes[ea])) continue;
-                   if (ea < eb)
-                     edge_edge_pair(ea, eb, pairs);
-                   else
-                     edge_edge_pair(eb, ea, pairs);
-                 }
-               }
-             });
-           });
+                 if (left_boxes.size() + tri_boxes.size() + edge_boxes.size() == 0) return;
+                 query_hierarchy(ix, FloatBox::outward(q), [&](int32_t item) {
+                   // Point against triangle.
+                   const FloatBox& item_box = ix.item_box[static_cast<size_t>(item)];
+                   const int32_t t = ix.item_tri[static_cast<size_t>(item)];
+                   if (t >= 0)
+                     for (uint64_t hits = left_boxes.may_overlap(item_box); hits != 0; hits &= hits - 1) {
+                       const int32_t p = left[static_cast<size_t>(std::countr_zero(hits))];
+                       if (ix.tri_boxes[static_cast<size_t>(t)].overlaps(ix.point_boxes[p]))
+                         point_triangle_pair(s.points[p], t, pt_pairs);
+                     }
+                   if (tri_boxes.size() != 0)
+                     for (int32_t j = ix.point_begin[item]; j < ix.point_begin[item + 1]; ++j) {
+                       const int32_t p = ix.owned_points[j];
+                       if (s.changed[s.points[p]]) continue;
+                       for (uint64_t hits = tri_boxes.may_overlap(ix.owned_point_box[j]); hits != 0; hits &= hits - 1) {
+                         const int32_t tc = tris[static_cast<size_t>(std::countr_zero(hits))];
+                         if (ix.point_boxes[p].overlaps(ix.tri_boxes[static_cast<size_t>(tc)]))
+                           point_triangle_pair(s.points[p], tc, pt_pairs);
+                       }
+                     }
+                   // Edge against edge.
+                   if (edge_boxes.size() != 0)
+                     for (int32_t j = ix.edge_begin[item]; j < ix.edge_begin[item + 1]; ++j) {
+                       const int32_t eb = ix.owned_edges[j];
+                       for (uint64_t hits = edge_boxes.may_overlap(ix.owned_edge_box[j]); hits != 0; hits &= hits - 1) {
+                         const int32_t ea = changed[static_cast<size_t>(std::countr_zero(hits))];
+                         if (eb == ea || (s.edge_changed[eb] && eb < ea)) continue;  // found from eb's side
+                         if (!ix.edge_boxes[eb].overlaps(ix.edge_boxes[ea])) continue;
+                         if (ea < eb)
+                           edge_edge_pair(ea, eb, ee_pairs);
+                         else
+                           edge_edge_pair(eb, ea, ee_pairs);
+                       }
+                     }
+                 });
+               });
     // The new pairs' gaps are measured when they are first met below.
     constexpr double unknown = -std::numeric_limits<double>::infinity();
     cache.point_triangle_gap.resize(cache.point_triangle.size() / 2, unknown);
