@@ -14,9 +14,10 @@
 //                 (a node's children, or grandchildren, side by side); the changed primitives of a
 //                 group of neighbouring items (kQueryGroup, in leaf order) share a walk, made with
 //                 their united box (points, triangles and edges in one walk), each primitive an
-//                 item met owns then tested against each of them. An item is a triangle with the particles and edges it owns
-//                 (each particle and edge owned by the first triangle holding it), or a particle or
-//                 edge held by no triangle, so a query meets each primitive once. Pairs
+//                 item met owns then tested against each of them. An item is a triangle with the
+//                 particles and edges it owns (each particle and edge owned by the first triangle
+//                 holding it), or a particle or edge held by no triangle, so a query meets each
+//                 primitive once. Pairs
 //                 that cannot come within their thickness while the regions hold (their distance,
 //                 less what the regions let them move) are dropped when the pairs are found, as are
 //                 the same body's pairs within their thickness in its rest shape (neighbours on the
