@@ -541,6 +541,14 @@ struct SelfCollisionIndex {
   // The owned particles' and edges' region boxes as FloatBoxes, in the order of owned_points and
   // owned_edges (a walk reads them in turn).
   std::vector<self_collision::FloatBox> owned_point_box, owned_edge_box;
+  // Where a changed particle's marks go (the topology's, with the items): per point (points order)
+  // the triangles and edges holding it; per triangle, edge and point the item that holds it.
+  std::vector<int32_t> point_tri_begin, point_tris, point_edge_begin, point_edges;
+  std::vector<int32_t> tri_item, edge_item, point_item;
+  // The refit's way up: per node its parent (-1 at the root) and its Wide slot (4 w + slot, or -1),
+  // per item its leaf; per node a mark while it waits to be refitted.
+  std::vector<int32_t> node_parent, node_slot, item_leaf;
+  std::vector<uint8_t> node_dirty;
   std::vector<Vec3> start;     // the positions at the start of the last substep
   std::vector<double> radius;  // the half thicknesses the pairs' gaps were measured with
   std::vector<Vec3> rest;      // the bodies' rest shapes (points order) near_at_rest was found in
@@ -725,7 +733,8 @@ struct Scratch {
   std::vector<int32_t> tri_body, edge_body;
   std::vector<int32_t> left;  // the particles that left their regions (points order)
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
-  std::vector<uint8_t> item_changed;                    // per item: holds a changed primitive
+  std::vector<uint8_t> item_changed;                                             // per item: holds a changed primitive
+  std::vector<int32_t> changed_tris, changed_edges, changed_items, dirty_nodes;  // the marks' lists
   std::vector<int32_t> groups;                          // the groups of kQueryGroup items holding a changed item
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<Box> moved;                               // per particle: its start and end, not grown
@@ -970,14 +979,60 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
   ix.item_box.resize(items);
   ix.owned_point_box.resize(ix.owned_points.size());
   ix.owned_edge_box.resize(ix.owned_edges.size());
+  // The marks' ways: each primitive's item in leaf order, each point's triangles and edges.
+  std::vector<int32_t> leaf_of(items);  // per item in creation order: its place in leaf order
+  for (size_t k = 0; k < items; ++k) leaf_of[static_cast<size_t>(order[k])] = static_cast<int32_t>(k);
+  ix.tri_item.resize(nt);
+  for (size_t t = 0; t < nt; ++t) ix.tri_item[t] = leaf_of[t];
+  ix.edge_item.resize(ne);
+  for (size_t e = 0; e < ne; ++e) ix.edge_item[e] = leaf_of[static_cast<size_t>(edge_owner[e])];
+  ix.point_item.resize(np);
+  for (size_t k = 0; k < np; ++k) ix.point_item[k] = leaf_of[static_cast<size_t>(point_owner[s.points[k]])];
+  std::vector<int32_t> point_of(x.size(), -1);  // per particle: its place in points order
+  for (size_t k = 0; k < np; ++k) point_of[static_cast<size_t>(s.points[k])] = static_cast<int32_t>(k);
+  const auto incident = [&](const std::vector<int32_t>& ids, int arity, std::vector<int32_t>& begin,
+                            std::vector<int32_t>& list) {
+    begin.assign(np + 1, 0);
+    for (int32_t i : ids) ++begin[static_cast<size_t>(point_of[static_cast<size_t>(i)]) + 1];
+    for (size_t k = 0; k < np; ++k) begin[k + 1] += begin[k];
+    list.resize(ids.size());
+    std::vector<int32_t> at(begin.begin(), begin.end() - 1);
+    for (size_t j = 0; j < ids.size(); ++j)
+      list[static_cast<size_t>(at[static_cast<size_t>(point_of[static_cast<size_t>(ids[j])])]++)] =
+          static_cast<int32_t>(j / static_cast<size_t>(arity));
+  };
+  incident(s.tris, 3, ix.point_tri_begin, ix.point_tris);
+  incident(s.edges, 2, ix.point_edge_begin, ix.point_edges);
+  // The refit's way up.
+  ix.node_parent.assign(ix.nodes.size(), -1);
+  ix.node_slot.assign(ix.nodes.size(), -1);
+  ix.item_leaf.assign(items, 0);
+  for (size_t k = 0; k < ix.nodes.size(); ++k) {
+    const SelfCollisionIndex::Node& node = ix.nodes[k];
+    if (node.count > 0) {
+      for (int32_t j = node.first; j < node.first + node.count; ++j)
+        ix.item_leaf[static_cast<size_t>(j)] = static_cast<int32_t>(k);
+    } else {
+      ix.node_parent[k + 1] = static_cast<int32_t>(k);
+      ix.node_parent[static_cast<size_t>(node.right)] = static_cast<int32_t>(k);
+    }
+  }
+  for (size_t w = 0; w < ix.wide.size(); ++w)
+    for (size_t k = 0; k < 4; ++k)
+      if (ix.wide[w].node[k] >= 0)
+        ix.node_slot[static_cast<size_t>(ix.wide[w].node[k])] = static_cast<int32_t>(4 * w + k);
+  ix.node_dirty.assign(ix.nodes.size(), 0);
 }
 
-/// The hierarchy refitted to the primitives' region boxes: a changed item's box holds its triangle's
-/// (which holds its vertices' and edges') or those of what it owns, a node's its children's.
-void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_changed, ThreadPool& pool, size_t grain) {
-  pool.run(0, ix.item_tri.size(), 1, grain, [&](size_t begin, size_t end, int) {
-    for (size_t k = begin; k < end; ++k) {
-      if (!item_changed[k]) continue;
+/// The hierarchy refitted to the primitives' region boxes where they changed: a changed item's box
+/// holds its triangle's (which holds its vertices' and edges') or those of what it owns, and each
+/// node above one its children's (the nodes in between keep theirs: the same boxes as a refit of
+/// all). `changed`: the changed items, ascending; `dirty`: scratch.
+void refit_hierarchy(SelfCollisionIndex& ix, std::span<const int32_t> changed, std::vector<int32_t>& dirty,
+                     ThreadPool& pool, size_t grain) {
+  pool.run(0, changed.size(), 1, grain, [&](size_t begin, size_t end, int) {
+    for (size_t c = begin; c < end; ++c) {
+      const size_t k = static_cast<size_t>(changed[c]);
       FloatBox owned = FloatBox::empty();
       for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
         owned.unite(ix.owned_point_box[j] = FloatBox::outward(ix.point_boxes[ix.owned_points[j]]));
@@ -988,24 +1043,33 @@ void refit_hierarchy(SelfCollisionIndex& ix, std::span<const uint8_t> item_chang
           ix.item_tri[k] >= 0 ? FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]) : owned;
     }
   });
-  for (size_t k = ix.nodes.size(); k-- > 0;) {
-    SelfCollisionIndex::Node& node = ix.nodes[k];
+  // The nodes above them, children before parents (a child comes after its parent).
+  dirty.clear();
+  for (int32_t item : changed)
+    for (int32_t n = ix.item_leaf[static_cast<size_t>(item)]; n >= 0 && !ix.node_dirty[static_cast<size_t>(n)];
+         n = ix.node_parent[static_cast<size_t>(n)]) {
+      ix.node_dirty[static_cast<size_t>(n)] = 1;
+      dirty.push_back(n);
+    }
+  std::sort(dirty.begin(), dirty.end(), std::greater<>());
+  for (int32_t n : dirty) {
+    SelfCollisionIndex::Node& node = ix.nodes[static_cast<size_t>(n)];
+    ix.node_dirty[static_cast<size_t>(n)] = 0;
     if (node.count > 0) {
       node.box = ix.item_box[static_cast<size_t>(node.first)];
       for (int32_t j = node.first + 1; j < node.first + node.count; ++j) node.box.unite(ix.item_box[j]);
     } else {
-      node.box = ix.nodes[k + 1].box;
+      node.box = ix.nodes[static_cast<size_t>(n) + 1].box;
       node.box.unite(ix.nodes[static_cast<size_t>(node.right)].box);
     }
-  }
-  for (SelfCollisionIndex::Wide& w : ix.wide)
-    for (size_t k = 0; k < 4 && w.node[k] >= 0; ++k) {
-      const FloatBox& b = ix.nodes[static_cast<size_t>(w.node[k])].box;
-      for (int a = 0; a < 3; ++a) {
-        w.lo[a][k] = b.lo[a];
-        w.hi[a][k] = b.hi[a];
-      }
+    const int32_t slot = ix.node_slot[static_cast<size_t>(n)];
+    if (slot < 0) continue;
+    SelfCollisionIndex::Wide& w = ix.wide[static_cast<size_t>(slot / 4)];
+    for (int a = 0; a < 3; ++a) {
+      w.lo[a][slot % 4] = node.box.lo[a];
+      w.hi[a][slot % 4] = node.box.hi[a];
     }
+  }
 }
 
 /// Bit k set where slot k's box of `w` overlaps q (never for an unused slot, whose box is empty).
@@ -1267,41 +1331,49 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
       for (int32_t i : ids) d = std::max(d, ix.reach[i]);
       return d;
     };
-    // The primitives holding them: new boxes.
+    // The primitives holding them: new boxes (marked from the particles' lists, boxed over the
+    // threads).
     s.tri_changed.assign(nt, 0);
     s.edge_changed.assign(ne, 0);
-    // (boxes and marks split over the threads, then the lists in index order)
-    in.pool->run(0, nt, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
-      for (size_t t = begin; t < end; ++t) {
-        const int32_t* v = &s.tris[3 * t];
-        if (!s.changed[v[0]] && !s.changed[v[1]] && !s.changed[v[2]]) continue;
-        ix.tri_boxes[t] = region({v[0], v[1], v[2]});
-        s.tri_changed[t] = 1;
+    s.changed_tris.clear();
+    s.changed_edges.clear();
+    for (int32_t k : s.left) {
+      for (int32_t j = ix.point_tri_begin[k]; j < ix.point_tri_begin[k + 1]; ++j) {
+        const int32_t t = ix.point_tris[j];
+        if (!s.tri_changed[t]) s.tri_changed[t] = 1, s.changed_tris.push_back(t);
+      }
+      for (int32_t j = ix.point_edge_begin[k]; j < ix.point_edge_begin[k + 1]; ++j) {
+        const int32_t e = ix.point_edges[j];
+        if (!s.edge_changed[e]) s.edge_changed[e] = 1, s.changed_edges.push_back(e);
+      }
+    }
+    in.pool->run(0, s.changed_tris.size(), 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t c = begin; c < end; ++c) {
+        const int32_t* v = &s.tris[3 * static_cast<size_t>(s.changed_tris[c])];
+        ix.tri_boxes[static_cast<size_t>(s.changed_tris[c])] = region({v[0], v[1], v[2]});
       }
     });
-    in.pool->run(0, ne, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
-      for (size_t e = begin; e < end; ++e) {
-        const int32_t a = s.edges[2 * e], b = s.edges[2 * e + 1];
-        if (!s.changed[a] && !s.changed[b]) continue;
-        ix.edge_boxes[e] = region({a, b});
-        s.edge_changed[e] = 1;
+    in.pool->run(0, s.changed_edges.size(), 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+      for (size_t c = begin; c < end; ++c) {
+        const int32_t* v = &s.edges[2 * static_cast<size_t>(s.changed_edges[c])];
+        ix.edge_boxes[static_cast<size_t>(s.changed_edges[c])] = region({v[0], v[1]});
       }
     });
     for (int32_t k : s.left) ix.point_boxes[k] = region({s.points[k]});
-    // The items holding a changed primitive.
+    // The items holding a changed primitive, ascending.
     const size_t items = ix.item_tri.size();
-    s.item_changed.resize(items);
-    in.pool->run(0, items, 1, kBoxGrain, [&](size_t begin, size_t end, int) {
-      for (size_t k = begin; k < end; ++k) {
-        const int32_t t = ix.item_tri[k];
-        uint8_t any = t >= 0 && s.tri_changed[static_cast<size_t>(t)];
-        for (int32_t j = ix.point_begin[k]; j < ix.point_begin[k + 1]; ++j)
-          any |= s.changed[s.points[ix.owned_points[j]]];
-        for (int32_t j = ix.edge_begin[k]; j < ix.edge_begin[k + 1]; ++j) any |= s.edge_changed[ix.owned_edges[j]];
-        s.item_changed[k] = any;
-      }
-    });
-    refit_hierarchy(ix, s.item_changed, *in.pool, kBoxGrain);
+    s.item_changed.assign(items, 0);
+    s.changed_items.clear();
+    const auto mark_item = [&](int32_t item) {
+      if (!s.item_changed[static_cast<size_t>(item)])
+        s.item_changed[static_cast<size_t>(item)] = 1, s.changed_items.push_back(item);
+    };
+    for (int32_t t : s.changed_tris) mark_item(ix.tri_item[static_cast<size_t>(t)]);
+    for (int32_t e : s.changed_edges) mark_item(ix.edge_item[static_cast<size_t>(e)]);
+    for (int32_t k : s.left) mark_item(ix.point_item[static_cast<size_t>(k)]);
+    std::sort(s.changed_items.begin(), s.changed_items.end());
+    s.dirty_nodes.reserve(ix.nodes.size());
+    refit_hierarchy(ix, s.changed_items, s.dirty_nodes, *in.pool, kBoxGrain);
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
@@ -1383,9 +1455,9 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     // Edge against edge, each pair once, the lower edge first.
     const bool kept_some = s.left.size() < np;
     s.groups.clear();
-    for (size_t k = 0; k < items; ++k)
-      if (s.item_changed[k] && (s.groups.empty() || static_cast<size_t>(s.groups.back()) != k / kQueryGroup))
-        s.groups.push_back(static_cast<int32_t>(k / kQueryGroup));
+    for (int32_t k : s.changed_items)
+      if (s.groups.empty() || s.groups.back() != k / static_cast<int32_t>(kQueryGroup))
+        s.groups.push_back(k / static_cast<int32_t>(kQueryGroup));
     // A group's items: [first, last).
     auto group_items = [&](size_t k) {
       const size_t first = static_cast<size_t>(s.groups[k]) * kQueryGroup;
