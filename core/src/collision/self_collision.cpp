@@ -733,8 +733,8 @@ struct Scratch {
   std::vector<int32_t> tri_body, edge_body;
   std::vector<int32_t> left;  // the particles that left their regions (points order)
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
-  std::vector<uint8_t> item_changed;                                             // per item: holds a changed primitive
-  std::vector<int32_t> changed_tris, changed_edges, changed_items, dirty_nodes;  // the marks' lists
+  std::vector<uint8_t> item_changed;                                // per item: holds a changed primitive
+  std::vector<int32_t> changed_tris, changed_edges, changed_items;  // the marks' lists
   std::vector<int32_t> groups;                          // the groups of kQueryGroup items holding a changed item
   std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
   std::vector<Box> moved;                               // per particle: its start and end, not grown
@@ -783,6 +783,7 @@ void gather(ThreadPool& pool, size_t n, size_t grain, std::vector<std::vector<T>
 constexpr size_t kPairGrain = 4;       // groups of items queried against the hierarchy
 constexpr size_t kContactGrain = 512;  // candidate pairs measured
 constexpr size_t kBoxGrain = 1024;     // particles or primitives boxed
+constexpr size_t kListGrain = 256;     // changed primitives or items boxed (a few regions each)
 
 /// gather() with two lists: body(k, first, second) for every k of [0, n), split over the pool's
 /// threads as the queries are (kPairGrain), each part appending to lists of its own; the lists are
@@ -1027,9 +1028,8 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
 /// The hierarchy refitted to the primitives' region boxes where they changed: a changed item's box
 /// holds its triangle's (which holds its vertices' and edges') or those of what it owns, and each
 /// node above one its children's (the nodes in between keep theirs: the same boxes as a refit of
-/// all). `changed`: the changed items, ascending; `dirty`: scratch.
-void refit_hierarchy(SelfCollisionIndex& ix, std::span<const int32_t> changed, std::vector<int32_t>& dirty,
-                     ThreadPool& pool, size_t grain) {
+/// all). `changed`: the changed items, ascending.
+void refit_hierarchy(SelfCollisionIndex& ix, std::span<const int32_t> changed, ThreadPool& pool, size_t grain) {
   pool.run(0, changed.size(), 1, grain, [&](size_t begin, size_t end, int) {
     for (size_t c = begin; c < end; ++c) {
       const size_t k = static_cast<size_t>(changed[c]);
@@ -1043,16 +1043,13 @@ void refit_hierarchy(SelfCollisionIndex& ix, std::span<const int32_t> changed, s
           ix.item_tri[k] >= 0 ? FloatBox::outward(ix.tri_boxes[static_cast<size_t>(ix.item_tri[k])]) : owned;
     }
   });
-  // The nodes above them, children before parents (a child comes after its parent).
-  dirty.clear();
+  // The nodes above them, then refitted children before parents (a child comes after its parent).
   for (int32_t item : changed)
     for (int32_t n = ix.item_leaf[static_cast<size_t>(item)]; n >= 0 && !ix.node_dirty[static_cast<size_t>(n)];
-         n = ix.node_parent[static_cast<size_t>(n)]) {
+         n = ix.node_parent[static_cast<size_t>(n)])
       ix.node_dirty[static_cast<size_t>(n)] = 1;
-      dirty.push_back(n);
-    }
-  std::sort(dirty.begin(), dirty.end(), std::greater<>());
-  for (int32_t n : dirty) {
+  for (int32_t n = static_cast<int32_t>(ix.nodes.size()) - 1; n >= 0; --n) {
+    if (!ix.node_dirty[static_cast<size_t>(n)]) continue;
     SelfCollisionIndex::Node& node = ix.nodes[static_cast<size_t>(n)];
     ix.node_dirty[static_cast<size_t>(n)] = 0;
     if (node.count > 0) {
@@ -1347,13 +1344,13 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
         if (!s.edge_changed[e]) s.edge_changed[e] = 1, s.changed_edges.push_back(e);
       }
     }
-    in.pool->run(0, s.changed_tris.size(), 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+    in.pool->run(0, s.changed_tris.size(), 1, kListGrain, [&](size_t begin, size_t end, int) {
       for (size_t c = begin; c < end; ++c) {
         const int32_t* v = &s.tris[3 * static_cast<size_t>(s.changed_tris[c])];
         ix.tri_boxes[static_cast<size_t>(s.changed_tris[c])] = region({v[0], v[1], v[2]});
       }
     });
-    in.pool->run(0, s.changed_edges.size(), 1, kBoxGrain, [&](size_t begin, size_t end, int) {
+    in.pool->run(0, s.changed_edges.size(), 1, kListGrain, [&](size_t begin, size_t end, int) {
       for (size_t c = begin; c < end; ++c) {
         const int32_t* v = &s.edges[2 * static_cast<size_t>(s.changed_edges[c])];
         ix.edge_boxes[static_cast<size_t>(s.changed_edges[c])] = region({v[0], v[1]});
@@ -1364,16 +1361,12 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     const size_t items = ix.item_tri.size();
     s.item_changed.assign(items, 0);
     s.changed_items.clear();
-    const auto mark_item = [&](int32_t item) {
-      if (!s.item_changed[static_cast<size_t>(item)])
-        s.item_changed[static_cast<size_t>(item)] = 1, s.changed_items.push_back(item);
-    };
-    for (int32_t t : s.changed_tris) mark_item(ix.tri_item[static_cast<size_t>(t)]);
-    for (int32_t e : s.changed_edges) mark_item(ix.edge_item[static_cast<size_t>(e)]);
-    for (int32_t k : s.left) mark_item(ix.point_item[static_cast<size_t>(k)]);
-    std::sort(s.changed_items.begin(), s.changed_items.end());
-    s.dirty_nodes.reserve(ix.nodes.size());
-    refit_hierarchy(ix, s.changed_items, s.dirty_nodes, *in.pool, kBoxGrain);
+    for (int32_t t : s.changed_tris) s.item_changed[static_cast<size_t>(ix.tri_item[static_cast<size_t>(t)])] = 1;
+    for (int32_t e : s.changed_edges) s.item_changed[static_cast<size_t>(ix.edge_item[static_cast<size_t>(e)])] = 1;
+    for (int32_t k : s.left) s.item_changed[static_cast<size_t>(ix.point_item[static_cast<size_t>(k)])] = 1;
+    for (size_t k = 0; k < items; ++k)
+      if (s.item_changed[k]) s.changed_items.push_back(static_cast<int32_t>(k));
+    refit_hierarchy(ix, s.changed_items, *in.pool, kListGrain);
     // The kept pairs: neither side holds a particle with a new region.
     // Each thread compacts a part of the list in place, then the parts are moved together in order:
     // the order one loop gives.
