@@ -1027,7 +1027,7 @@ void build_hierarchy(SelfCollisionIndex& ix, const Scratch& s, std::span<const V
 
 /// The hierarchy refitted to the primitives' region boxes where they changed: a changed item's box
 /// holds its triangle's (which holds its vertices' and edges') or those of what it owns, and each
-/// node above one its children's (the nodes in between keep theirs: the same boxes as a refit of
+/// node above one its children's (the other nodes keep theirs: the same boxes as a refit of
 /// all). `changed`: the changed items, ascending.
 void refit_hierarchy(SelfCollisionIndex& ix, std::span<const int32_t> changed, ThreadPool& pool, size_t grain) {
   pool.run(0, changed.size(), 1, grain, [&](size_t begin, size_t end, int) {

@@ -17,9 +17,9 @@
 //                 item met owns then tested against each of them. An item is a triangle with the
 //                 particles and edges it owns (each particle and edge owned by the first triangle
 //                 holding it), or a particle or edge held by no triangle, so a query meets each
-//                 primitive once. Pairs
-//                 that cannot come within their thickness while the regions hold (their distance,
-//                 less what the regions let them move) are dropped when the pairs are found, as are
+//                 primitive once. Pairs that cannot come within their thickness while the regions
+//                 hold (their distance, less what the regions let them move) are dropped when the
+//                 pairs are found, as are
 //                 the same body's pairs within their thickness in its rest shape (neighbours on the
 //                 surface, listed once for the topology from a grid over the rest shape). The
 //                 loops over particles, primitives, items and pairs are split over the pool's
