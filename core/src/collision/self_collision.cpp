@@ -1458,7 +1458,6 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     };
     // One walk a group for both kinds: the union of the boxes of its changed points, triangles
     // and edges.
-    s.part_ee_pairs.resize(s.part_pairs.size());
     pair_lists(*in.pool, s.groups.size(), s.part_pairs, s.part_ee_pairs, cache.point_triangle, cache.edge_edge,
                [&](size_t k, std::vector<int32_t>& pt_pairs, std::vector<int32_t>& ee_pairs) {
                  std::array<int32_t, 3 * kQueryGroup> left;  // points order
