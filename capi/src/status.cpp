@@ -6,13 +6,40 @@
 
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <new>
 
 namespace embra::capi {
 
 namespace {
 
-thread_local std::string g_last_error;
+// The message, in a fixed buffer of plain chars: a thread_local with a destructor is torn down at
+// thread exit by MinGW's libstdc++ in an order that can free its storage first (a host thread that
+// called embra and ended could corrupt the heap: msys2/MINGW-packages#2519, #7096), so nothing here
+// has one. Zero-initialised: "" until a call fails.
+thread_local char g_last_error[EMBRA_MAX_ERROR_MESSAGE];
+
+/// Sets the message to the parts one after the other, cut at a UTF-8 character boundary to what
+/// the buffer holds.
+void set_last_error(std::initializer_list<const char*> parts) noexcept {
+  char* out = g_last_error;
+  const size_t room = sizeof g_last_error - 1;
+  size_t n = 0;
+  unsigned char next = 0;  // the first byte left out, if any
+  for (const char* part : parts) {
+    for (; *part != '\0' && n < room; ++part) out[n++] = *part;
+    if (*part != '\0') {
+      next = static_cast<unsigned char>(*part);
+      break;
+    }
+  }
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(out[k]); };
+  if ((next & 0xc0) == 0x80) {  // the cut falls inside a character: leave all of it out
+    while (n > 0 && (byte(n - 1) & 0xc0) == 0x80) --n;
+    if (n > 0 && (byte(n - 1) & 0xc0) == 0xc0) --n;
+  }
+  out[n] = '\0';
+}
 
 embra_status map(embra::ErrorCode code) {
   switch (code) {
@@ -44,22 +71,22 @@ embra_status failed(const char* function) noexcept {
   try {
     throw;
   } catch (const Refused& r) {
-    g_last_error = std::string(function) + ": " + r.message;
+    set_last_error({function, ": ", r.message.c_str()});
     return r.status;
   } catch (const embra::io::SceneError& e) {
-    g_last_error = std::string(function) + ": " + e.what();
+    set_last_error({function, ": ", e.what()});
     return EMBRA_ERROR_SCHEMA;
   } catch (const embra::Error& e) {
-    g_last_error = std::string(function) + ": " + e.what();
+    set_last_error({function, ": ", e.what()});
     return map(e.code());
   } catch (const std::bad_alloc&) {
-    g_last_error = std::string(function) + ": out of memory";
+    set_last_error({function, ": out of memory"});
     return EMBRA_ERROR_INTERNAL;
   } catch (const std::exception& e) {
-    g_last_error = std::string(function) + ": internal error: " + e.what();
+    set_last_error({function, ": internal error: ", e.what()});
     return EMBRA_ERROR_INTERNAL;
   } catch (...) {
-    g_last_error = std::string(function) + ": internal error";
+    set_last_error({function, ": internal error"});
     return EMBRA_ERROR_INTERNAL;
   }
 }
@@ -111,7 +138,7 @@ static_assert(EMBRA_GLOBAL_SOLVE_AUTO_LIMIT == embra::kGlobalSolveAutoLimit);
 extern "C" {
 
 const char* embra_last_error_message(void) {
-  return embra::capi::g_last_error.c_str();
+  return embra::capi::g_last_error;
 }
 
 const char* embra_status_name(embra_status status) {

@@ -32,6 +32,7 @@ namespace Embra
         public const int MaxPassesPerStep = 100000;
         public const int MaxObjBytes = 268435456;
         public const int MaxThreads = 256;
+        public const int MaxErrorMessage = 4096;
     }
 
     /// <summary>EMBRA_GENERATE_*.</summary>

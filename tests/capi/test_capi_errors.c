@@ -2525,6 +2525,69 @@ static void test_step(void) {
   REFUSED_NO_WORLD(EMBRA_ERROR_INVALID_ARGUMENT, "world", embra_world_step(NULL));
 }
 
+/* Whether `s` is well-formed UTF-8 (RFC 3629: no overlong form, surrogate or value past U+10FFFF). */
+static int valid_utf8(const char* s) {
+  const unsigned char* p = (const unsigned char*)s;
+  while (*p != 0) {
+    int n, k;
+    unsigned cp;
+    if (*p < 0x80) {
+      ++p;
+      continue;
+    }
+    if ((*p & 0xe0) == 0xc0)
+      n = 1, cp = *p & 0x1fu;
+    else if ((*p & 0xf0) == 0xe0)
+      n = 2, cp = *p & 0x0fu;
+    else if ((*p & 0xf8) == 0xf0)
+      n = 3, cp = *p & 0x07u;
+    else
+      return 0;
+    for (k = 1; k <= n; ++k) {
+      if ((p[k] & 0xc0) != 0x80) return 0;
+      cp = cp << 6 | (p[k] & 0x3fu);
+    }
+    if ((n == 1 && cp < 0x80) || (n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) || cp > 0x10ffff ||
+        (cp >= 0xd800 && cp <= 0xdfff))
+      return 0;
+    p += n + 1;
+  }
+  return 1;
+}
+
+/* A message longer than EMBRA_MAX_ERROR_MESSAGE (a scene's unknown key of 3,000 two-byte
+ * characters, after 0, 1 and 2 one-byte ones so that the cut falls at each place in a character):
+ * the message keeps its start, fills the buffer to within one character and stays valid UTF-8. */
+static void test_long_message_cut(void) {
+  enum { CHARS = 3000 };
+  static const char head[] = "{\"format\": \"embra-scene\", \"version\": 1, \"";
+  static const char tail[] = "\": 1}";
+  int shift;
+  for (shift = 0; shift < 3; ++shift) {
+    char* doc = (char*)malloc(sizeof head + 2 * CHARS + 2 + sizeof tail);
+    embra_world* w = NULL;
+    size_t n = 0;
+    int k;
+    const char* m;
+    CAPI_CONTEXT("%d one-byte characters first", shift);
+    CHECK(doc != NULL);
+    if (doc == NULL) return;
+    memcpy(doc, head, sizeof head - 1), n = sizeof head - 1;
+    for (k = 0; k < shift; ++k) doc[n++] = 'x';
+    for (k = 0; k < CHARS; ++k) doc[n++] = (char)0xc3, doc[n++] = (char)0xa9; /* U+00E9 */
+    memcpy(doc + n, tail, sizeof tail), n += sizeof tail - 1;
+    CHECK_STATUS(embra_world_load_json(&w, doc, (int64_t)n, NULL), EMBRA_ERROR_SCHEMA);
+    CHECK(w == NULL);
+    m = embra_last_error_message();
+    CHECK_MSG(strncmp(m, "embra_world_load_json: ", 23) == 0, "the message starts: %.40s", m);
+    CHECK_CONTAINS(m, "unknown key");
+    CHECK_MSG(strlen(m) <= EMBRA_MAX_ERROR_MESSAGE - 1 && strlen(m) >= EMBRA_MAX_ERROR_MESSAGE - 2, "%d bytes",
+              (int)strlen(m));
+    CHECK(valid_utf8(m));
+    free(doc);
+  }
+}
+
 int main(void) {
   if (!scene_build(&g_ref)) {
     fprintf(stderr, "the scene does not build: %s\n", embra_last_error_message());
@@ -2556,5 +2619,6 @@ int main(void) {
   RUN(test_mesh_supports);
   RUN(test_panel_planarity_tolerance);
   RUN(test_step);
+  RUN(test_long_message_cut);
   return capi_test_finish();
 }

@@ -125,7 +125,9 @@ enum {
 #define EMBRA_GLOBAL_SOLVE_AUTO_LIMIT 20000
 
 /* The message of the last failed call on this thread ("" if none). Never NULL; valid until the
- * next embra call on this thread. */
+ * next embra call on this thread. At most EMBRA_MAX_ERROR_MESSAGE bytes with its terminating zero:
+ * a longer one is cut before the character that does not fit. */
+#define EMBRA_MAX_ERROR_MESSAGE 4096
 EMBRA_API const char* embra_last_error_message(void);
 
 /* A short constant name for a status code, e.g. "EMBRA_ERROR_STALE_ID". Never NULL. */

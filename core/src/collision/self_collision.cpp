@@ -726,8 +726,9 @@ bool edge_edge_toi(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b
 
 // --- detection -------------------------------------------------------------------------------------
 
-namespace {
-
+/// find_contacts' working arrays, one set per world (SelfCollisionCache::scratch), kept from substep
+/// to substep for their storage. Not thread_local: a host thread that steps a world and ends would
+/// tear them down with MinGW's thread-exit destructors, which can free their storage first.
 struct Scratch {
   std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
   std::vector<int32_t> tri_body, edge_body;
@@ -760,10 +761,7 @@ struct Scratch {
   std::vector<SelfContact> sorted;
 };
 
-Scratch& scratch() {
-  thread_local Scratch s;
-  return s;
-}
+namespace {
 
 /// Calls body(k, list) for every k of [0, n), split over the pool's threads, each part appending
 /// to a list of its own; the lists are then appended to `out` in part order, which is the order one
@@ -1218,7 +1216,9 @@ bool listed(const std::vector<uint64_t>& keys, uint64_t key) {
 
 void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   out.clear();
-  Scratch& s = scratch();
+  SelfCollisionCache& cache = *in.cache;
+  if (!cache.scratch) cache.scratch = std::make_shared<Scratch>();
+  Scratch& s = *cache.scratch;
   s.tris.clear();
   s.edges.clear();
   s.tri_body.clear();
@@ -1239,7 +1239,6 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const auto& r = in.radius;
   auto grow_of = [&](int32_t i) { return self_collision::grow_of(r[i]); };
   const size_t nt = s.tris.size() / 3, ne = s.edges.size() / 2;
-  SelfCollisionCache& cache = *in.cache;
 
   // The candidate pairs hold while every particle stays inside the region it had when they were
   // found (its swept bounds stretched ahead and grown by a margin), at the start and at the end of

@@ -58,14 +58,12 @@ T ThreadPool::wait_change(const std::atomic<T>& a, T old) {
   } while (std::chrono::steady_clock::now() < until);
   // Asleep on a condition variable, the value looked at under its mutex (which every change takes
   // before notifying: wake), so no change is missed. Not std::atomic::wait: MinGW's libstdc++
-  // (GCC 12) implements it without futexes, and a worker there once slept through the pool's
-  // stop under wine (test_capi_threads hung at exit).
+  // (GCC 12) implements it without futexes.
   std::unique_lock<std::mutex> lock(sleep_mutex_);
   sleepers_.fetch_add(1, std::memory_order_seq_cst);
   std::atomic_thread_fence(std::memory_order_seq_cst);  // pairs with wake's: one of us sees the other
   // Looked at again every kSleepLook even without a notification: a wake-up lost to the platform
-  // (capi.test_capi_threads once never exited under wine after every check passed, a worker asleep
-  // through the pool's stop) then costs that long, never a hang.
+  // then costs that long, never a hang.
   while (!sleep_.wait_for(lock, kSleepLook, [&] { return (now = a.load(std::memory_order_acquire)) != old; })) {
   }
   sleepers_.fetch_sub(1, std::memory_order_relaxed);
