@@ -726,10 +726,15 @@ bool edge_edge_toi(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b
 
 // --- detection -------------------------------------------------------------------------------------
 
+}  // namespace embra::self_collision
+
+namespace embra {
+
 /// find_contacts' working arrays, one set per world (SelfCollisionCache::scratch), kept from substep
 /// to substep for their storage. Not thread_local: a host thread that steps a world and ends would
 /// tear them down with MinGW's thread-exit destructors, which can free their storage first.
-struct Scratch {
+struct SelfCollisionScratch {
+  using Box = self_collision::Box;
   std::vector<int32_t> tris, edges, points;  // world indices: 3, 2, 1 per primitive
   std::vector<int32_t> tri_body, edge_body;
   std::vector<int32_t> left;  // the particles that left their regions (points order)
@@ -760,6 +765,12 @@ struct Scratch {
   std::vector<Order> order;
   std::vector<SelfContact> sorted;
 };
+
+}  // namespace embra
+
+namespace embra::self_collision {
+
+using Scratch = SelfCollisionScratch;
 
 namespace {
 

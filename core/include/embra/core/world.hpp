@@ -414,10 +414,8 @@ struct SelfContact {
 
 /// Self-collision candidate pairs (core/src/self_collision.hpp), kept while every particle stays
 /// inside the region [lo, hi] it had when they were found.
-struct SelfCollisionIndex;  // collision/self_collision.cpp
-namespace self_collision {
-struct Scratch;  // collision/self_collision.cpp
-}
+struct SelfCollisionIndex;    // collision/self_collision.cpp
+struct SelfCollisionScratch;  // collision/self_collision.cpp
 struct SelfCollisionCache {
   std::vector<Vec3> lo, hi;             // per particle
   std::vector<int32_t> point_triangle;  // (particle, triangle) pairs
@@ -425,9 +423,9 @@ struct SelfCollisionCache {
   // Per pair: a lower bound of its distance less its thickness at the start of the last substep
   // (-inf until it is measured).
   std::vector<double> point_triangle_gap, edge_edge_gap;
-  std::vector<int32_t> triangles, edges;             // the primitives they were found for (world indices)
-  std::shared_ptr<SelfCollisionIndex> index;         // the regions' boxes and their hierarchy
-  std::shared_ptr<self_collision::Scratch> scratch;  // the detection's working arrays (their storage)
+  std::vector<int32_t> triangles, edges;          // the primitives they were found for (world indices)
+  std::shared_ptr<SelfCollisionIndex> index;      // the regions' boxes and their hierarchy
+  std::shared_ptr<SelfCollisionScratch> scratch;  // the detection's working arrays (their storage)
 };
 
 struct Contact {
