@@ -44,6 +44,9 @@ static_assert(static_cast<int>(embra::PanelPins::top_and_bottom_corners) == 2, "
 static_assert(static_cast<int>(embra::PanelCorners::welded) == 0, "embra::PanelCorners::welded is EMBRA_PANEL_CORNERS_WELDED = 0");
 static_assert(static_cast<int>(embra::PanelCorners::shared) == 1, "embra::PanelCorners::shared is EMBRA_PANEL_CORNERS_SHARED = 1");
 
+static_assert(static_cast<int>(embra::PanelPrecision::full) == 0, "embra::PanelPrecision::full is EMBRA_PANEL_PRECISION_FULL = 0");
+static_assert(static_cast<int>(embra::PanelPrecision::single) == 1, "embra::PanelPrecision::single is EMBRA_PANEL_PRECISION_SINGLE = 1");
+
 static_assert(static_cast<int>(embra::PinSupport::point) == 0, "embra::PinSupport::point is EMBRA_PIN_SUPPORT_POINT = 0");
 static_assert(static_cast<int>(embra::PinSupport::plane) == 1, "embra::PinSupport::plane is EMBRA_PIN_SUPPORT_PLANE = 1");
 static_assert(static_cast<int>(embra::PinSupport::line) == 2, "embra::PinSupport::line is EMBRA_PIN_SUPPORT_LINE = 2");

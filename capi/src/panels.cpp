@@ -33,6 +33,7 @@ embra_panel_mesh_def embra_default_panel_mesh_def(void) {
   const embra::PanelMeshDesc p;
   d.pins = static_cast<int32_t>(p.pins);
   d.corners = static_cast<int32_t>(p.corners);
+  d.precision = static_cast<int32_t>(p.precision);
   to_c(kPanelMeshCopies, p, d);
   return d;
 }
@@ -61,8 +62,8 @@ embra_status embra_panel_mesh_create(embra_world* world, const embra_panel_mesh_
     }
     to_core(kPanelMeshCopies, *def, d);
     d.pins = static_cast<embra::PanelPins>(def->pins);
-    d.corners = static_cast<embra::PanelCorners>(def->corners);  // checked by build_panel_mesh
-    if (def->reserved0 != 0) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "def.reserved0 must be 0");
+    d.corners = static_cast<embra::PanelCorners>(def->corners);        // checked by build_panel_mesh
+    d.precision = static_cast<embra::PanelPrecision>(def->precision);  // checked by build_panel_mesh
     d.group = to_id(def->group);
     d.tolerances = embra::io::parse_tolerances(world->meta.tolerances);  // the world's, in force
     const embra::Id id = embra::build_panel_mesh(world->world, d);

@@ -66,6 +66,9 @@ namespace Embra
     /// <summary>EMBRA_PANEL_CORNERS_*.</summary>
     public enum PanelCorners { Welded = 0, Shared = 1 }
 
+    /// <summary>EMBRA_PANEL_PRECISION_*.</summary>
+    public enum PanelPrecision { Full = 0, Single = 1 }
+
     /// <summary>EMBRA_PANEL_METRIC_*.</summary>
     public enum PanelMetric { Planarity = 0, Thickness = 1, Miter = 2, CornerDistance = 3, Conical = 4 }
 
@@ -469,7 +472,7 @@ namespace Embra
         public double SlideCompliance;
         public GroupId Group;
         public int Corners;
-        public int Reserved0;
+        public int Precision;
     }
 
     /// <summary>embra_tolerance.</summary>

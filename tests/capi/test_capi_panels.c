@@ -362,6 +362,13 @@ static void test_create(void) {
   d.quad_count = 1;
   d.positions = NULL;
   CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
+  d = embra_default_panel_mesh_def();
+  CHECK_INT(d.precision, EMBRA_PANEL_PRECISION_FULL);
+  d.precision = EMBRA_PANEL_PRECISION_SINGLE + 1;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
+  CHECK_CONTAINS(embra_last_error_message(), "precision");
+  d.precision = -1;
+  CHECK_STATUS(embra_panel_mesh_create(w, &d, &body, &first), EMBRA_ERROR_INVALID_ARGUMENT);
   CHECK_OK(embra_world_get_counts(w, &c));
   CHECK_INT(c.particles, 0);
   CHECK_INT(c.bodies, 0);

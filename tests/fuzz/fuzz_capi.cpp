@@ -739,7 +739,7 @@ void Session::op_panel_mesh() {
   if (which & 64) d.slide_compliance = in_.value();
   if (in_.chance(2)) d.pins = in_.u8() % 5 - 1;
   if (in_.chance(2)) d.corners = in_.u8() % 4 - 1;
-  if (in_.chance(32)) d.reserved0 = 1;
+  if (in_.chance(2)) d.precision = in_.u8() % 4 - 1;
   if (in_.chance(2)) d.group = pick_id(in_, groups_);
   embra_body_id id{};
   const embra_status s =

@@ -216,6 +216,7 @@ std::map<std::string, std::vector<json>> code_defaults() {
   c[pm + "slide_compliance"] = {p.slide_compliance};
   c[pm + "pins"] = {panel_pins_name(p.pins)};
   c[d + "panel_corners"] = {p.corners == EMBRA_PANEL_CORNERS_WELDED ? "welded" : "shared"};
+  c[d + "panel_precision"] = {p.precision == EMBRA_PANEL_PRECISION_FULL ? "full" : "single"};
   c[pm + "group"] = {group_name(p.group)};
 
   // An area load's mode left out is a zeroed embra_area_load's (there is no default def).

@@ -670,6 +670,8 @@ static_assert(std::size(kAreaLoadModeNames) == kAreaLoadModeCount);
 constexpr const char* kPanelPinsNames[] = {"none", "top_corners", "top_and_bottom_corners"};
 /// The panel corners' names in the scene format, by PanelCorners.
 constexpr const char* kPanelCornersNames[] = {"welded", "shared"};
+/// The panel rows' precisions' names in the scene format, by PanelPrecision.
+constexpr const char* kPanelPrecisionNames[] = {"full", "single"};
 
 /// The enumerator `o[key]` names in `names` (the schema has checked it is one of them), or `absent`
 /// when `o` has no `key`.
@@ -1414,6 +1416,7 @@ class Builder {
         for (const json& v : q) l.quads.push_back(v.get<int32_t>());
       l.thickness = p["thickness"].get<double>();
       l.shared = named_enum(p, "corners", kPanelCornersNames, PanelCorners::welded) == PanelCorners::shared;
+      l.single = named_enum(p, "precision", kPanelPrecisionNames, PanelPrecision::full) == PanelPrecision::single;
       guard(at, [&] {
         w.set_panel_layout(l);
         return 0;
@@ -1458,6 +1461,7 @@ class Builder {
     if (doc_.contains("tolerances")) d.tolerances = parse_tolerances(doc_["tolerances"].dump());
     d.pins = named_enum(p, "pins", kPanelPinsNames, d.pins);
     d.corners = named_enum(p, "corners", kPanelCornersNames, d.corners);
+    d.precision = named_enum(p, "precision", kPanelPrecisionNames, d.precision);
     d.group = group(p, "group", at);
     std::vector<bool> had(w.pins().size());
     for (size_t i = 0; i < w.pins().size(); ++i) had[i] = w.pins()[i].alive;
@@ -1736,7 +1740,8 @@ std::string save_scene(const World& w, const SceneMeta& meta) {
                             {"vertex_count", l.vertex_count},
                             {"quads", quads},
                             {"thickness", l.thickness},
-                            {"corners", kPanelCornersNames[l.shared ? 1 : 0]}});
+                            {"corners", kPanelCornersNames[l.shared ? 1 : 0]},
+                            {"precision", kPanelPrecisionNames[l.single ? 1 : 0]}});
   }
   if (!panel_meshes.empty()) doc["panel_meshes"] = panel_meshes;
 

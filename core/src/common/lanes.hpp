@@ -28,26 +28,34 @@ namespace embra::lanes {
 template <class T>
 struct Lanes;
 
-template <>
-struct Lanes<double> {
+template <class E>
+struct ScalarLanes {
+  using Elem = E;
   static constexpr int count = 1;
-  static EMBRA_ALWAYS_INLINE double get(double v, int) { return v; }
-  static EMBRA_ALWAYS_INLINE double make(const double* a) { return a[0]; }
+  static EMBRA_ALWAYS_INLINE E get(E v, int) { return v; }
+  static EMBRA_ALWAYS_INLINE E make(const E* a) { return a[0]; }
   template <class M>
   static EMBRA_ALWAYS_INLINE bool on(M m, int) {
     return static_cast<bool>(m);
   }
 };
+template <>
+struct Lanes<double> : ScalarLanes<double> {};
+template <>
+struct Lanes<float> : ScalarLanes<float> {};
 
 #if EMBRA_LANES_VECTOR
 using D2 = double __attribute__((vector_size(16)));
 using D4 = double __attribute__((vector_size(32)));
+using F4 = float __attribute__((vector_size(16)));
+using F8 = float __attribute__((vector_size(32)));
 
 template <class V, int N>
 struct VectorLanes {
+  using Elem = std::remove_cvref_t<decltype(V{}[0])>;
   static constexpr int count = N;
-  static EMBRA_ALWAYS_INLINE double get(V v, int l) { return v[l]; }
-  static EMBRA_ALWAYS_INLINE V make(const double* a) {
+  static EMBRA_ALWAYS_INLINE Elem get(V v, int l) { return v[l]; }
+  static EMBRA_ALWAYS_INLINE V make(const Elem* a) {
     V v;
     std::memcpy(&v, a, sizeof v);
     return v;
@@ -61,12 +69,29 @@ template <>
 struct Lanes<D2> : VectorLanes<D2, 2> {};
 template <>
 struct Lanes<D4> : VectorLanes<D4, 4> {};
+template <>
+struct Lanes<F4> : VectorLanes<F4, 4> {};
+template <>
+struct Lanes<F8> : VectorLanes<F8, 8> {};
 #endif
 
+/// The element type of lanes T (double or float).
 template <class T>
-EMBRA_ALWAYS_INLINE T splat(double s) {
-  double a[Lanes<T>::count];
-  for (double& v : a) v = s;
+using Elem = typename Lanes<T>::Elem;
+
+/// The smallest length a row divides by: 1e-300 in doubles, 1e-30 in floats.
+template <class T>
+constexpr Elem<T> tiny() {
+  if constexpr (std::is_same_v<Elem<T>, double>)
+    return 1e-300;
+  else
+    return 1e-30f;
+}
+
+template <class T>
+EMBRA_ALWAYS_INLINE T splat(Elem<T> s) {
+  Elem<T> a[Lanes<T>::count];
+  for (Elem<T>& v : a) v = s;
   return Lanes<T>::make(a);
 }
 
@@ -86,7 +111,7 @@ EMBRA_ALWAYS_INLINE T select(M m, T a, T b) {
 
 template <class T>
 EMBRA_ALWAYS_INLINE T sqrt(T v) {
-  double a[Lanes<T>::count];
+  Elem<T> a[Lanes<T>::count];
   for (int l = 0; l < Lanes<T>::count; ++l) a[l] = std::sqrt(Lanes<T>::get(v, l));
   return Lanes<T>::make(a);
 }

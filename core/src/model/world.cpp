@@ -1106,7 +1106,7 @@ using IslandRows = std::vector<std::pair<int8_t, int32_t>>;
 /// same local particles, numbered by first use) go in items of up to kItemIslands, per colour.
 /// None when an island uses more than kSlots particles.
 IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector<IslandRows>& islands,
-                        const std::vector<int32_t>& colour_start) {
+                        const std::vector<int32_t>& colour_start, const std::vector<uint8_t>& single) {
   IslandPlan plan;
   std::map<std::vector<int8_t>, int32_t> shape_of;
   std::vector<int32_t> local(particle_count, -1);
@@ -1140,6 +1140,7 @@ IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector
       }
       for (int32_t q : particles) local[q] = -1;
       key.push_back(static_cast<int8_t>(particles.size()));
+      key.push_back(static_cast<int8_t>(single[static_cast<size_t>(particles[0])]));
       const auto [it, fresh] = shape_of.emplace(key, static_cast<int32_t>(plan.shapes.size()));
       if (fresh) {
         IslandPlan::Shape shape;
@@ -1147,6 +1148,7 @@ IslandPlan plan_islands(const Group& g, size_t particle_count, const std::vector
         shape.steps = static_cast<int32_t>(list.size());
         for (const auto& [kr, i] : list) shape.kind.push_back(kr);
         shape.slot = slots;
+        shape.single = single[static_cast<size_t>(particles[0])] != 0;
         plan.shapes.push_back(std::move(shape));
         first.push_back(-1);
         order.emplace_back();
@@ -1296,6 +1298,12 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
       }
   }
   if (rows == 0) return {};
+  // The particles of panel meshes in single precision: an island takes its first particle's.
+  std::vector<uint8_t> single(particle_count, 0);
+  for (const PanelLayout& l : layouts)
+    if (l.single)
+      for (int64_t i = l.first_particle; i < l.first_particle + l.particle_count(); ++i)
+        if (static_cast<size_t>(i) < particle_count) single[static_cast<size_t>(i)] = 1;
   // Each island's rows in the passes' order, islands in the order of their first row.
   std::vector<int32_t> island_of(particle_count, -1);
   std::vector<IslandRows> islands;
@@ -1314,12 +1322,12 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
     }
   }
   if (small) {
-    IslandPlan plan = plan_islands(g, particle_count, islands, {0, static_cast<int32_t>(islands.size())});
+    IslandPlan plan = plan_islands(g, particle_count, islands, {0, static_cast<int32_t>(islands.size())}, single);
     if (plan.active()) return plan;
   }
   std::vector<int32_t> colour_start;
   if (!panel_islands(g, particle_count, layouts, islands, colour_start)) return {};
-  return plan_islands(g, particle_count, islands, colour_start);
+  return plan_islands(g, particle_count, islands, colour_start, single);
 }
 
 /// A coloured plan's rows in memory as its threads take them: within each colour of the three

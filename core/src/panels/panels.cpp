@@ -419,6 +419,8 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   const int64_t np = static_cast<int64_t>(d.quads.size() / 4);
   const int32_t corners = static_cast<int32_t>(d.corners);
   if (corners < 0 || corners > 1) invalid("panel mesh corners must be 0 (welded) or 1 (shared)");
+  const int32_t precision = static_cast<int32_t>(d.precision);
+  if (precision < 0 || precision > 1) invalid("panel mesh precision must be 0 (full) or 1 (single)");
   const bool shared = d.corners == PanelCorners::shared;
   if (nv > std::numeric_limits<int32_t>::max()) invalid("panel mesh has more vertices than an int32 counts");
   // The layout first (body-local: first_particle 0 until the body exists): it places the particles
@@ -428,6 +430,7 @@ Id build_panel_mesh(World& world, const PanelMeshDesc& d) {
   layout.quads.assign(d.quads.begin(), d.quads.end());
   layout.thickness = d.thickness;
   layout.shared = shared;
+  layout.single = d.precision == PanelPrecision::single;
   const int64_t particles = layout.particle_count();
   if (particles + world.particle_count() > limits::kMaxParticles)
     invalid("a world holds at most 2097152 particles; " + std::to_string(np) + " panels on " + std::to_string(nv) +

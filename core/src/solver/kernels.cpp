@@ -52,7 +52,7 @@ EMBRA_ALWAYS_INLINE auto distance_step(const lanes::V3<T>& p0, const lanes::V3<T
   const T len = lanes::sqrt(dot(d, d));
   const T c = len - r;
   const T denom = w0 + w1 + alpha;
-  auto ok = (len > 1e-300) & (denom > 0.0);
+  auto ok = (len > tiny<T>()) & (denom > 0.0);
   T dl = (-c - alpha * lam) / denom;
   if constexpr (kTether) {
     ok = ok & ((c > 0.0) | (lam != 0.0));  // a slack tether with no pull left does nothing
@@ -201,8 +201,8 @@ EMBRA_ALWAYS_INLINE auto offset_step(const lanes::V3<T> p[4], const T wk[4], T r
   const V3<T> s = kPlanarity ? p[1] - p[0] : p[0] - p[1];
   const V3<T> n = cross(a, b);
   const T m = lanes::sqrt(dot(n, n));
-  const auto valid = m > 1e-300;
-  const T inv_m = 1.0 / m;  // one division, not six: the block is bound by its divider
+  const auto valid = m > tiny<T>();
+  const T inv_m = 1.0f / m;  // one division, not six: the block is bound by its divider
   const V3<T> u = inv_m * n;
   const T value = dot(s, u);
   const V3<T> t = s - value * u;
@@ -305,12 +305,112 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
     }
 }
 
+/// island_block in single precision (T: lanes of floats, Shape::single) for the islands
+/// first .. first + lanes - 1 of `item` (first = item.first + k): each lane's particles relative to
+/// its island's first particle, the rows projected on those, each particle's move summed from zero
+/// (so a row's correction keeps its own digits, not those of the particle's place) and added to its
+/// double position at the end. The rows' operands are vector loads (Shape::rest_single).
+template <class T>
+EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, const IslandPlan::Item& item, int k,
+                                             double* x, const double* w) {
+  using namespace lanes;
+  using L = Lanes<T>;
+  constexpr int N = L::count;
+  const int slots = shape.slots, steps = shape.steps;
+  const size_t first = static_cast<size_t>(item.first + k);
+  const size_t ops = static_cast<size_t>(item.first) * static_cast<size_t>(steps) + static_cast<size_t>(k);
+  const int32_t* ids = &shape.particle[first * static_cast<size_t>(slots)];
+  V3<T> p[IslandPlan::kSlots], moved[IslandPlan::kSlots];  // where a particle started, how far it moved
+  T wp[IslandPlan::kSlots];
+  double origin[N][3];
+  for (int l = 0; l < N; ++l) std::memcpy(origin[l], x + 3 * static_cast<int64_t>(ids[l * slots]), sizeof origin[l]);
+  for (int s = 0; s < slots; ++s) {
+    float a[3][N], ws[N];
+    for (int l = 0; l < N; ++l) {
+      const int32_t id = ids[l * slots + s];
+      const double* q = x + 3 * static_cast<int64_t>(id);
+      for (int c = 0; c < 3; ++c) a[c][l] = static_cast<float>(q[c] - origin[l][c]);
+      ws[l] = static_cast<float>(w[id]);
+    }
+    p[s] = {L::make(a[0]), L::make(a[1]), L::make(a[2])};
+    moved[s] = {splat<T>(0.0f), splat<T>(0.0f), splat<T>(0.0f)};
+    wp[s] = L::make(ws);
+  }
+  for (int step = 0; step < steps; ++step) {
+    const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
+    const size_t at = ops + static_cast<size_t>(step * item.count);
+    float* own = shape.lambda_single.data() + at;
+    const T r = L::make(shape.rest_single.data() + at), lam = L::make(own);
+    const T alpha = L::make(shape.alpha_single.data() + at);
+    T lam_new;
+    decltype(T{} > 0.0f) ok;  // the lanes where the row applies
+    if (shape.kind[step] == 0) {
+      const int a = sl[0], b = sl[1];
+      V3<T> d;
+      T s0, s1;
+      ok = distance_step<T, false>(p[a] + moved[a], p[b] + moved[b], wp[a], wp[b], r, lam, alpha, d, s0, s1, lam_new);
+      moved[a] = select3(ok & (wp[a] != 0.0f), moved[a] + s0 * d, moved[a]);
+      moved[b] = select3(ok & (wp[b] != 0.0f), moved[b] - s1 * d, moved[b]);
+    } else {
+      const V3<T> o[4] = {p[sl[0]] + moved[sl[0]], p[sl[1]] + moved[sl[1]], p[sl[2]] + moved[sl[2]],
+                          p[sl[3]] + moved[sl[3]]};
+      const T wk[4] = {wp[sl[0]], wp[sl[1]], wp[sl[2]], wp[sl[3]]};
+      V3<T> g[4];
+      T dl;
+      ok = shape.kind[step] == 1 ? offset_step<T, true>(o, wk, r, lam, alpha, g, dl)
+                                 : offset_step<T, false>(o, wk, r, lam, alpha, g, dl);
+      for (int j = 0; j < 4; ++j)
+        moved[sl[j]] = select3(ok & (wk[j] != 0.0f), moved[sl[j]] + (wk[j] * dl) * g[j], moved[sl[j]]);
+      lam_new = lam + dl;
+    }
+    const T kept = select(ok, lam_new, lam);
+    std::memcpy(own, &kept, sizeof kept);
+  }
+  for (int s = 0; s < slots; ++s)
+    for (int l = 0; l < N; ++l) {
+      if (L::get(wp[s], l) == 0.0f) continue;  // an immovable particle is not written
+      double* q = x + 3 * static_cast<int64_t>(ids[l * slots + s]);
+      q[0] += static_cast<double>(L::get(moved[s].x, l));
+      q[1] += static_cast<double>(L::get(moved[s].y, l));
+      q[2] += static_cast<double>(L::get(moved[s].z, l));
+    }
+}
+
+/// The lanes of floats that fill the same vector register as lanes of doubles T.
+template <class T>
+struct SingleLanes {
+  using type = float;
+};
+#if EMBRA_LANES_VECTOR
+template <>
+struct SingleLanes<lanes::D2> {
+  using type = lanes::F4;
+};
+template <>
+struct SingleLanes<lanes::D4> {
+  using type = lanes::F8;
+};
+#endif
+
 /// An item's rows' multipliers from the arrays into its islands' own (`take`), or back.
 inline void own_lambda(const IslandPlan::Shape& shape, const IslandPlan::Item& item, SolverArray* const* rows,
                        bool take) {
   const size_t steps = static_cast<size_t>(shape.steps);
-  double* own = shape.lambda.data() + static_cast<size_t>(item.first) * steps;
   const int32_t* row = shape.row.data() + static_cast<size_t>(item.first) * steps;
+  if (shape.single) {  // item by item, step by step (Shape::lambda_single)
+    const size_t n = static_cast<size_t>(item.count);
+    float* single = shape.lambda_single.data() + static_cast<size_t>(item.first) * steps;
+    for (size_t island = 0; island < n; ++island, row += steps)
+      for (size_t step = 0; step < steps; ++step) {
+        double& in_array = rows[shape.kind[step]]->lambda[static_cast<size_t>(row[step])];
+        if (take)
+          single[step * n + island] = static_cast<float>(in_array);
+        else
+          in_array = static_cast<double>(single[step * n + island]);
+      }
+    return;
+  }
+  double* own = shape.lambda.data() + static_cast<size_t>(item.first) * steps;
   for (int32_t island = 0; island < item.count; ++island, own += steps, row += steps)
     for (size_t step = 0; step < steps; ++step) {
       double& in_array = rows[shape.kind[step]]->lambda[static_cast<size_t>(row[step])];
@@ -322,7 +422,8 @@ inline void own_lambda(const IslandPlan::Shape& shape, const IslandPlan::Item& i
 }
 
 /// The islands of items [begin, end) (IslandPlan::items): in two blocks of lanes of T side by side
-/// while an item has that many left, then one block, then one at a time.
+/// while an item has that many left, then one block, then one at a time; in single precision one
+/// block of as many floats as the register holds (8 in AVX2), then one at a time.
 template <class T>
 EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows,
                                       double inv_h2, double* x, const double* w, int ends) {
@@ -332,6 +433,12 @@ EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size
     const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
     if (ends & kIslandsTake) own_lambda(shape, item, rows, true);
     int k = 0;
+    if (shape.single) {
+      using F = typename SingleLanes<T>::type;
+      for (; k + lanes::Lanes<F>::count <= item.count; k += lanes::Lanes<F>::count)
+        island_block_single<F>(shape, item, k, x, w);
+      for (; k < item.count; ++k) island_block_single<float>(shape, item, k, x, w);
+    }
     for (; k + 2 * lanes_n <= item.count; k += 2 * lanes_n)
       island_block<T, 2>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
     for (; k + lanes_n <= item.count; k += lanes_n)
@@ -1027,7 +1134,32 @@ void find_borders(IslandPlan& plan, size_t colours, size_t parts) {
 }  // namespace
 
 void own_multipliers(const IslandPlan& plan) {
-  for (const IslandPlan::Shape& shape : plan.shapes) shape.lambda.resize(shape.row.size());
+  for (const IslandPlan::Shape& shape : plan.shapes)
+    if (shape.single)
+      shape.lambda_single.resize(shape.row.size());
+    else
+      shape.lambda.resize(shape.row.size());
+}
+
+void island_operands(const IslandPlan& plan, SolverArray* const* rows, double inv_h2) {
+  for (const IslandPlan::Shape& shape : plan.shapes)
+    if (shape.single) {
+      shape.rest_single.resize(shape.row.size());
+      shape.alpha_single.resize(shape.row.size());
+    }
+  for (const IslandPlan::Item& item : plan.items) {
+    const IslandPlan::Shape& shape = plan.shapes[static_cast<size_t>(item.shape)];
+    if (!shape.single) continue;
+    const size_t steps = static_cast<size_t>(shape.steps), n = static_cast<size_t>(item.count);
+    const size_t base = static_cast<size_t>(item.first) * steps;
+    for (size_t island = 0; island < n; ++island)
+      for (size_t step = 0; step < steps; ++step) {
+        const SolverArray& a = *rows[shape.kind[step]];
+        const size_t row = static_cast<size_t>(shape.row[base + island * steps + step]);
+        shape.rest_single[base + step * n + island] = static_cast<float>(a.rest[row]);
+        shape.alpha_single[base + step * n + island] = static_cast<float>(a.compliance[row] * inv_h2);
+      }
+  }
 }
 
 void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,

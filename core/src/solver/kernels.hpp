@@ -156,6 +156,11 @@ void chain_pass(ThreadPool& pool, SolverArray& a, double inv_h2, double* x, cons
                 std::vector<double>& scratch, ChainTrack* track = nullptr);
 /// Every automatic tether run of `t` (runs share no particle).
 void tether_runs_pass(ThreadPool& pool, const SolverArray& t, double* x, const double* w);
+/// The rest values and compliances over h^2 (inv_h2 = 1 / h^2) of the rows of `plan`'s islands in
+/// single precision, from the arrays into IslandPlan::Shape::rest_single and alpha_single, rounded
+/// to floats (World::step, once a frame: the arrays change between frames only).
+void island_operands(const IslandPlan& plan, SolverArray* const* rows, double inv_h2);
+
 /// The distance, planarity and plane-offset rows of a group, island by island (IslandPlan), colour
 /// by colour, each colour's items split over the pool's threads (its islands share no particle).
 void islands_pass(ThreadPool& pool, IslandPlan& plan, SolverArray* const* rows, double inv_h2, double* x,

@@ -239,7 +239,10 @@ void World::reset_multipliers() {
   for (int32_t slot : order_) {
     Group& g = groups_[slot];
     for (SolverArray& a : g.solve) std::fill(a.lambda.begin(), a.lambda.end(), 0.0);
-    for (const IslandPlan::Shape& shape : g.islands.shapes) std::fill(shape.lambda.begin(), shape.lambda.end(), 0.0);
+    for (const IslandPlan::Shape& shape : g.islands.shapes) {
+      std::fill(shape.lambda.begin(), shape.lambda.end(), 0.0);
+      std::fill(shape.lambda_single.begin(), shape.lambda_single.end(), 0.0f);
+    }
     std::fill(g.tethers.lambda.begin(), g.tethers.lambda.end(), 0.0);
     for (int32_t pi : g.soft_pins) pins_[pi].lambda.setZero();
     for (ShapeMatch& sm : g.shapes) std::fill(sm.lambda.begin(), sm.lambda.end(), Vec3::Zero());
@@ -714,6 +717,13 @@ void World::step(const StepControl& control) {
     begin_frame(control);
     const int substeps = settings_.substeps;
     const double h = settings_.dt / substeps;
+    for (int32_t slot : order_) {  // the rows' operands of islands in single precision, for the frame
+      Group& g = groups_[slot];
+      SolverArray* rows[IslandPlan::kRowKinds] = {&g.solve[static_cast<int>(Kind::distance)],
+                                                  &g.solve[static_cast<int>(Kind::planarity)],
+                                                  &g.solve[static_cast<int>(Kind::plane_offset)]};
+      if (g.islands.active()) island_operands(g.islands, rows, 1.0 / (h * h));
+    }
     for (int s = 0; s < substeps; ++s) {
       const double alpha = static_cast<double>(s + 1) / substeps;
       move_colliders(alpha);

@@ -124,6 +124,10 @@ const PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2;
 const PANEL_CORNERS_WELDED = 0;
 const PANEL_CORNERS_SHARED = 1;
 
+// --- EMBRA_PANEL_PRECISION_* ---
+const PANEL_PRECISION_FULL = 0;
+const PANEL_PRECISION_SINGLE = 1;
+
 // --- EMBRA_PANEL_METRIC_* ---
 const PANEL_METRIC_PLANARITY = 0;
 const PANEL_METRIC_THICKNESS = 1;
@@ -146,6 +150,7 @@ const SOLVE_NAMES = Object.freeze({ settled_within_tolerance: 0, settled_out_of_
 const AREA_LOAD_NAMES = Object.freeze({ normal: 0, true_area: 1, projected_area: 2 });
 const PANEL_PINS_NAMES = Object.freeze({ none: 0, top_corners: 1, top_and_bottom_corners: 2 });
 const PANEL_CORNERS_NAMES = Object.freeze({ welded: 0, shared: 1 });
+const PANEL_PRECISION_NAMES = Object.freeze({ full: 0, single: 1 });
 const PANEL_METRIC_NAMES = Object.freeze({ planarity: 0, thickness: 1, miter: 2, corner_distance: 3, conical: 4 });
 const CUTS_NAMES = Object.freeze({ json: 0, csv: 1 });
 
@@ -420,7 +425,7 @@ const PanelMeshDef = koffi.struct('embra_panel_mesh_def', {
   slide_compliance: 'double',
   group: GroupIdType,
   corners: 'int32_t',
-  reserved0: 'int32_t',
+  precision: 'int32_t',
 });
 const Tolerance = koffi.struct('embra_tolerance', {
   target: 'double',
@@ -711,13 +716,14 @@ module.exports = {
   SOLVE_UNTIL_SETTLED, SOLVE_UNTIL_TOLERANCE, SOLVE_SETTLED_WITHIN_TOLERANCE, SOLVE_SETTLED_OUT_OF_TOLERANCE,
   SOLVE_OSCILLATING, SOLVE_DRIFTING, AREA_LOAD_NORMAL, AREA_LOAD_TRUE_AREA, AREA_LOAD_PROJECTED_AREA,
   PANEL_PINS_NONE, PANEL_PINS_TOP_CORNERS, PANEL_PINS_TOP_AND_BOTTOM_CORNERS, PANEL_CORNERS_WELDED,
-  PANEL_CORNERS_SHARED, PANEL_METRIC_PLANARITY, PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER,
-  PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON, CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES,
-  PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES, SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES,
-  PANEL_PINS_NAMES, PANEL_CORNERS_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType,
-  ColliderIdType, SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef,
-  BrokenConstraint, PinDef, SupportDef, PolylineSupportDef, MeshSupportDef, ColliderDef, StepReport,
-  KindResidual, ConstraintResidual, GroupConflict, Reaction, ColliderReaction, GroupReport, SolveDef,
-  SolveResult, Warning, AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics,
-  LoadOptions, FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
+  PANEL_CORNERS_SHARED, PANEL_PRECISION_FULL, PANEL_PRECISION_SINGLE, PANEL_METRIC_PLANARITY,
+  PANEL_METRIC_THICKNESS, PANEL_METRIC_MITER, PANEL_METRIC_CORNER_DISTANCE, PANEL_METRIC_CONICAL, CUTS_JSON,
+  CUTS_CSV, GENERATE_NAMES, CONSTRAINT_NAMES, PIN_SUPPORT_NAMES, COLLIDER_NAMES, RESIDUAL_NAMES,
+  SOLVE_UNTIL_NAMES, SOLVE_NAMES, AREA_LOAD_NAMES, PANEL_PINS_NAMES, PANEL_CORNERS_NAMES,
+  PANEL_PRECISION_NAMES, PANEL_METRIC_NAMES, CUTS_NAMES, GroupIdType, BodyIdType, PinIdType, ColliderIdType,
+  SolverDef, WorldCounts, GroupDef, Material, BodyDef, ConstraintDef, ConstraintBatchDef, BrokenConstraint,
+  PinDef, SupportDef, PolylineSupportDef, MeshSupportDef, ColliderDef, StepReport, KindResidual,
+  ConstraintResidual, GroupConflict, Reaction, ColliderReaction, GroupReport, SolveDef, SolveResult, Warning,
+  AreaLoad, LineLoad, PanelMeshDef, Tolerance, Tolerances, MetricSummary, PanelMetrics, LoadOptions,
+  FieldIdType, WindDef, PressureDef, SurfaceTensionDef, VortexDef,
 };

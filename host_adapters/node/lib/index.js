@@ -66,7 +66,7 @@ module.exports = {
   ...errors,
   World: world.World, Body: world.Body, Id: world.Id, GroupId: world.GroupId, BodyId: world.BodyId,
   PinId: world.PinId, ColliderId: world.ColliderId, FieldId: world.FieldId,
-  SHAPES: world.SHAPES, KINDS: world.KINDS, GENERATE: world.GENERATE, PANEL_PINS: world.PANEL_PINS, PANEL_CORNERS: world.PANEL_CORNERS,
+  SHAPES: world.SHAPES, KINDS: world.KINDS, GENERATE: world.GENERATE, PANEL_PINS: world.PANEL_PINS, PANEL_CORNERS: world.PANEL_CORNERS, PANEL_PRECISION: world.PANEL_PRECISION,
   PANEL_METRICS: world.PANEL_METRICS, CUTS_FORMATS: world.CUTS_FORMATS, SOLVE_UNTIL: world.SOLVE_UNTIL,
   version, versionString, abiVersion, checkAbi, statusName, lastErrorMessage, constraintArity,
   defaultSolverDef: defaults('embra_default_solver_def', capi.SolverDef),

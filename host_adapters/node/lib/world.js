@@ -29,6 +29,7 @@ const KINDS = capi.CONSTRAINT_NAMES;
 const GENERATE = capi.GENERATE_NAMES;
 const PANEL_PINS = capi.PANEL_PINS_NAMES;
 const PANEL_CORNERS = capi.PANEL_CORNERS_NAMES;
+const PANEL_PRECISION = capi.PANEL_PRECISION_NAMES;
 const PIN_SUPPORTS = capi.PIN_SUPPORT_NAMES;
 const AREA_LOAD_MODES = capi.AREA_LOAD_NAMES;
 const AREA_LOAD_MODE_NAMES = Object.fromEntries(Object.entries(AREA_LOAD_MODES).map(([k, v]) => [v, k]));
@@ -554,7 +555,8 @@ class World {
    * per panel welded, 2 per vertex shared). settings: positions and quads (the top quad mesh: xyz per
    * vertex, 4 indices per quad) or, without them, a grid of grid_columns x grid_rows panels of
    * panel_size at origin; pins (a PANEL_PINS name or number); corners (a PANEL_CORNERS name or
-   * number); group; any other embra_panel_mesh_def field (thickness, mass, ...).
+   * number); precision (a PANEL_PRECISION name, 'full' or 'single', or number); group; any other
+   * embra_panel_mesh_def field (thickness, mass, ...).
    */
   createPanelMesh(settings) {
     const o = options(settings, 'createPanelMesh settings');
@@ -563,6 +565,7 @@ class World {
     const quads = take(o, 'quads');
     if (o.has('pins')) d.pins = enumValue(take(o, 'pins'), PANEL_PINS, 'pins');
     if (o.has('corners')) d.corners = enumValue(take(o, 'corners'), PANEL_CORNERS, 'corners');
+    if (o.has('precision')) d.precision = enumValue(take(o, 'precision'), PANEL_PRECISION, 'precision');
     for (const key of ['vertex_count', 'quad_count']) {
       if (o.has(key)) throw new TypeError(`createPanelMesh: ${key} is taken from positions and quads`);
     }
@@ -1613,6 +1616,6 @@ if (typeof Symbol.dispose === 'symbol') {
 }
 
 module.exports = {
-  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_CORNERS, PANEL_METRICS, SOLVE_UNTIL,
+  World, Body, Id, GroupId, BodyId, PinId, ColliderId, FieldId, SHAPES, KINDS, GENERATE, PANEL_PINS, PANEL_CORNERS, PANEL_PRECISION, PANEL_METRICS, SOLVE_UNTIL,
   CUTS_FORMATS, EmbraError, wrapIds,
 };

@@ -21,7 +21,7 @@ from ._capi import Warning as StepWarning
 from ._buffers import have_numpy
 from .errors import (BufferTooSmallError, CancelledError, EmbraError, InternalError, InvalidArgumentError, LockedError,
                      NumericalError, SchemaError, StaleIdError, VersionError, check)
-from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_CORNERS, PANEL_METRICS, PANEL_PINS, SHAPES, SOLVE_UNTIL, Body, Solved, World, as_dict
+from .world import CUTS_FORMATS, GENERATE, KINDS, PANEL_CORNERS, PANEL_METRICS, PANEL_PRECISION, PANEL_PINS, SHAPES, SOLVE_UNTIL, Body, Solved, World, as_dict
 
 _lib = _capi.lib
 
@@ -137,5 +137,5 @@ __all__ = [
     "PanelMeshDef", "Tolerance", "Tolerances", "MetricSummary", "PanelMetrics", "WindDef", "PressureDef",
     "SurfaceTensionDef", "VortexDef", "LoadOptions", "StepReport", "GroupReport", "StepWarning", "WorldCounts",
     "GroupId", "BodyId", "PinId", "ColliderId", "FieldId",
-    "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_CORNERS", "PANEL_METRICS", "CUTS_FORMATS",
+    "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_CORNERS", "PANEL_PRECISION", "PANEL_METRICS", "CUTS_FORMATS",
 ]

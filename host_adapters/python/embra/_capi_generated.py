@@ -126,6 +126,10 @@ PANEL_PINS_TOP_AND_BOTTOM_CORNERS = 2
 PANEL_CORNERS_WELDED = 0
 PANEL_CORNERS_SHARED = 1
 
+# --- EMBRA_PANEL_PRECISION_* ---
+PANEL_PRECISION_FULL = 0
+PANEL_PRECISION_SINGLE = 1
+
 # --- EMBRA_PANEL_METRIC_* ---
 PANEL_METRIC_PLANARITY = 0
 PANEL_METRIC_THICKNESS = 1
@@ -148,6 +152,7 @@ SOLVE_NAMES = {"settled_within_tolerance": 0, "settled_out_of_tolerance": 1, "os
 AREA_LOAD_NAMES = {"normal": 0, "true_area": 1, "projected_area": 2}
 PANEL_PINS_NAMES = {"none": 0, "top_corners": 1, "top_and_bottom_corners": 2}
 PANEL_CORNERS_NAMES = {"welded": 0, "shared": 1}
+PANEL_PRECISION_NAMES = {"full": 0, "single": 1}
 PANEL_METRIC_NAMES = {"planarity": 0, "thickness": 1, "miter": 2, "corner_distance": 3, "conical": 4}
 CUTS_NAMES = {"json": 0, "csv": 1}
 
@@ -547,7 +552,7 @@ class PanelMeshDef(_Struct):
         ("slide_compliance", c_double),
         ("group", GroupId),
         ("corners", c_int32),
-        ("reserved0", c_int32),
+        ("precision", c_int32),
     ]
 
 

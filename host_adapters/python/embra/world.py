@@ -28,6 +28,7 @@ KINDS = dict(_capi.CONSTRAINT_NAMES)
 GENERATE = dict(_capi.GENERATE_NAMES)
 PANEL_PINS = dict(_capi.PANEL_PINS_NAMES)
 PANEL_CORNERS = dict(_capi.PANEL_CORNERS_NAMES)
+PANEL_PRECISION = dict(_capi.PANEL_PRECISION_NAMES)
 PIN_SUPPORTS = dict(_capi.PIN_SUPPORT_NAMES)
 AREA_LOAD_MODES = dict(_capi.AREA_LOAD_NAMES)
 AREA_LOAD_MODE_NAMES = {v: k for k, v in _capi.AREA_LOAD_NAMES.items()}
@@ -451,15 +452,17 @@ class World:
         return self._body_int32s("embra_body_get_triangles", body, 3)
 
     # --- panel meshes --------------------------------------------------------------------------
-    def create_panel_mesh(self, positions=None, quads=None, *, pins=None, corners=None, group=None, **fields):
+    def create_panel_mesh(self, positions=None, quads=None, *, pins=None, corners=None, precision=None, group=None,
+                          **fields):
         """Builds a Planar Offset Quad panel mesh (embra_panel_mesh_create) and returns its Body (id,
         first particle, count: 8 particles per panel welded, 2 per vertex shared).
 
         positions and quads: the top quad mesh (xyz per vertex; 4 vertex indices per quad, flat,
         nested or numpy); without them, a grid of grid_columns x grid_rows square panels of
         panel_size at origin. pins: "none", "top_corners", "top_and_bottom_corners" or the number;
-        corners: "welded" or "shared" (PANEL_CORNERS) or the number; any other PanelMeshDef field as
-        a keyword (thickness=0.01, mass=16.0, damping=9.0, ...)."""
+        corners: "welded" or "shared" (PANEL_CORNERS) or the number; precision: "full" or "single"
+        (PANEL_PRECISION) or the number; any other PanelMeshDef field as a keyword (thickness=0.01,
+        mass=16.0, damping=9.0, ...)."""
         d = lib.embra_default_panel_mesh_def()
         _fill(d, fields, "PanelMeshDef")
         keep = []
@@ -482,6 +485,8 @@ class World:
             d.pins = _enum(pins, PANEL_PINS, "pins")
         if corners is not None:
             d.corners = _enum(corners, PANEL_CORNERS, "corners")
+        if precision is not None:
+            d.precision = _enum(precision, PANEL_PRECISION, "precision")
         d.group = _id(group, GroupId, "group")
         body, first = BodyId(), c_int32()
         self._call("embra_panel_mesh_create", byref(d), byref(body), byref(first))
@@ -1226,5 +1231,5 @@ class Solved:
         return text + ")"
 
 
-__all__ = ["World", "Body", "Solved", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_CORNERS", "PANEL_METRICS",
+__all__ = ["World", "Body", "Solved", "as_dict", "SHAPES", "KINDS", "GENERATE", "PANEL_PINS", "PANEL_CORNERS", "PANEL_PRECISION", "PANEL_METRICS",
            "CUTS_FORMATS", "SOLVE_UNTIL", "EmbraError"]

@@ -33,6 +33,10 @@ enum class PanelPins : int32_t { none = 0, top_corners = 1, top_and_bottom_corne
 /// share (2 a vertex, no welds: the offset quads of the panels round a vertex meet in one point, the
 /// paper's POQ condition, which asks the top mesh to stay conical).
 enum class PanelCorners : int32_t { welded = 0, shared = 1 };
+/// The arithmetic of the mesh's own rows (its panels' distances, planarity and plane offsets) where
+/// they are projected panel by panel (IslandPlan): full (double) or single precision
+/// (embra_panel_mesh_def.precision says what single costs in accuracy and gains in time).
+enum class PanelPrecision : int32_t { full = 0, single = 1 };
 
 /// A metric's tolerance: its target and the end of its colour scale.
 struct Tolerance {
@@ -63,6 +67,7 @@ struct PanelMeshDesc {
   double slide_compliance = 1e-3;    // m/N of the soft distance from each bottom corner to its top corner
   PanelPins pins = PanelPins::none;  // hard pins at the mesh's corners (vertices on one panel only)
   PanelCorners corners = PanelCorners::welded;
+  PanelPrecision precision = PanelPrecision::full;
   Id group;  // group of every constraint; null = the default group
   // The tolerances in force (the world's tolerance document; through the C ABI the one set with
   // embra_world_set_tolerances, in a scene its "tolerances"): a top quad is accepted when its

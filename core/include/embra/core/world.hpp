@@ -508,7 +508,8 @@ struct StaticsState {
 ///   order they were added: a Gauss-Seidel sweep panel by panel, not the passes' order.
 /// tests/scenes/kernels_same_bits.sh checks the bits: EMBRA_ISLANDS=rows projects the islands' rows
 /// in the same order one at a time with the pass kernels (either layout), EMBRA_ISLANDS=off the
-/// passes instead of islands (the welded layout's bits; the shared layout's differ).
+/// passes instead of islands (the welded layout's bits; the shared layout's differ). Islands in
+/// single precision (Shape::single) have bits of their own, the same at every lane width.
 struct IslandPlan {
   static constexpr int kSlots = 8;     // particles of an island, at most
   static constexpr int kSteps = 32;    // rows of an island, at most
@@ -520,9 +521,17 @@ struct IslandPlan {
     std::vector<int8_t> slot;       // per step: 4 local particles (a distance uses 2)
     std::vector<int32_t> particle;  // per island: its `slots` particles
     std::vector<int32_t> row;       // per island: its `steps` rows (indices into that kind's array)
+    /// Projected in single precision (a panel mesh's PanelPrecision::single): positions relative to
+    /// each island's first particle, the moves summed from zero and added to the double positions.
+    bool single = false;
     /// Per island: its rows' multipliers while a pass projects the islands (IslandEnds: taken from
     /// the arrays at its first projection, given back at its last); scratch the kernels write.
     mutable std::vector<double> lambda;
+    /// In single precision, `lambda` in floats instead, with the rows' rest values and compliances
+    /// over h^2 (copied from the arrays once a frame, island_operands): item by item (Item), an
+    /// item's rows step by step, its islands side by side (row `step` of island first + k at
+    /// first * steps + step * count + k), so that a block of lanes loads each with one instruction.
+    mutable std::vector<float> lambda_single, rest_single, alpha_single;
     size_t islands() const { return slots == 0 ? 0 : particle.size() / static_cast<size_t>(slots); }
   };
   struct Item {  // up to kItemIslands consecutive islands of one shape
@@ -681,6 +690,7 @@ struct PanelLayout {
   std::vector<int32_t> quads;  // 4 mesh vertex indices per panel
   double thickness = 0.0;      // model units
   bool shared = false;         // corners shared per mesh vertex (2 particles a vertex), else welded
+  bool single = false;         // its rows' islands projected in single precision (PanelPrecision)
   // Derived from the quads by World::set_panel_layout (panel_topology, panels.hpp) for the metrics;
   // null in a layout made by hand, for which the metrics derive it each time.
   std::shared_ptr<const PanelTopology> topology;
