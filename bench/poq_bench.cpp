@@ -4,11 +4,11 @@
 // particles a panel) or shared (2 a vertex). `drape` takes its solver settings as arguments: the
 // 4 x 4 welded at 60 substeps x 2 iterations (examples/poq_drape.json) and the welded 16 x 16 and
 // 32 x 32 at the settings they needed (30 x 10 and 60 x 10, Chebyshev rho 0.95), for comparison.
-// `drape_example` times the shared meshes of examples/large/poq_drape_{16,32}.json at the solver
-// settings embra's scene loader reads from those files (the settings that settle within every target of their tolerance
-// documents), reported as counters. Times 20 frames of World::step after 40 frames of draping (the
-// mesh folding over the sphere: face contacts active). The 32 x 32 case is the interactive target
-// (33 ms per frame on 2 threads is the goal).
+// `drape_example` times the meshes of examples/large/poq_drape_{16,32}.json with the corners, the
+// precision and the solver settings embra's scene loader reads from those files (the settings that
+// settle within every target of their tolerance documents), reported as counters. Times 20 frames of World::step after
+// 40 frames of draping (the mesh folding over the sphere: face contacts active). The 32 x 32 case is the interactive
+// target (33 ms per frame on 2 threads is the goal).
 #include "embra/core/panels.hpp"
 #include "embra/io/files.hpp"
 #include "embra/io/scene.hpp"
@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,8 @@ namespace {
 
 using embra::Vec3;
 
-void run_drape(benchmark::State& state, int n, embra::PanelCorners corners, const embra::Settings& s) {
+void run_drape(benchmark::State& state, int n, embra::PanelCorners corners, const embra::Settings& s,
+               embra::PanelPrecision precision = embra::PanelPrecision::full) {
   embra::World w(s);
   std::vector<double> pos;
   std::vector<int32_t> quads;
@@ -37,6 +39,7 @@ void run_drape(benchmark::State& state, int n, embra::PanelCorners corners, cons
   d.damping = 9;
   d.pins = embra::PanelPins::top_corners;
   d.corners = corners;
+  d.precision = precision;
   embra::build_panel_mesh(w, d);
   embra::ColliderDesc c;
   c.shape = embra::ColliderShape::sphere;
@@ -85,15 +88,23 @@ void drape_example(benchmark::State& state) {
     return;
   }
   embra::Settings s;
+  embra::PanelCorners corners = embra::PanelCorners::welded;
+  embra::PanelPrecision precision = embra::PanelPrecision::full;
   try {
     embra::io::SceneMeta meta;
-    s = embra::io::load_scene(text, dir, meta)->settings();
+    const auto world = embra::io::load_scene(text, dir, meta);
+    s = world->settings();
+    if (world->panel_layouts().size() != 1) throw std::runtime_error("expected one panel mesh");
+    const embra::PanelLayout& l = world->panel_layouts().front();
+    corners = l.shared ? embra::PanelCorners::shared : embra::PanelCorners::welded;
+    precision = l.single ? embra::PanelPrecision::single : embra::PanelPrecision::full;
   } catch (const std::exception& e) {
     state.SkipWithError((path + ": " + e.what()).c_str());
     return;
   }
   s.threads = static_cast<int32_t>(state.range(1));
-  run_drape(state, n, embra::PanelCorners::shared, s);
+  run_drape(state, n, corners, s, precision);
+  state.counters["single"] = precision == embra::PanelPrecision::single;
 }
 
 BENCHMARK(drape)
