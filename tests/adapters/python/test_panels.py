@@ -207,6 +207,7 @@ def test_grid_builder_pins_tolerances_and_a_mesh_of_quads():
         d = embra.default_panel_mesh_def()
         assert (d.version, d.grid_columns, d.grid_rows) == (embra._capi.PANEL_MESH_DEF_VERSION, 4, 4)
         assert (d.pins, d.corners) == (embra.PANEL_PINS["none"], embra.PANEL_CORNERS["welded"])
+        assert d.precision == embra.PANEL_PRECISION["full"]
         assert (d.panel_size, d.thickness, d.density, d.slide_compliance) == (0.8, 0.01, 1.0, 1e-3)
         assert (d.friction_static, d.friction_dynamic, d.group) == (0.5, 0.3, embra.GroupId())
         # Corners shared: one top and one bottom particle per vertex of the 3 x 4 vertex grid, the
@@ -217,6 +218,12 @@ def test_grid_builder_pins_tolerances_and_a_mesh_of_quads():
             c = [int(v) for v in flat(ws.panel_corner_particles(shared))]
             assert len(c) == 48 and c[1] == c[8 + 0] and c[2] == c[8 + 3] and max(c) == 23
             assert embra.as_dict(ws.panel_metrics(shared))["within_tolerance"] == 1
+        # Its rows in single precision: built and stepped like any other, the panels held.
+        with embra.World() as wf:
+            single = wf.create_panel_mesh(grid_columns=2, grid_rows=3, corners="shared", precision="single",
+                                          pins="top_corners")
+            wf.step(10)
+            assert embra.as_dict(wf.panel_metrics(single))["within_tolerance"] == 1
         body = w.create_panel_mesh(grid_columns=2, grid_rows=3, pins="top_and_bottom_corners")
         assert (body.first, body.count) == (0, 48) and w.panel_count(body) == 6
         assert [int(v) for v in flat(w.panel_corner_particles(body))] == list(range(48))
@@ -291,6 +298,10 @@ def test_refused_panel_calls_raise_the_c_message_and_change_nothing(panels):
         w.create_panel_mesh([(0, 0, 0), (1, 0, 0), (1, 1, 0)], [0, 1, 2])
     with pytest.raises(ValueError, match="unknown name 'bottom'"):
         w.create_panel_mesh(pins="bottom")
+    with pytest.raises(ValueError, match="unknown name 'double'"):
+        w.create_panel_mesh(precision="double")
+    with pytest.raises(embra.InvalidArgumentError, match="embra_panel_mesh_create: .*precision"):
+        w.create_panel_mesh(precision=2)
     assert snapshot(w) == before
 
 
