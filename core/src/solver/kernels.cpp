@@ -305,32 +305,49 @@ EMBRA_ALWAYS_INLINE void island_block(const IslandPlan::Shape& shape, size_t fir
     }
 }
 
+/// Lanes of floats from `from`: straight where all are valid, else the first `valid` and the first
+/// repeated. (Not a lambda: a lambda is a function of its own, compiled without the kernel set's
+/// target attribute, and a 32-byte vector returned from it across that line is garbled by Clang.)
+template <class T>
+EMBRA_ALWAYS_INLINE T lane_operands(const float* from, int valid) {
+  using L = lanes::Lanes<T>;
+  if (valid == L::count) return L::make(from);
+  float v[L::count];
+  for (int l = 0; l < L::count; ++l) v[l] = from[l < valid ? l : 0];
+  return L::make(v);
+}
+
 /// island_block in single precision (T: lanes of floats, Shape::single) for the islands
-/// first .. first + lanes - 1 of `item` (first = item.first + k): each lane's particles relative to
-/// its island's first particle, the rows projected on those, each particle's move summed from zero
-/// (so a row's correction keeps its own digits, not those of the particle's place) and added to its
-/// double position at the end. The rows' operands are vector loads (Shape::rest_single).
+/// first .. first + valid - 1 of `item` (first = item.first + k; valid <= the lane count, the lanes
+/// past it repeating the first island with nothing movable, written nowhere): each lane's particles
+/// relative to its island's first particle, the rows projected on those, each particle's move summed
+/// from zero (so a row's correction keeps its own digits, not those of the particle's place) and
+/// added to its double position at the end. The rows' operands are vector loads
+/// (Shape::rest_single) where every lane is valid. A lane computes the same bits in any block.
 template <class T>
 EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, const IslandPlan::Item& item, int k,
-                                             double* x, const double* w) {
+                                             int valid, double* x, const double* w) {
   using namespace lanes;
   using L = Lanes<T>;
   constexpr int N = L::count;
+  const bool full = valid == N;
   const int slots = shape.slots, steps = shape.steps;
   const size_t first = static_cast<size_t>(item.first + k);
   const size_t ops = static_cast<size_t>(item.first) * static_cast<size_t>(steps) + static_cast<size_t>(k);
-  const int32_t* ids = &shape.particle[first * static_cast<size_t>(slots)];
+  const int32_t* ids[N];  // lane l's island's particles
+  for (int l = 0; l < N; ++l)
+    ids[l] = &shape.particle[(first + static_cast<size_t>(l < valid ? l : 0)) * static_cast<size_t>(slots)];
   V3<T> p[IslandPlan::kSlots], moved[IslandPlan::kSlots];  // where a particle started, how far it moved
   T wp[IslandPlan::kSlots];
   double origin[N][3];
-  for (int l = 0; l < N; ++l) std::memcpy(origin[l], x + 3 * static_cast<int64_t>(ids[l * slots]), sizeof origin[l]);
+  for (int l = 0; l < N; ++l) std::memcpy(origin[l], x + 3 * static_cast<int64_t>(ids[l][0]), sizeof origin[l]);
   for (int s = 0; s < slots; ++s) {
     float a[3][N], ws[N];
     for (int l = 0; l < N; ++l) {
-      const int32_t id = ids[l * slots + s];
+      const int32_t id = ids[l][s];
       const double* q = x + 3 * static_cast<int64_t>(id);
       for (int c = 0; c < 3; ++c) a[c][l] = static_cast<float>(q[c] - origin[l][c]);
-      ws[l] = static_cast<float>(w[id]);
+      ws[l] = l < valid ? static_cast<float>(w[id]) : 0.0f;
     }
     p[s] = {L::make(a[0]), L::make(a[1]), L::make(a[2])};
     moved[s] = {splat<T>(0.0f), splat<T>(0.0f), splat<T>(0.0f)};
@@ -340,8 +357,8 @@ EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, con
     const int8_t* sl = &shape.slot[4 * static_cast<size_t>(step)];
     const size_t at = ops + static_cast<size_t>(step * item.count);
     float* own = shape.lambda_single.data() + at;
-    const T r = L::make(shape.rest_single.data() + at), lam = L::make(own);
-    const T alpha = L::make(shape.alpha_single.data() + at);
+    const T r = lane_operands<T>(shape.rest_single.data() + at, valid), lam = lane_operands<T>(own, valid);
+    const T alpha = lane_operands<T>(shape.alpha_single.data() + at, valid);
     T lam_new;
     decltype(T{} > 0.0f) ok;  // the lanes where the row applies
     if (shape.kind[step] == 0) {
@@ -364,12 +381,16 @@ EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, con
       lam_new = lam + dl;
     }
     const T kept = select(ok, lam_new, lam);
-    std::memcpy(own, &kept, sizeof kept);
+    if (full) {
+      std::memcpy(own, &kept, sizeof kept);
+    } else {
+      for (int l = 0; l < valid; ++l) own[l] = L::get(kept, l);
+    }
   }
   for (int s = 0; s < slots; ++s)
-    for (int l = 0; l < N; ++l) {
+    for (int l = 0; l < valid; ++l) {
       if (L::get(wp[s], l) == 0.0f) continue;  // an immovable particle is not written
-      double* q = x + 3 * static_cast<int64_t>(ids[l * slots + s]);
+      double* q = x + 3 * static_cast<int64_t>(ids[l][s]);
       q[0] += static_cast<double>(L::get(moved[s].x, l));
       q[1] += static_cast<double>(L::get(moved[s].y, l));
       q[2] += static_cast<double>(L::get(moved[s].z, l));
@@ -422,8 +443,8 @@ inline void own_lambda(const IslandPlan::Shape& shape, const IslandPlan::Item& i
 }
 
 /// The islands of items [begin, end) (IslandPlan::items): in two blocks of lanes of T side by side
-/// while an item has that many left, then one block, then one at a time; in single precision one
-/// block of as many floats as the register holds (8 in AVX2), then one at a time.
+/// while an item has that many left, then one block, then one at a time; in single precision blocks
+/// of as many floats as the register holds (8 in AVX2), the last one filled up.
 template <class T>
 EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size_t end, SolverArray* const* rows,
                                       double inv_h2, double* x, const double* w, int ends) {
@@ -435,9 +456,8 @@ EMBRA_ALWAYS_INLINE void island_items(const IslandPlan& plan, size_t begin, size
     int k = 0;
     if (shape.single) {
       using F = typename SingleLanes<T>::type;
-      for (; k + lanes::Lanes<F>::count <= item.count; k += lanes::Lanes<F>::count)
-        island_block_single<F>(shape, item, k, x, w);
-      for (; k < item.count; ++k) island_block_single<float>(shape, item, k, x, w);
+      for (; k < item.count; k += lanes::Lanes<F>::count)
+        island_block_single<F>(shape, item, k, std::min(item.count - k, lanes::Lanes<F>::count), x, w);
     }
     for (; k + 2 * lanes_n <= item.count; k += 2 * lanes_n)
       island_block<T, 2>(shape, static_cast<size_t>(item.first + k), rows, inv_h2, x, w);
