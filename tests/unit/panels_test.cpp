@@ -163,6 +163,26 @@ TEST(PanelMesh, RefusedInputChangesNothing) {
   refused(bad, "unknown pin mode");
 }
 
+// The conical band of the tests below: a band of a sphere of radius 3 m along its meridians and
+// parallels, 24 around and 4 rows, closed round, its quads counter-clockwise seen from outside.
+constexpr int kBandAround = 24, kBandRows = 4;
+constexpr double kBandRadius = 3.0;
+void conical_band(std::vector<double>& pos, std::vector<int32_t>& quads) {
+  for (int i = 0; i <= kBandRows; ++i) {
+    const double phi = -0.4 + 0.8 * i / kBandRows;
+    for (int j = 0; j < kBandAround; ++j) {
+      const double theta = 2 * std::numbers::pi * j / kBandAround;
+      pos.insert(pos.end(), {kBandRadius * std::cos(phi) * std::cos(theta),
+                             kBandRadius * std::cos(phi) * std::sin(theta), kBandRadius * std::sin(phi)});
+    }
+  }
+  for (int i = 0; i < kBandRows; ++i)
+    for (int j = 0; j < kBandAround; ++j) {
+      const int32_t a = i * kBandAround + j, b = i * kBandAround + (j + 1) % kBandAround;
+      quads.insert(quads.end(), {a, b, b + kBandAround, a + kBandAround});  // east, then north: outward normal
+    }
+}
+
 // A known conical mesh: a band of a sphere along its meridians and parallels (a surface of
 // revolution), 24 around and 4 rows, closed round. Each quad is an isosceles trapezoid (planar); at
 // each vertex the mirror symmetry across the meridian plane makes opposite face angles sum equal
@@ -172,23 +192,11 @@ TEST(PanelMesh, RefusedInputChangesNothing) {
 // shared (one bottom particle a vertex at the thickness from all four of its panels' planes, which
 // exists only because the mesh is conical).
 TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
-  constexpr int around = 24, rows = 4;
-  constexpr double radius = 3.0;
+  constexpr int around = kBandAround, rows = kBandRows;
+  constexpr double radius = kBandRadius;
   std::vector<double> pos;
-  for (int i = 0; i <= rows; ++i) {
-    const double phi = -0.4 + 0.8 * i / rows;
-    for (int j = 0; j < around; ++j) {
-      const double theta = 2 * std::numbers::pi * j / around;
-      pos.insert(pos.end(), {radius * std::cos(phi) * std::cos(theta), radius * std::cos(phi) * std::sin(theta),
-                             radius * std::sin(phi)});
-    }
-  }
   std::vector<int32_t> quads;
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < around; ++j) {
-      const int32_t a = i * around + j, b = i * around + (j + 1) % around;
-      quads.insert(quads.end(), {a, b, b + around, a + around});  // east, then north: outward normal
-    }
+  conical_band(pos, quads);
   for (PanelCorners corners : {PanelCorners::welded, PanelCorners::shared}) {
     const bool shared = corners == PanelCorners::shared;
     SCOPED_TRACE(shared ? "corners shared" : "corners welded");
@@ -237,23 +245,9 @@ TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
 // frames of 20 substeps x 4 iterations: each precision and place ends with the panels planar, at
 // their thickness and mitred, and at rest.
 TEST(PanelMesh, SinglePrecisionRowsHoldThePanelsAnywhere) {
-  constexpr int around = 24, rows = 4;
-  constexpr double radius = 3.0;
   std::vector<double> pos;
-  for (int i = 0; i <= rows; ++i) {
-    const double phi = -0.4 + 0.8 * i / rows;
-    for (int j = 0; j < around; ++j) {
-      const double theta = 2 * std::numbers::pi * j / around;
-      pos.insert(pos.end(), {radius * std::cos(phi) * std::cos(theta), radius * std::cos(phi) * std::sin(theta),
-                             radius * std::sin(phi)});
-    }
-  }
   std::vector<int32_t> quads;
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < around; ++j) {
-      const int32_t a = i * around + j, b = i * around + (j + 1) % around;
-      quads.insert(quads.end(), {a, b, b + around, a + around});
-    }
+  conical_band(pos, quads);
   for (const double far : {0.0, 1e4})
     for (const PanelPrecision precision : {PanelPrecision::full, PanelPrecision::single}) {
       const bool single = precision == PanelPrecision::single;
