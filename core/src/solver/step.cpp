@@ -31,6 +31,7 @@
 #include "solver/residuals.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -39,6 +40,13 @@
 namespace embra {
 
 namespace {
+
+/// A group's solver arrays of the islands' row kinds, in IslandPlan::kRowKind's order.
+std::array<SolverArray*, IslandPlan::kRowKinds> island_rows(Group& g) {
+  std::array<SolverArray*, IslandPlan::kRowKinds> rows{};
+  for (int k = 0; k < IslandPlan::kRowKinds; ++k) rows[k] = &g.solve[static_cast<int>(IslandPlan::kRowKind[k])];
+  return rows;
+}
 
 /// Particles per thread below which a per-particle pass is not split (a particle costs nanoseconds).
 constexpr size_t kParticleGrain = 2048;
@@ -406,8 +414,7 @@ void World::project_group(Group& g, double h, bool first, int ends) {
   else
     tether_runs_pass(*pool_, g.tethers, x, w);
   SolverArray& distance = g.solve[static_cast<int>(Kind::distance)];
-  SolverArray* rows[IslandPlan::kRowKinds] = {&distance, &g.solve[static_cast<int>(Kind::planarity)],
-                                              &g.solve[static_cast<int>(Kind::plane_offset)]};
+  const auto rows = island_rows(g);
   // Islands (a panel mesh's panels, IslandPlan): the three kinds' rows island by island. Where the
   // hard pins' impulses are tracked, islands in one colour (welded panels) go in the passes, with the
   // same bits, and islands in colours one row at a time (tracked_islands). build_islands lists the
@@ -420,9 +427,9 @@ void World::project_group(Group& g, double h, bool first, int ends) {
   // Chains in a group's first projection of a substep only (Settings::chain_solve; with realignment
   // passes, before the first of them): see chain_pass.
   if (islands && pinned_rows) {
-    tracked_islands(*pool_, g.islands, rows, inv_h2, x_, w, *tracked, ends);
+    tracked_islands(*pool_, g.islands, rows.data(), inv_h2, x_, w, *tracked, ends);
   } else if (islands) {
-    islands_pass(*pool_, g.islands, rows, inv_h2, x, w, ends);
+    islands_pass(*pool_, g.islands, rows.data(), inv_h2, x, w, ends);
   } else if (distance.chain_start.empty() || !first) {
     kernel_pass<Kind::distance>(*pool_, k.distance, distance, inv_h2, x_, w, tracked);
   } else if (tracked == nullptr || distance.pinned.empty()) {
@@ -717,13 +724,9 @@ void World::step(const StepControl& control) {
     begin_frame(control);
     const int substeps = settings_.substeps;
     const double h = settings_.dt / substeps;
-    for (int32_t slot : order_) {  // the rows' operands of islands in single precision, for the frame
-      Group& g = groups_[slot];
-      SolverArray* rows[IslandPlan::kRowKinds] = {&g.solve[static_cast<int>(Kind::distance)],
-                                                  &g.solve[static_cast<int>(Kind::planarity)],
-                                                  &g.solve[static_cast<int>(Kind::plane_offset)]};
-      if (g.islands.active()) island_operands(g.islands, rows, 1.0 / (h * h));
-    }
+    for (int32_t slot : order_)  // the rows' operands of islands in single precision, for the frame
+      if (Group& g = groups_[slot]; g.islands.active())
+        island_operands(g.islands, island_rows(g).data(), 1.0 / (h * h));
     for (int s = 0; s < substeps; ++s) {
       const double alpha = static_cast<double>(s + 1) / substeps;
       move_colliders(alpha);
