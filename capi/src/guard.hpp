@@ -6,6 +6,7 @@
 
 #include "embra/embra.h"
 
+#include "embra/core/panels.hpp"
 #include "embra/core/world.hpp"
 #include "embra/io/scene.hpp"
 
@@ -13,6 +14,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 struct embra_world {
   embra::World world;
@@ -21,6 +23,20 @@ struct embra_world {
   mutable std::atomic<bool> busy{false};
   /// embra_world_cancel: set by any thread, consumed by the step that sees it.
   std::atomic<bool> cancel{false};
+  /// The last panel mesh measured (embra_panel_mesh_get_metrics, _get_vertex_errors,
+  /// _get_corner_gap), kept while its layout and its particles' positions are bit for bit the same:
+  /// a host that reads a frame's metrics and several error fields measures the mesh once.
+  struct PanelMeasure {
+    bool valid = false;
+    embra::Id body;
+    const embra::PanelLayout* layout = nullptr;
+    int32_t first_particle = 0;
+    int64_t particles = 0;
+    double thickness = 0.0;
+    std::vector<embra::Vec3> x;  // the layout's particles, first_particle onwards
+    embra::PanelErrors errors;
+  };
+  mutable PanelMeasure panel_measure{};
 };
 
 namespace embra::capi {

@@ -5,6 +5,8 @@
 #include "embra/core/limits.hpp"
 #include "embra/core/panels.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <vector>
 
 using namespace embra::capi;
@@ -81,6 +83,33 @@ const embra::PanelLayout& layout_of(const embra_world* world, embra_body_id body
   const embra::PanelLayout* l = world->world.panel_layout(to_id(body));
   if (l == nullptr) refuse(EMBRA_ERROR_INVALID_ARGUMENT, "the body is not a panel mesh");
   return *l;
+}
+
+/// measure_panels of the body's layout at the world's positions, or the last one while neither has
+/// changed (embra_world::panel_measure).
+const embra::PanelErrors& measured(const embra_world* world, embra_body_id body) {
+  const embra::PanelLayout& l = layout_of(world, body);
+  const std::vector<embra::Vec3>& x = world->world.positions();
+  const auto first = x.begin() + l.first_particle;
+  const auto last = first + static_cast<std::ptrdiff_t>(l.particle_count());
+  embra_world::PanelMeasure& m = world->panel_measure;
+  const bool same = m.valid && m.body == to_id(body) && m.layout == &l && m.first_particle == l.first_particle &&
+                    m.particles == l.particle_count() && m.thickness == l.thickness &&
+                    std::equal(first, last, m.x.begin(), m.x.end(), [](const embra::Vec3& a, const embra::Vec3& b) {
+                      return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0;
+                    });
+  if (!same) {
+    m.valid = false;
+    m.errors = embra::measure_panels(l, x);
+    m.x.assign(first, last);
+    m.body = to_id(body);
+    m.layout = &l;
+    m.first_particle = l.first_particle;
+    m.particles = l.particle_count();
+    m.thickness = l.thickness;
+    m.valid = true;
+  }
+  return m.errors;
 }
 
 constexpr std::tuple kTolerancesCopies{
@@ -174,7 +203,7 @@ embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_i
                                           const embra_tolerances* tolerances, embra_panel_metrics* out_metrics) {
   return guard("embra_panel_mesh_get_metrics", world, [&] {
     need(out_metrics, "out_metrics");
-    const embra::PanelLayout& l = layout_of(world, body);
+    layout_of(world, body);  // the body refused before the tolerances
     embra::Tolerances t;
     if (tolerances) {
       check_tolerances(*tolerances);
@@ -182,7 +211,7 @@ embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_i
     } else {
       t = embra::io::parse_tolerances(world->meta.tolerances);
     }
-    const embra::PanelReport r = embra::report_panels(embra::measure_panels(l, world->world.positions()), t);
+    const embra::PanelReport r = embra::report_panels(measured(world, body), t);
     embra_panel_metrics m{};
     m.version = EMBRA_PANEL_METRICS_VERSION;
     m.within_tolerance = r.within_tolerance ? 1 : 0;
@@ -203,8 +232,7 @@ embra_status embra_panel_mesh_get_corner_gap(const embra_world* world, embra_bod
                                              embra_metric_summary* out_summary) {
   return guard("embra_panel_mesh_get_corner_gap", world, [&] {
     need(out_summary, "out_summary");
-    const embra::PanelLayout& l = layout_of(world, body);
-    const embra::PanelReport r = embra::report_panels(embra::measure_panels(l, world->world.positions()), {});
+    const embra::PanelReport r = embra::report_panels(measured(world, body), {});
     *out_summary = from_summary(r.corner_gap);
   });
 }
@@ -221,8 +249,8 @@ embra_status embra_panel_mesh_get_vertex_errors(const embra_world* world, embra_
       *out_count = n;
       return;
     }
-    const std::vector<double> v = embra::vertex_errors(l, embra::measure_panels(l, world->world.positions()),
-                                                       static_cast<embra::PanelMetric>(metric));
+    const std::vector<double> v =
+        embra::vertex_errors(l, measured(world, body), static_cast<embra::PanelMetric>(metric));
     std::copy(v.begin(), v.end(), out);
     *out_count = n;
   });

@@ -413,6 +413,27 @@ static void test_create(void) {
   CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
   CHECK_NEAR(gap.max, 0.0, 0.0);        /* as built: every copy of a vertex where the grid puts it */
   CHECK_INT((int)gap.count, 3 * 4 - 4); /* a 2 x 3 grid of panels: 12 mesh vertices, 4 of one panel */
+  /* The metrics follow the positions however often they are read: the first panel's four top
+   * corners lifted by 1 mm stand 1 mm above their copies on the other panels (three of them are
+   * shared); put back, they meet again. */
+  double top4[12], lifted[12];
+  CHECK_OK(embra_world_get_positions(w, top4, 12, first, 4));
+  for (int k = 0; k < 12; ++k) lifted[k] = top4[k] + (k % 3 == 2 ? 1e-3 : 0.0);
+  for (int round = 0; round < 2; ++round) {
+    CHECK_OK(embra_world_set_positions(w, lifted, first, 4));
+    CHECK_OK(embra_panel_mesh_get_metrics(w, body, NULL, &m));
+    CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
+    CHECK_NEAR(gap.max, 1e-3, 1e-12);
+    double errors[48];
+    int64_t n = 0;
+    CHECK_OK(embra_panel_mesh_get_vertex_errors(w, body, EMBRA_PANEL_METRIC_THICKNESS, errors, 48, &n));
+    CHECK_NEAR(errors[0], 1e-3, 1e-12); /* a lifted top corner: 1 mm off its panel's thickness */
+    CHECK_OK(embra_world_set_positions(w, top4, first, 4));
+    CHECK_OK(embra_panel_mesh_get_corner_gap(w, body, &gap));
+    CHECK_NEAR(gap.max, 0.0, 0.0);
+    CHECK_OK(embra_panel_mesh_get_vertex_errors(w, body, EMBRA_PANEL_METRIC_THICKNESS, errors, 48, &n));
+    CHECK_NEAR(errors[0], 0.0, 1e-15);
+  }
   embra_world_destroy(w);
 }
 

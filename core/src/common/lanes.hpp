@@ -209,6 +209,24 @@ EMBRA_ALWAYS_INLINE void transpose(const V3<D4>& v, double (*out)[4]) {
 }
 #endif
 
+#if EMBRA_LANES_VECTOR && __has_builtin(__builtin_shufflevector)
+/// The transpose of eight lanes' points r[l] = (x, y, z, unused) into lanes of floats, in
+/// registers (a block filled lane by lane through memory stalls on the store it reads back).
+EMBRA_ALWAYS_INLINE V3<F8> transpose_in(const F4 (&r)[8]) {
+  const F8 v0 = __builtin_shufflevector(r[0], r[4], 0, 1, 2, 3, 4, 5, 6, 7);
+  const F8 v1 = __builtin_shufflevector(r[1], r[5], 0, 1, 2, 3, 4, 5, 6, 7);
+  const F8 v2 = __builtin_shufflevector(r[2], r[6], 0, 1, 2, 3, 4, 5, 6, 7);
+  const F8 v3 = __builtin_shufflevector(r[3], r[7], 0, 1, 2, 3, 4, 5, 6, 7);
+  const F8 t0 = __builtin_shufflevector(v0, v1, 0, 8, 1, 9, 4, 12, 5, 13);
+  const F8 t1 = __builtin_shufflevector(v0, v1, 2, 10, 3, 11, 6, 14, 7, 15);
+  const F8 t2 = __builtin_shufflevector(v2, v3, 0, 8, 1, 9, 4, 12, 5, 13);
+  const F8 t3 = __builtin_shufflevector(v2, v3, 2, 10, 3, 11, 6, 14, 7, 15);
+  return {__builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13),
+          __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15),
+          __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13)};
+}
+#endif
+
 /// atan2_det (constraint_math.hpp) lane by lane, its branches turned into selects: one division for
 /// the range reduction and one for the rational approximation.
 template <class T>

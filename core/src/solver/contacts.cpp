@@ -89,14 +89,20 @@ void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* on
     const size_t i = only ? static_cast<size_t>((*only)[k]) : k;
     if (w_[i] == 0.0) continue;
     // The clearance, plus the path, plus the clearance again as a margin (see find_shape_contacts).
-    const double reach = 2.0 * (radius_[i] + col.desc.thickness) + (x_[i] - x_prev_[i]).norm();
+    const Vec3 d = x_[i] - x_prev_[i];
+    const double path = d.norm();
+    const double reach = 2.0 * (radius_[i] + col.desc.thickness) + path;
     double gap;
     if (col.desc.shape == ColliderShape::plane) {
       gap = normal.dot(x_[i] - col.position);
     } else {
       // The closest point of the swept segment to the sphere's centre catches a particle that
-      // crosses the whole sphere within one substep.
-      const Vec3 a = x_prev_[i], d = x_[i] - x_prev_[i];
+      // crosses the whole sphere within one substep. No point of the segment is nearer the centre
+      // than its start less the path: a start beyond the radius, the reach and the path (by far more
+      // than rounding) has no contact, found without the division and the root below.
+      const Vec3 a = x_prev_[i];
+      const double beyond = col.desc.radius + reach + path;
+      if ((a - col.position).squaredNorm() > beyond * beyond * (1.0 + 1e-9)) continue;
       const double len2 = d.squaredNorm();
       const double t = len2 > 0.0 ? std::clamp((col.position - a).dot(d) / len2, 0.0, 1.0) : 1.0;
       gap = (a + t * d - col.position).norm() - col.desc.radius;

@@ -342,6 +342,25 @@ EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, con
   double origin[N][3];
   for (int l = 0; l < N; ++l) std::memcpy(origin[l], x + 3 * static_cast<int64_t>(ids[l][0]), sizeof origin[l]);
   for (int s = 0; s < slots; ++s) {
+    moved[s] = {splat<T>(0.0f), splat<T>(0.0f), splat<T>(0.0f)};
+#if EMBRA_LANES_VECTOR && __has_builtin(__builtin_shufflevector) && __has_builtin(__builtin_convertvector)
+    if constexpr (std::is_same_v<T, F8>) {  // in registers: the same values, without a stall on memory
+      F4 r[N];
+      double wd[N];
+      for (int l = 0; l < N; ++l) {
+        const int32_t id = ids[l][s];
+        const double* q = x + 3 * static_cast<int64_t>(id);
+        const D4 d = D4{q[0], q[1], q[2], 0.0} - D4{origin[l][0], origin[l][1], origin[l][2], 0.0};
+        r[l] = __builtin_convertvector(d, F4);
+        wd[l] = l < valid ? w[id] : 0.0;
+      }
+      p[s] = transpose_in(r);
+      const F4 w0 = __builtin_convertvector((D4{wd[0], wd[1], wd[2], wd[3]}), F4);
+      const F4 w1 = __builtin_convertvector((D4{wd[4], wd[5], wd[6], wd[7]}), F4);
+      wp[s] = __builtin_shufflevector(w0, w1, 0, 1, 2, 3, 4, 5, 6, 7);
+      continue;
+    }
+#endif
     float a[3][N], ws[N];
     for (int l = 0; l < N; ++l) {
       const int32_t id = ids[l][s];
@@ -350,7 +369,6 @@ EMBRA_ALWAYS_INLINE void island_block_single(const IslandPlan::Shape& shape, con
       ws[l] = l < valid ? static_cast<float>(w[id]) : 0.0f;
     }
     p[s] = {L::make(a[0]), L::make(a[1]), L::make(a[2])};
-    moved[s] = {splat<T>(0.0f), splat<T>(0.0f), splat<T>(0.0f)};
     wp[s] = L::make(ws);
   }
   for (int step = 0; step < steps; ++step) {

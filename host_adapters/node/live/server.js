@@ -232,7 +232,12 @@ function startServer(options) {
     next += dtMs;
     const after = performance.now();
     if (after - next > 250 || next < now - dtMs) next = after;
-    timer = setTimeout(tick, Math.max(0, next - after));
+    schedule(next - after);
+  };
+  // A frame already due runs once the pending I/O has been handled (setImmediate), not after
+  // setTimeout's floor of 1 ms: behind the clock, that floor is a millisecond lost every frame.
+  const schedule = (delay) => {
+    timer = delay > 0 ? { timeout: setTimeout(tick, delay) } : { immediate: setImmediate(tick) };
   };
 
   // The WebSocket handshake: refused with an http status before any upgrade unless the Host is the
@@ -345,7 +350,7 @@ function startServer(options) {
       const { port } = server.address();
       gate = allowed(host, port, extraOrigins);
       next = performance.now();
-      timer = setTimeout(tick, 0);
+      schedule(0);
       resolve({
         url: `http://${urlHost(host)}:${port}/`,
         port,
@@ -356,7 +361,8 @@ function startServer(options) {
         waiting: () => waiting,
         close: () => new Promise((done) => {
           closed = true;
-          if (timer) clearTimeout(timer);
+          if (timer?.timeout) clearTimeout(timer.timeout);
+          if (timer?.immediate) clearImmediate(timer.immediate);
           for (const ws of clients) ws.terminate();
           wss.close(() => server.close(() => {
             session.close();
