@@ -1,6 +1,7 @@
-// The frame rate a page receives from embra-live: starts the server on a scene, opens the page in
-// headless Chromium, lets it run, and reports frames received per second by the page and the
-// server's ms per step. A measurement, not a test:
+// The frame rate of embra-live: starts the server on a scene, opens the page in headless Chromium,
+// lets it run, and reports the frames the server stepped per second (the page's frame numbers), the
+// frames the page received per second (it acknowledges each one it draws, and the server sends it
+// two ahead at most: docs/live-protocol.md) and the server's ms per step. A measurement, not a test:
 //
 //   node bench/live_fps.mjs [SCENE.json] [SECONDS]     (default examples/large/poq_drape_32.json, 20)
 //
@@ -42,7 +43,8 @@ const median = serverMs[Math.floor(serverMs.length / 2)];
 console.log(JSON.stringify({
   scene: path.relative(source, scene), particles: live.session.particles, seconds: Number(elapsed.toFixed(1)),
   frames_received: b.frames - a.frames, page_fps: Number(((b.frames - a.frames) / elapsed).toFixed(1)),
-  frames_stepped: b.frame - a.frame, step_ms_median: Number(median.toFixed(1)),
+  frames_stepped: b.frame - a.frame, steps_per_second: Number(((b.frame - a.frame) / elapsed).toFixed(1)),
+  step_ms_median: Number(median.toFixed(1)),
   realtime_fps: Number((1 / live.session.dt).toFixed(1)),
 }));
 await context.close();

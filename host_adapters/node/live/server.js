@@ -31,6 +31,8 @@ const CLOSE_BEHIND_BYTES = 64 * 1024 * 1024; // a page this far behind (not read
 const HTTP_EXTRA_SOCKETS = 16; // sockets beyond maxConnections for page loads (server.maxConnections)
 const REQUEST_TIMEOUT_MS = 10000; // an http request (or a WebSocket handshake) must arrive within this
 const FIGHTS_EVERY = 10; // frames between `fights` messages
+const FRAMES_AHEAD = 2; // frames sent to a page that acknowledges what it draws, and not yet drawn
+const DRAWN_WAIT_MS = 1000; // a frame not acknowledged within this no longer holds the next back
 const HEAVY = new Set(['save', 'export', 'export_all', 'reset']);
 const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8',
                 '.css': 'text/css; charset=utf-8', '.json': 'application/json', '.png': 'image/png',
@@ -186,15 +188,41 @@ function startServer(options) {
     const text = JSON.stringify(message);
     for (const ws of clients) send(ws, text);
   };
+  // Pacing (docs/live-protocol.md, `drawn`): a page that acknowledges the frames it draws has at most
+  // FRAMES_AHEAD frames sent and not yet drawn; the frames stepped meanwhile are skipped for it, and
+  // the latest goes out as soon as it catches up. So what it shows lags the server by a frame or two,
+  // however slowly it draws, instead of by the 4 MB a socket may hold. A page that never
+  // acknowledges is limited by that buffer alone.
+  const pacing = new Map(); // ws -> { sent: [{ frame, at }], behind: the latest frame was skipped }
+  let latest = null; // the last frame stepped: { record, geometry }
   const sendFrame = (ws, record, geometry) => {
     if (ws.readyState !== ws.OPEN || ws.bufferedAmount > FRAME_SKIP_BYTES) return;
+    const pace = pacing.get(ws);
+    if (pace) {
+      const now = performance.now();
+      pace.sent = pace.sent.filter((f) => f.at > now - DRAWN_WAIT_MS);
+      if (pace.sent.length >= FRAMES_AHEAD) {
+        pace.behind = true;
+        return;
+      }
+      pace.sent.push({ frame: session.record.frame, at: now });
+      pace.behind = false;
+    }
     ws.send(record);
     ws.send(geometry, { binary: true });
+  };
+  const drawn = (ws, frame) => {
+    if (!Number.isInteger(frame) || frame < 0) throw new RefusedMessage('drawn: frame must be a frame number');
+    let pace = pacing.get(ws);
+    if (!pace) pacing.set(ws, pace = { sent: [], behind: false });
+    pace.sent = pace.sent.filter((f) => f.frame > frame);
+    if (pace.behind && latest) sendFrame(ws, latest.record, latest.geometry);
   };
   const broadcastFrame = () => {
     if (clients.size === 0) return;
     const record = JSON.stringify(session.frameMessage());
     const geometry = Buffer.from(session.geometryMessage());
+    latest = { record, geometry };
     for (const ws of clients) sendFrame(ws, record, geometry);
     // What fights, every FIGHTS_EVERY frames and at every frame stepped while paused.
     if (session.paused || session.record.frame % FIGHTS_EVERY === 0) {
@@ -312,12 +340,14 @@ function startServer(options) {
         }
         if (msg && HEAVY.has(msg.type) && !bucket.take(limits.heavyMessageCost - 1)) return drop();
         if (closed) return;
+        if (msg && msg.type === 'drawn') return drawn(ws, msg.frame);
         let result = session.handle(msg, ws); // a refusal throws here, answered before the next message
         if (result instanceof Promise) result = await result;
         for (const r of result.replies || []) send(ws, r);
         if (result.broadcast) for (const other of clients) if (other !== ws) for (const r of result.replies || []) send(other, r);
         if (result.scene) {
           broadcast(session.sceneMessage());
+          for (const pace of pacing.values()) pace.sent = []; // frame numbers may start again
           broadcastFrame();
         }
         if (result.stepped) stepAndSend();
@@ -333,6 +363,7 @@ function startServer(options) {
     });
     ws.on('close', () => {
       clients.delete(ws);
+      pacing.delete(ws);
       if (reportTimer) clearTimeout(reportTimer);
       if (session.world) session.releaseDrag(ws); // a page that goes away lets go of what it held
     });

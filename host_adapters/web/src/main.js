@@ -604,6 +604,9 @@ function loop() {
     const g = pendingFrame;
     pendingFrame = null;
     showGeometry(g.frame, g.positions, g.poses, g.fields);
+    // Paces the server (docs/live-protocol.md, `drawn`): it sends the next frames as this one is
+    // drawn, so a page that draws slowly shows the latest frame, not a queue of old ones.
+    if (state.mode === 'live' && live) live.send({ type: 'drawn', frame: g.frame });
   }
   if (state.mode === 'live') {
     const now = performance.now();

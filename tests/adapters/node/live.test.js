@@ -115,6 +115,25 @@ test('frames stream in order, each a record and its geometry in the documented l
   assert.ok(Math.abs(top - g.record.miter_error_max) <= 1e-7 * Math.max(g.record.miter_error_max, 1e-30));
 });
 
+test('a page that acknowledges what it draws is sent two frames ahead at most, then the latest', async () => {
+  const p = await connect(live.url);
+  const frameOf = (g) => g.buffer.readUInt32LE(8);
+  const first = await next(p, ofType('geometry'), 'a first frame');
+  send(p, { type: 'drawn', frame: frameOf(first) });
+  // The server steps on (60 frames a second); unacknowledged, the page gets two frames and then none.
+  await new Promise((r) => setTimeout(r, 400));
+  const held = p.frames.length;
+  await new Promise((r) => setTimeout(r, 400));
+  assert.equal(p.frames.length, held, 'no frame is sent past two unacknowledged ones');
+  const last = frameOf(p.frames[p.frames.length - 1]);
+  const t0 = performance.now();
+  send(p, { type: 'drawn', frame: last });
+  const caught = await next(p, (m) => m.type === 'geometry' && frameOf(m) > last, 'the frame after an acknowledgement');
+  assert.ok(performance.now() - t0 < 500, 'sent as soon as the page caught up');
+  assert.ok(frameOf(caught) > last + 10, `the latest frame (${frameOf(caught)}), not the one after ${last}`);
+  p.ws.close();
+});
+
 test('a drag moves the corner it holds, and releasing it removes its pin', async () => {
   await paused(page);
   const w = live.session.world;
@@ -193,7 +212,8 @@ test('bad messages are refused with a reason and change nothing', async () => {
     { type: 'collider_pose', index: 1, position: [0, 0, 0] },
     { type: 'collider_pose', index: 0, position: [0, 0, 1e400] },
     { type: 'collider_pose', index: 0, position: [0, 0, 0], rotation: [0, 0, 0, 0] },
-    { type: 'gravity', on: 'yes' }, { type: 'pins', on: 1 },
+    { type: 'gravity', on: 'yes' }, { type: 'pins', on: 1 }, { type: 'drawn', frame: 'latest' },
+    { type: 'drawn', frame: -1 },
     { type: 'group_weight', index: 9, weight: 2 }, { type: 'group_weight', index: 0, weight: 0 },
     { type: 'group_weight', index: 0, weight: 2.5 },
     { type: 'rest_scale', body: 0, scale: -1 }, { type: 'rest_scale', body: 3, scale: 1 },
