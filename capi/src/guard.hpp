@@ -24,15 +24,13 @@ struct embra_world {
   /// embra_world_cancel: set by any thread, consumed by the step that sees it.
   std::atomic<bool> cancel{false};
   /// The last panel mesh measured (embra_panel_mesh_get_metrics, _get_vertex_errors,
-  /// _get_corner_gap), kept while its layout and its particles' positions are bit for bit the same:
-  /// a host that reads a frame's metrics and several error fields measures the mesh once.
+  /// _get_corner_gap), kept while its particles' positions are bit for bit the same: a host that
+  /// reads a frame's metrics and several error fields measures the mesh once. A world's layouts are
+  /// only ever appended, never changed, so the body and its layout's address name the layout.
   struct PanelMeasure {
     bool valid = false;
     embra::Id body;
     const embra::PanelLayout* layout = nullptr;
-    int32_t first_particle = 0;
-    int64_t particles = 0;
-    double thickness = 0.0;
     std::vector<embra::Vec3> x;  // the layout's particles, first_particle onwards
     embra::PanelErrors errors;
   };

@@ -93,8 +93,7 @@ const embra::PanelErrors& measured(const embra_world* world, embra_body_id body)
   const auto first = x.begin() + l.first_particle;
   const auto last = first + static_cast<std::ptrdiff_t>(l.particle_count());
   embra_world::PanelMeasure& m = world->panel_measure;
-  const bool same = m.valid && m.body == to_id(body) && m.layout == &l && m.first_particle == l.first_particle &&
-                    m.particles == l.particle_count() && m.thickness == l.thickness &&
+  const bool same = m.valid && m.body == to_id(body) && m.layout == &l &&
                     std::equal(first, last, m.x.begin(), m.x.end(), [](const embra::Vec3& a, const embra::Vec3& b) {
                       return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0;
                     });
@@ -104,9 +103,6 @@ const embra::PanelErrors& measured(const embra_world* world, embra_body_id body)
     m.x.assign(first, last);
     m.body = to_id(body);
     m.layout = &l;
-    m.first_particle = l.first_particle;
-    m.particles = l.particle_count();
-    m.thickness = l.thickness;
     m.valid = true;
   }
   return m.errors;
