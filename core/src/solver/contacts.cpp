@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace embra {
@@ -146,14 +147,51 @@ void World::catch_late_contacts() {
 void World::find_face_contacts() {
   face_contacts_.clear();
   if (panel_layouts_.empty()) return;
+  // A panel's faces far from a sphere stay out of its reach for some substeps: each bound set when
+  // a panel is looked at (below) is kept with what it can have lost since, so a panel is looked at
+  // again only once that loss could bring it within reach. Between two looks a bound loses no
+  // more than three times the layout's largest particle shift (the corner it is measured from
+  // moves by one, the panel's extent by two) plus how far the sphere moved. A panel skipped so
+  // would have been skipped by its own look, so the contacts are the same.
+  FaceReach& fr = face_reach_;
+  size_t spheres = 0, panels = 0;
+  for (const Collider& col : colliders_)
+    if (col.alive && col.desc.shape == ColliderShape::sphere) ++spheres;
+  for (const PanelLayout& l : panel_layouts_) panels += static_cast<size_t>(l.panel_count());
+  if (spheres == 0) return;
+  if (!fr.started || fr.bound.size() != spheres * panels || fr.sphere.size() != spheres) {
+    fr.started = true;
+    fr.bound.assign(spheres * panels, -std::numeric_limits<double>::infinity());
+    fr.spent.assign(spheres * panel_layouts_.size(), 0.0);
+    fr.sphere.clear();
+    for (const Collider& col : colliders_)
+      if (col.alive && col.desc.shape == ColliderShape::sphere) fr.sphere.push_back(col.position);
+    fr.seen = x_;
+  }
+  // Per layout: the largest shift of a particle since the last look, and of its motion this substep.
+  std::vector<std::pair<double, double>> shifts(panel_layouts_.size());
+  for (size_t li = 0; li < panel_layouts_.size(); ++li) {
+    const PanelLayout& l = panel_layouts_[li];
+    double shift2 = 0.0, motion2 = 0.0;
+    for (int64_t k = 0; k < l.particle_count(); ++k) {
+      const size_t i = static_cast<size_t>(l.first_particle + k);
+      shift2 = std::max(shift2, (x_[i] - fr.seen[i]).squaredNorm());
+      motion2 = std::max(motion2, (x_[i] - x_prev_[i]).squaredNorm());
+      fr.seen[i] = x_[i];
+    }
+    shifts[li] = {std::sqrt(shift2), std::sqrt(motion2)};
+  }
   // Each part looks at a contiguous run of a mesh's panels: the contacts stand in panel order.
+  size_t sphere = 0;
   for (size_t c = 0; c < colliders_.size(); ++c) {
     const Collider& col = colliders_[c];
     if (!col.alive || col.desc.shape != ColliderShape::sphere) continue;
     const double r = col.desc.radius + col.desc.thickness;
     const double move = (col.position - col.position_prev).norm();
+    const double sphere_shift = (col.position - fr.sphere[sphere]).norm();
+    fr.sphere[sphere] = col.position;
     // A panel's four triangles (two a layer) that come within reach of the sphere.
-    auto look_at = [&](const PanelLayout& l, int32_t p, std::vector<FaceContact>& found) {
+    auto look_at = [&](const PanelLayout& l, int32_t p, double spent, double& bound, std::vector<FaceContact>& found) {
       // First the whole panel: its triangles are no nearer the centre than its first corner less the
       // farthest corner from that one, and move no more than its corners do. A panel out of reach by
       // that bound (and 1 um more, far beyond rounding) has no contact below; most panels are.
@@ -164,7 +202,9 @@ void World::find_face_contacts() {
         extent2 = std::max(extent2, (x_[i] - o).squaredNorm());
         moved2 = std::max(moved2, (x_[i] - x_prev_[i]).squaredNorm());
       }
-      if ((o - col.position).norm() - std::sqrt(extent2) - r > std::sqrt(moved2) + move + 1e-6) return;
+      const double reach = (o - col.position).norm() - std::sqrt(extent2) - r;
+      bound = reach + spent;
+      if (reach > std::sqrt(moved2) + move + 1e-6) return;
       for (int layer = 0; layer < 2; ++layer)
         for (int half = 0; half < 2; ++half) {
           auto corner = [&](int k, bool top) { return top ? l.top(p, k) : l.bottom(p, k); };
@@ -183,11 +223,23 @@ void World::find_face_contacts() {
                 {ids[0], ids[1], ids[2]}, {partner[0], partner[1], partner[2]}, static_cast<int32_t>(c), 0.0});
         }
     };
-    for (const PanelLayout& l : panel_layouts_)
+    size_t first = 0;  // the layout's first panel in the bounds of this sphere
+    for (size_t li = 0; li < panel_layouts_.size(); ++li) {
+      const PanelLayout& l = panel_layouts_[li];
+      double& spent = fr.spent[sphere * panel_layouts_.size() + li];
+      spent += 3.0 * shifts[li].first + sphere_shift;
+      // Skipped when the bound, less what it can have lost, clears what the look above asks for
+      // with the layout's largest motion for the panel's (and 1 nm for the sums' rounding).
+      const double clear = shifts[li].second + move + 1e-6 + 1e-9;
+      double* bound = fr.bound.data() + sphere * panels + first;
       pool_->collect(0, static_cast<size_t>(l.panel_count()), kFaceGrain, face_parts_, face_contacts_,
                      [&](size_t begin, size_t end, std::vector<FaceContact>& found) {
-                       for (size_t p = begin; p < end; ++p) look_at(l, static_cast<int32_t>(p), found);
+                       for (size_t p = begin; p < end; ++p)
+                         if (!(bound[p] - spent > clear)) look_at(l, static_cast<int32_t>(p), spent, bound[p], found);
                      });
+      first += static_cast<size_t>(l.panel_count());
+    }
+    ++sphere;
   }
 }
 

@@ -727,6 +727,7 @@ void World::step(const StepControl& control) {
     for (int32_t slot : order_)  // the rows' operands of islands in single precision, for the frame
       if (Group& g = groups_[slot]; g.islands.active())
         island_operands(g.islands, island_rows(g).data(), 1.0 / (h * h));
+    face_reach_.started = false;  // the faces' bounds hold over this frame's substeps
     for (int s = 0; s < substeps; ++s) {
       const double alpha = static_cast<double>(s + 1) / substeps;
       move_colliders(alpha);

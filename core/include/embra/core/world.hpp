@@ -1075,6 +1075,15 @@ class World {
   std::unique_ptr<GlobalSolve> global_;               // Settings::global_solve: pattern, factorisation, scratch
   std::vector<std::vector<Contact>> contact_parts_;   // find_collider_contacts: one list per thread
   std::vector<std::vector<FaceContact>> face_parts_;  // find_face_contacts: one list per thread
+  /// find_face_contacts' bounds over one frame's substeps: per sphere, layout and panel, how far
+  /// its faces were at least from the sphere (less its radius) when last looked at, plus `spent`
+  /// then (-inf: not yet); per sphere and layout, `spent`: what such a bound can have lost since the
+  /// frame began; and where the spheres and the layouts' particles were at the last look.
+  struct FaceReach {
+    bool started = false;
+    std::vector<double> bound, spent;
+    std::vector<Vec3> sphere, seen;
+  } face_reach_;
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   // The per-particle passes' parts, where a group's islands go in colours over several threads
   // (find_particle_parts): (begin, end, part) runs of particles, each particle in the part of the
