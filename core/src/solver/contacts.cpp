@@ -91,16 +91,24 @@ void World::find_collider_contacts(int32_t index, const std::vector<int32_t>* on
     if (w_[i] == 0.0) continue;
     // The clearance, plus the path, plus the clearance again as a margin (see find_shape_contacts).
     const Vec3 d = x_[i] - x_prev_[i];
+    const double clearance2 = 2.0 * (radius_[i] + col.desc.thickness);
+    if (col.desc.shape == ColliderShape::sphere) {
+      // The closest point of the swept segment to the sphere's centre (below) catches a particle that
+      // crosses the whole sphere within one substep. No point of the segment is nearer the centre
+      // than its start less the path: a start beyond the radius, the reach and the path (by far more
+      // than rounding) has no contact, found without the division and the roots below; the path
+      // is bounded by the sum of its coordinates' magnitudes first (a weaker test, its margin
+      // doubled for the bound's own rounding).
+      const double longer = d.cwiseAbs().sum();
+      const double beyond = col.desc.radius + clearance2 + 2.0 * longer;
+      if ((x_prev_[i] - col.position).squaredNorm() > beyond * beyond * (1.0 + 2e-9)) continue;
+    }
     const double path = d.norm();
-    const double reach = 2.0 * (radius_[i] + col.desc.thickness) + path;
+    const double reach = clearance2 + path;
     double gap;
     if (col.desc.shape == ColliderShape::plane) {
       gap = normal.dot(x_[i] - col.position);
     } else {
-      // The closest point of the swept segment to the sphere's centre catches a particle that
-      // crosses the whole sphere within one substep. No point of the segment is nearer the centre
-      // than its start less the path: a start beyond the radius, the reach and the path (by far more
-      // than rounding) has no contact, found without the division and the root below.
       const Vec3 a = x_prev_[i];
       const double beyond = col.desc.radius + reach + path;
       if ((a - col.position).squaredNorm() > beyond * beyond * (1.0 + 1e-9)) continue;
@@ -124,8 +132,9 @@ void World::catch_late_contacts() {
     return;
   Group& g = groups_[settings_.contact_group.index];
   const size_t before = g.contacts.size();
-  std::vector<int32_t> moved;
-  std::vector<uint8_t> watched(x_.size());
+  std::vector<int32_t>& moved = late_moved_;
+  std::vector<uint8_t>& watched = late_watched_;
+  watched.resize(x_.size());
   for (size_t c = 0; c < colliders_.size(); ++c) {
     const Collider& col = colliders_[c];
     if (!col.alive) continue;
@@ -133,9 +142,13 @@ void World::catch_late_contacts() {
     for (size_t k = 0; k < before; ++k)
       if (g.contacts[k].collider == static_cast<int32_t>(c)) watched[g.contacts[k].particle] = 1;
     moved.clear();
-    for (size_t i = 0; i < x_.size(); ++i)
-      if (w_[i] != 0.0 && !watched[i] && (x_[i] - detected_[i]).norm() > radius_[i] + col.desc.thickness)
-        moved.push_back(static_cast<int32_t>(i));
+    for (size_t i = 0; i < x_.size(); ++i) {
+      if (w_[i] == 0.0 || watched[i]) continue;
+      // (a particle that moved clearly less than its clearance is decided without the root)
+      const double clearance = radius_[i] + col.desc.thickness, moved2 = (x_[i] - detected_[i]).squaredNorm();
+      if (moved2 < clearance * clearance * (1.0 - 1e-9)) continue;
+      if (std::sqrt(moved2) > clearance) moved.push_back(static_cast<int32_t>(i));
+    }
     if (!moved.empty()) find_collider_contacts(static_cast<int32_t>(c), &moved, g.contacts);
   }
   for (size_t k = before; k < g.contacts.size(); ++k) project_contact(g.contacts[k]);

@@ -1084,6 +1084,8 @@ class World {
     std::vector<double> bound, spent;
     std::vector<Vec3> sphere, seen;
   } face_reach_;
+  std::vector<int32_t> late_moved_;                   // catch_late_contacts: the particles looked at again
+  std::vector<uint8_t> late_watched_;                 // catch_late_contacts: per particle, whether a contact watched it
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   // The per-particle passes' parts, where a group's islands go in colours over several threads
   // (find_particle_parts): (begin, end, part) runs of particles, each particle in the part of the
