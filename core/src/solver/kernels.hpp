@@ -52,7 +52,10 @@ struct Kernels {
 /// from the arrays (where a global solve or an earlier pass set them; World::reset_multipliers
 /// zeroes both), its last gives them back, so between them each thread writes the multipliers
 /// of its own items only, on cache lines of their own (a row's place in its array colour does not
-/// follow the threads' cut). Every other reader of the arrays comes after a pass's last projection.
+/// follow the threads' cut). Every other reader of the arrays comes after a pass's last projection:
+/// a realignment (Settings::realign_passes) within the substep, else only what reads the frame's
+/// last substep (the reactions, the fights, the constraints' forces), so the multipliers are given
+/// back in that substep alone unless a realignment follows (World::solve).
 enum IslandEnds : int { kIslandsTake = 1, kIslandsGive = 2 };
 
 /// Calls f(kind, row) for each row of the island items [begin, end) of `plan`, island by island in

@@ -525,7 +525,8 @@ struct IslandPlan {
     /// each island's first particle, the moves summed from zero and added to the double positions.
     bool single = false;
     /// Per island: its rows' multipliers while a pass projects the islands (IslandEnds: taken from
-    /// the arrays at its first projection, given back at its last); scratch the kernels write.
+    /// the arrays at its first projection, given back at its last where something reads them);
+    /// scratch the kernels write.
     mutable std::vector<double> lambda;
     /// In single precision, `lambda` in floats instead, with the rows' rest values and compliances
     /// over h^2 (copied from the arrays once a frame, island_operands): item by item (Item), an
@@ -1084,8 +1085,9 @@ class World {
     std::vector<double> bound, spent;
     std::vector<Vec3> sphere, seen;
   } face_reach_;
-  std::vector<int32_t> late_moved_;                   // catch_late_contacts: the particles looked at again
-  std::vector<uint8_t> late_watched_;                 // catch_late_contacts: per particle, whether a contact watched it
+  bool last_substep_ = true;           // solve(): the frame's last substep (the islands give their multipliers back)
+  std::vector<int32_t> late_moved_;    // catch_late_contacts: the particles looked at again
+  std::vector<uint8_t> late_watched_;  // catch_late_contacts: per particle, whether a contact watched it
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   // The per-particle passes' parts, where a group's islands go in colours over several threads
   // (find_particle_parts): (begin, end, part) runs of particles, each particle in the part of the
