@@ -182,7 +182,8 @@ void World::find_face_contacts() {
     fr.seen = x_;
   }
   // Per layout: the largest shift of a particle since the last look, and of its motion this substep.
-  std::vector<std::pair<double, double>> shifts(panel_layouts_.size());
+  std::vector<std::pair<double, double>>& shifts = fr.shifts;
+  shifts.resize(panel_layouts_.size());
   for (size_t li = 0; li < panel_layouts_.size(); ++li) {
     const PanelLayout& l = panel_layouts_[li];
     double shift2 = 0.0, motion2 = 0.0;

@@ -745,8 +745,7 @@ void World::step(const StepControl& control) {
             for (int32_t p : sm.particles) track_pins_ = track_pins_ || hard_pin_of_[p] >= 0;
       }
       reset_multipliers();
-      last_substep_ = s + 1 == substeps;
-      solve(h, control);
+      solve(h, control, s + 1 == substeps);
       // The global solve's Newton steps are not tracked: without a realignment after them, the
       // impulses are read from the multipliers where the substep ends.
       if (track_pins_ && settings_.global_solve && settings_.realign_passes == 0) restart_pin_impulses();
@@ -780,7 +779,7 @@ void World::begin_frame(const StepControl& control) {
     refresh_rest();
 }
 
-void World::solve(double h, const StepControl& control) {
+void World::solve(double h, const StepControl& control, bool last) {
   if (settings_.realign_passes > 0) predicted_ = x_;
   if (settings_.global_solve) global_step(h);
   for (int pass = 0; pass <= settings_.realign_passes; ++pass) {
@@ -807,7 +806,7 @@ void World::solve(double h, const StepControl& control) {
           // The islands take the arrays' multipliers only where a global solve or a pass before set
           // them: after reset_multipliers both are zero.
           const bool set = settings_.global_solve != 0 || pass > 0;
-          const bool give = last_substep_ || settings_.realign_passes > 0;
+          const bool give = last || settings_.realign_passes > 0;
           const int ends = (set && it == 0 && k == 0 ? kIslandsTake : 0) |
                            (give && it + 1 == settings_.iterations && k + 1 == g.desc.weight ? kIslandsGive : 0);
           project_group(g, h, pass == 0 && it == 0 && k == 0, ends);

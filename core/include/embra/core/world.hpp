@@ -999,7 +999,8 @@ class World {
   void global_terms(const std::vector<Vec3>& x, double inv_h2, int pass, double t, bool matrix, bool store);
   // The step's stages (step.cpp lists them in order).
   void begin_frame(const StepControl& control);
-  void solve(double h, const StepControl& control);
+  /// `last`: the frame's last substep, where the islands give their multipliers back (IslandEnds).
+  void solve(double h, const StepControl& control, bool last);
   void apply_friction(double h);
   void apply_collider_friction(Contact& contact, double h);  // one collider contact's (apply_friction)
   void update_velocities(double h);
@@ -1084,10 +1085,10 @@ class World {
     bool started = false;
     std::vector<double> bound, spent;
     std::vector<Vec3> sphere, seen;
+    std::vector<std::pair<double, double>> shifts;  // per layout: this substep's (see find_face_contacts)
   } face_reach_;
-  bool last_substep_ = true;           // solve(): the frame's last substep (the islands give their multipliers back)
-  std::vector<int32_t> late_moved_;    // catch_late_contacts: the particles looked at again
-  std::vector<uint8_t> late_watched_;  // catch_late_contacts: per particle, whether a contact watched it
+  std::vector<int32_t> late_moved_;                   // catch_late_contacts: the particles looked at again
+  std::vector<uint8_t> late_watched_;                 // catch_late_contacts: per particle, whether a contact watched it
   std::vector<Vec3> chebyshev_prev_, chebyshev_now_;  // Settings::chebyshev_rho_milli: x^(k-1), x^k
   // The per-particle passes' parts, where a group's islands go in colours over several threads
   // (find_particle_parts): (begin, end, part) runs of particles, each particle in the part of the
