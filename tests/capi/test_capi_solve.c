@@ -310,6 +310,19 @@ static void test_fighting_groups(void) {
   CHECK(worst[0].residual < 0.02 * worst[0].violation);
   CHECK_INT(worst[2].kind, EMBRA_CONSTRAINT_DISTANCE);
   CHECK(worst[2].force < 10.0 && worst[2].index >= 0 && worst[2].index < 10);
+  /* The whole ranking (10 links and 2 pins): violation x force never rising, its first four the
+     four above. */
+  {
+    embra_constraint_residual all[16];
+    int32_t m = 0;
+    CHECK_OK(embra_world_get_worst_constraints(w, all, 16, &m));
+    CHECK_INT(m, 12);
+    for (i = 1; i < m; ++i)
+      CHECK(all[i].violation * all[i].force <= all[i - 1].violation * all[i - 1].force);
+    for (i = 0; i < 4; ++i)
+      CHECK(all[i].kind == worst[i].kind && all[i].index == worst[i].index &&
+            all[i].pin.index == worst[i].pin.index && all[i].violation == worst[i].violation);
+  }
   /* Per constraint, in the order added: the hard links' residuals. */
   {
     embra_group_id def_group;

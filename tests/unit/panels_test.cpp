@@ -117,6 +117,31 @@ TEST(PanelMesh, GridBuildsFlatAndExact) {
   EXPECT_EQ(vertex_errors(*l, measure_panels(*l, w.positions()), PanelMetric::miter).size(), 48u);
 }
 
+// measure_panels shares each corner's plane between a panel's metrics; its values are those of the
+// per-quad functions above, to the bit, on panels bent every way.
+TEST(PanelMetrics, MeasuredAsThePerQuadFunctions) {
+  World w(test::settings(10, 1));
+  const Id body = test::add_panel_grid(w, 4, 3, 0.8);
+  const PanelLayout& l = *w.panel_layout(body);
+  std::vector<Vec3> x = w.positions();
+  for (size_t i = 0; i < x.size(); ++i)  // a fixed bend per particle, up to 3 cm
+    x[i] += 0.03 * Vec3(std::sin(1.7 * static_cast<double>(i)), std::cos(2.3 * static_cast<double>(i)),
+                        std::sin(0.9 * static_cast<double>(i) + 0.4));
+  const PanelErrors e = measure_panels(l, x);
+  ASSERT_EQ(e.thickness.size(), 12u);
+  for (int32_t p = 0; p < l.panel_count(); ++p) {
+    Vec3 t[4], b[4];
+    for (int k = 0; k < 4; ++k) t[k] = x[l.top(p, k)], b[k] = x[l.bottom(p, k)];
+    const size_t i = static_cast<size_t>(p);
+    EXPECT_EQ(e.planarity_top[i], quad_planarity(t[0], t[1], t[2], t[3])) << p;
+    EXPECT_EQ(e.planarity_bottom[i], quad_planarity(b[0], b[1], b[2], b[3])) << p;
+    EXPECT_EQ(e.corner_distance_top[i], quad_corner_distance(t[0], t[1], t[2], t[3])) << p;
+    EXPECT_EQ(e.corner_distance_bottom[i], quad_corner_distance(b[0], b[1], b[2], b[3])) << p;
+    EXPECT_EQ(e.thickness[i], panel_thickness_error(t, b, l.thickness)) << p;
+    EXPECT_GT(e.thickness[i], 1e-3);  // bent: the comparison is not of zeros
+  }
+}
+
 // A bad description is refused and changes nothing.
 TEST(PanelMesh, RefusedInputChangesNothing) {
   World w(test::settings(10, 1));

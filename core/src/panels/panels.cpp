@@ -31,6 +31,28 @@ double plane_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
   return std::abs((p - a).dot(unit_normal(a, b, c)));
 }
 
+/// A quad's corner planes: normal[k] = unit_normal(q[k - 1], q[k], q[k + 1]) (indices mod 4), what
+/// quad_planarity, quad_corner_distance and panel_thickness_error compute again and again.
+struct CornerPlanes {
+  Vec3 normal[4];
+
+  explicit CornerPlanes(const Vec3 q[4]) {
+    for (int k = 0; k < 4; ++k) normal[k] = unit_normal(q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+  }
+  /// plane_distance(p, q[k - 1], q[k], q[k + 1]).
+  double distance(const Vec3& p, const Vec3 q[4], int k) const { return std::abs((p - q[(k + 3) % 4]).dot(normal[k])); }
+  /// quad_planarity(q[0], q[1], q[2], q[3]).
+  double planarity(const Vec3 q[4]) const {
+    const double split02 = 1.0 - normal[1].dot(unit_normal(q[0], q[2], q[3]));
+    const double split13 = 1.0 - normal[2].dot(unit_normal(q[1], q[3], q[0]));
+    return std::max({split02, split13, 0.0});
+  }
+  /// quad_corner_distance(q[0], q[1], q[2], q[3]).
+  double corner_distance(const Vec3 q[4]) const {
+    return std::max({distance(q[3], q, 1), distance(q[0], q, 2), distance(q[1], q, 3), distance(q[2], q, 0)});
+  }
+};
+
 /// The corners on each mesh vertex, (panel, corner k) in panel order, from quads of 4 indices.
 std::vector<std::vector<std::pair<int32_t, int32_t>>> corners_around(std::span<const int32_t> quads,
                                                                      int64_t vertex_count) {
@@ -166,19 +188,34 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
   const PanelTopology& topology = topology_of(layout, own);
   PanelErrors e;
   const int32_t n = layout.panel_count();
+  for (auto* v : {&e.planarity_top, &e.planarity_bottom, &e.corner_distance_top, &e.corner_distance_bottom,
+                  &e.diagonal_top, &e.diagonal_bottom, &e.thickness})
+    v->resize(static_cast<size_t>(n));
   for (int32_t p = 0; p < n; ++p) {
     Vec3 t[4], b[4];
     for (int k = 0; k < 4; ++k) {
       t[k] = x[layout.top(p, k)];
       b[k] = x[layout.bottom(p, k)];
     }
-    e.planarity_top.push_back(quad_planarity(t[0], t[1], t[2], t[3]));
-    e.planarity_bottom.push_back(quad_planarity(b[0], b[1], b[2], b[3]));
-    e.corner_distance_top.push_back(quad_corner_distance(t[0], t[1], t[2], t[3]));
-    e.corner_distance_bottom.push_back(quad_corner_distance(b[0], b[1], b[2], b[3]));
-    e.diagonal_top.push_back(quad_diagonal_distance(t[0], t[1], t[2], t[3]));
-    e.diagonal_bottom.push_back(quad_diagonal_distance(b[0], b[1], b[2], b[3]));
-    e.thickness.push_back(panel_thickness_error(t, b, layout.thickness));
+    // The functions above, each corner's plane (through it and its two neighbours) computed once
+    // for the planarity, the corner distances and the thickness: the same operations, the same bits.
+    const CornerPlanes top(t), bottom(b);
+    const size_t i = static_cast<size_t>(p);
+    e.planarity_top[i] = top.planarity(t);
+    e.planarity_bottom[i] = bottom.planarity(b);
+    e.corner_distance_top[i] = top.corner_distance(t);
+    e.corner_distance_bottom[i] = bottom.corner_distance(b);
+    e.diagonal_top[i] = quad_diagonal_distance(t[0], t[1], t[2], t[3]);
+    e.diagonal_bottom[i] = quad_diagonal_distance(b[0], b[1], b[2], b[3]);
+    double worst = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const int a = (k + 3) % 4, c = (k + 1) % 4;
+      for (int j : {a, k, c}) {
+        worst = std::max(worst, std::abs(top.distance(b[j], t, k) - layout.thickness));
+        worst = std::max(worst, std::abs(bottom.distance(t[j], b, k) - layout.thickness));
+      }
+    }
+    e.thickness[i] = worst;
   }
   for (const PanelJoint& j : topology.joints) {
     const int k = j.corner, k1 = (j.corner + 1) % 4;

@@ -51,46 +51,71 @@ void each_constraint(ThreadPool& pool, const Group& g, const std::vector<Vec3>& 
 std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
   const double h = settings_.dt / settings_.substeps;
   const double inv_h2 = 1.0 / (h * h);
-  std::vector<ConstraintResidual> all;
+  // Ranked by largest violation x force first, then the larger residual, then the projection order
+  // (group order, kind, colour order). Only the `count` first are kept while the constraints are
+  // visited: a heap whose top is the last of them, which a constraint has to come before to enter
+  // (a few comparisons for most, instead of a record each and a sort of them all).
+  struct Ranked {
+    double energy, residual;
+    size_t order;
+    ConstraintResidual c;
+  };
+  const auto before = [](const Ranked& a, const Ranked& b) {
+    if (a.energy != b.energy) return a.energy > b.energy;
+    if (a.residual != b.residual) return a.residual > b.residual;
+    return a.order < b.order;
+  };
+  std::vector<Ranked> kept;
+  kept.reserve(std::min<size_t>(count, 1024));  // (a host may ask for far more than there are)
+  size_t order = 0;
+  auto offer = [&](double residual, double violation, double force, auto&& record) {
+    Ranked r{violation * force, residual, order++, {}};
+    if (count == 0) return;
+    if (kept.size() == count) {
+      if (!before(r, kept.front())) return;
+      std::pop_heap(kept.begin(), kept.end(), before);
+      kept.pop_back();
+    }
+    r.c = record();
+    r.c.residual = residual;
+    r.c.violation = violation;
+    r.c.force = force;
+    kept.push_back(r);
+    std::push_heap(kept.begin(), kept.end(), before);
+  };
   for (int32_t slot : order_) {
     const Group& g = groups_[slot];
     const Id gid{static_cast<uint32_t>(slot), g.generation};
     each_constraint(*pool_, g, x_, inv_h2, [&](Kind kind, size_t i, double residual, double violation, double force) {
-      const SolverArray& a = g.solve[static_cast<int>(kind)];
-      ConstraintResidual c;
-      c.kind = static_cast<int32_t>(kind);
-      c.group = gid;
-      c.index = a.source[i];
-      const int n = arity(kind);
-      for (int m = 0; m < n; ++m) c.particles[m] = a.ids[i * n + m];
-      c.residual = residual;
-      c.violation = violation;
-      c.force = force;
-      all.push_back(c);
+      offer(residual, violation, force, [&] {
+        const SolverArray& a = g.solve[static_cast<int>(kind)];
+        ConstraintResidual c;
+        c.kind = static_cast<int32_t>(kind);
+        c.group = gid;
+        c.index = a.source[i];
+        const int n = arity(kind);
+        for (int m = 0; m < n; ++m) c.particles[m] = a.ids[i * n + m];
+        return c;
+      });
     });
     for (int32_t pi : g.soft_pins) {
       const Pin& p = pins_[pi];
-      ConstraintResidual c;
-      c.kind = kResidualPins;
-      c.group = gid;
-      c.pin = Id{static_cast<uint32_t>(pi), p.generation};
-      c.particles[0] = p.particle;
-      c.residual = (p.held(x_[p.particle] - p.target) + p.compliance * inv_h2 * p.lambda).norm();
-      c.violation = p.held(x_[p.particle] - p.target).norm();
-      c.force = p.lambda.norm() * inv_h2;
-      all.push_back(c);
+      offer((p.held(x_[p.particle] - p.target) + p.compliance * inv_h2 * p.lambda).norm(),
+            p.held(x_[p.particle] - p.target).norm(), p.lambda.norm() * inv_h2, [&] {
+              ConstraintResidual c;
+              c.kind = kResidualPins;
+              c.group = gid;
+              c.pin = Id{static_cast<uint32_t>(pi), p.generation};
+              c.particles[0] = p.particle;
+              return c;
+            });
     }
   }
-  // Largest violation x force first, then the larger residual; stable, so equal ones keep the
-  // projection order (group order, kind, colour order).
-  const auto before = [](const ConstraintResidual& a, const ConstraintResidual& b) {
-    const double ea = a.violation * a.force, eb = b.violation * b.force;
-    if (ea != eb) return ea > eb;
-    return a.residual > b.residual;
-  };
-  std::stable_sort(all.begin(), all.end(), before);
-  if (all.size() > count) all.resize(count);
-  return all;
+  std::sort_heap(kept.begin(), kept.end(), before);
+  std::vector<ConstraintResidual> out;
+  out.reserve(kept.size());
+  for (const Ranked& r : kept) out.push_back(r.c);
+  return out;
 }
 
 std::vector<GroupConflict> World::group_conflicts() const {
