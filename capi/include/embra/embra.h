@@ -1431,7 +1431,7 @@ typedef struct embra_panel_metrics {
 /* Measures a panel-mesh body at the current positions against `tolerances` (nullable: the world's).
  * Counts for diagonal and conical are against a target of 0. This call, _get_corner_gap and
  * _get_vertex_errors share one measurement while the body's particles keep their positions bit for
- * bit: a frame's metrics and every error field cost one (0.43 ms on the 2,178 particles of
+ * bit: a frame's metrics and every error field cost one (0.32-0.33 ms on the 2,178 particles of
  * examples/large/poq_drape_32.json; each further read 0.01-0.03 ms). */
 EMBRA_API embra_status embra_panel_mesh_get_metrics(const embra_world* world, embra_body_id body,
                                                     const embra_tolerances* tolerances,
