@@ -20,7 +20,9 @@ namespace embra {
 
 namespace {
 
-Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
+// (not inlined: inlined into CornerPlanes, measure_panels took 0.39 ms on the 32 x 32 drape's mesh
+// instead of 0.30, GCC 12)
+[[gnu::noinline]] Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 n = (b - a).cross(c - a);
   const double len = n.norm();
   return len > 1e-300 ? Vec3(n / len) : Vec3(Vec3::Zero());
@@ -31,8 +33,9 @@ double plane_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
   return std::abs((p - a).dot(unit_normal(a, b, c)));
 }
 
-/// A quad's corner planes: normal[k] = unit_normal(q[k - 1], q[k], q[k + 1]) (indices mod 4), what
-/// quad_planarity, quad_corner_distance and panel_thickness_error compute again and again.
+/// A quad's corner planes, normal[k] = unit_normal(q[k - 1], q[k], q[k + 1]) (indices mod 4), and
+/// the metrics made of them: measure_panels computes them once for a panel's planarity, corner
+/// distance and thickness.
 struct CornerPlanes {
   Vec3 normal[4];
 
@@ -52,6 +55,20 @@ struct CornerPlanes {
     return std::max({distance(q[3], q, 1), distance(q[0], q, 2), distance(q[1], q, 3), distance(q[2], q, 0)});
   }
 };
+
+/// panel_thickness_error of a panel whose layers' corner planes are top_planes and bottom_planes.
+double thickness_error(const CornerPlanes& top_planes, const Vec3 top[4], const CornerPlanes& bottom_planes,
+                       const Vec3 bottom[4], double thickness) {
+  double worst = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const int a = (k + 3) % 4, b = (k + 1) % 4;
+    for (int j : {a, k, b}) {
+      worst = std::max(worst, std::abs(top_planes.distance(bottom[j], top, k) - thickness));
+      worst = std::max(worst, std::abs(bottom_planes.distance(top[j], bottom, k) - thickness));
+    }
+  }
+  return worst;
+}
 
 /// The corners on each mesh vertex, (panel, corner k) in panel order, from quads of 4 indices.
 std::vector<std::vector<std::pair<int32_t, int32_t>>> corners_around(std::span<const int32_t> quads,
@@ -79,14 +96,13 @@ std::pair<int32_t, int32_t> edge_key(int32_t a, int32_t b) {
 // --- metrics -----------------------------------------------------------------------------------------
 
 double quad_planarity(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
-  const double split02 = 1.0 - unit_normal(q0, q1, q2).dot(unit_normal(q0, q2, q3));
-  const double split13 = 1.0 - unit_normal(q1, q2, q3).dot(unit_normal(q1, q3, q0));
-  return std::max({split02, split13, 0.0});
+  const Vec3 q[4] = {q0, q1, q2, q3};
+  return CornerPlanes(q).planarity(q);
 }
 
 double quad_corner_distance(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
-  return std::max({plane_distance(q3, q0, q1, q2), plane_distance(q0, q1, q2, q3), plane_distance(q1, q2, q3, q0),
-                   plane_distance(q2, q3, q0, q1)});
+  const Vec3 q[4] = {q0, q1, q2, q3};
+  return CornerPlanes(q).corner_distance(q);
 }
 
 double quad_diagonal_distance(const Vec3& q0, const Vec3& q1, const Vec3& q2, const Vec3& q3) {
@@ -98,15 +114,7 @@ double quad_diagonal_distance(const Vec3& q0, const Vec3& q1, const Vec3& q2, co
 }
 
 double panel_thickness_error(const Vec3 top[4], const Vec3 bottom[4], double thickness) {
-  double worst = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    const int a = (k + 3) % 4, b = (k + 1) % 4;
-    for (int j : {a, k, b}) {
-      worst = std::max(worst, std::abs(plane_distance(bottom[j], top[a], top[k], top[b]) - thickness));
-      worst = std::max(worst, std::abs(plane_distance(top[j], bottom[a], bottom[k], bottom[b]) - thickness));
-    }
-  }
-  return worst;
+  return thickness_error(CornerPlanes(top), top, CornerPlanes(bottom), bottom, thickness);
 }
 
 double miter_twist(const Vec3& top_i, const Vec3& top_j, const Vec3& bottom_i, const Vec3& bottom_j) {
@@ -197,8 +205,7 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
       t[k] = x[layout.top(p, k)];
       b[k] = x[layout.bottom(p, k)];
     }
-    // The functions above, each corner's plane (through it and its two neighbours) computed once
-    // for the planarity, the corner distances and the thickness: the same operations, the same bits.
+    // (each corner's plane, through it and its two neighbours, computed once for the three metrics)
     const CornerPlanes top(t), bottom(b);
     const size_t i = static_cast<size_t>(p);
     e.planarity_top[i] = top.planarity(t);
@@ -207,15 +214,7 @@ PanelErrors measure_panels(const PanelLayout& layout, std::span<const Vec3> x) {
     e.corner_distance_bottom[i] = bottom.corner_distance(b);
     e.diagonal_top[i] = quad_diagonal_distance(t[0], t[1], t[2], t[3]);
     e.diagonal_bottom[i] = quad_diagonal_distance(b[0], b[1], b[2], b[3]);
-    double worst = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const int a = (k + 3) % 4, c = (k + 1) % 4;
-      for (int j : {a, k, c}) {
-        worst = std::max(worst, std::abs(top.distance(b[j], t, k) - layout.thickness));
-        worst = std::max(worst, std::abs(bottom.distance(t[j], b, k) - layout.thickness));
-      }
-    }
-    e.thickness[i] = worst;
+    e.thickness[i] = thickness_error(top, t, bottom, b, layout.thickness);
   }
   for (const PanelJoint& j : topology.joints) {
     const int k = j.corner, k1 = (j.corner + 1) % 4;
