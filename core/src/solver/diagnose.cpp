@@ -121,6 +121,11 @@ std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
 std::vector<GroupConflict> World::group_conflicts() const {
   const double h = settings_.dt / settings_.substeps;
   const double inv_h2 = 1.0 / (h * h);
+  // Fewer than two groups with constraints or soft pins: no pair to weigh, no force to add up.
+  const auto holds_any = [](const Group& g) {
+    return !g.soft_pins.empty() || std::ranges::any_of(g.solve, [](const SolverArray& a) { return a.size() > 0; });
+  };
+  if (std::ranges::count_if(order_, [&](int32_t slot) { return holds_any(groups_[slot]); }) < 2) return {};
   // Each group's force on each particle: sum over its constraints of lambda / h^2 grad C.
   std::vector<std::vector<Vec3>> force;
   std::vector<int32_t> slots;
