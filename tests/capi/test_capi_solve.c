@@ -317,11 +317,10 @@ static void test_fighting_groups(void) {
     int32_t m = 0;
     CHECK_OK(embra_world_get_worst_constraints(w, all, 16, &m));
     CHECK_INT(m, 12);
-    for (i = 1; i < m; ++i)
-      CHECK(all[i].violation * all[i].force <= all[i - 1].violation * all[i - 1].force);
+    for (i = 1; i < m; ++i) CHECK(all[i].violation * all[i].force <= all[i - 1].violation * all[i - 1].force);
     for (i = 0; i < 4; ++i)
-      CHECK(all[i].kind == worst[i].kind && all[i].index == worst[i].index &&
-            all[i].pin.index == worst[i].pin.index && all[i].violation == worst[i].violation);
+      CHECK(all[i].kind == worst[i].kind && all[i].index == worst[i].index && all[i].pin.index == worst[i].pin.index &&
+            all[i].violation == worst[i].violation);
   }
   /* Per constraint, in the order added: the hard links' residuals. */
   {
