@@ -8,7 +8,8 @@
 // precision and the solver settings embra's scene loader reads from those files (the settings that
 // settle within every target of their tolerance documents), reported as counters. Times 20 frames of World::step after
 // 40 frames of draping (the mesh folding over the sphere: face contacts active). The 32 x 32 case is the interactive
-// target (33 ms per frame on 2 threads is the goal).
+// target (33 ms per frame on 2 threads is the goal). `drape_diagnostics` times what the live page
+// reads of that example besides the step (bench/README.md, the live page's frame rate).
 #include "embra/core/panels.hpp"
 #include "embra/io/files.hpp"
 #include "embra/io/scene.hpp"
@@ -17,6 +18,7 @@
 
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -107,6 +109,50 @@ void drape_example(benchmark::State& state) {
   state.counters["single"] = precision == embra::PanelPrecision::single;
 }
 
+/// examples/large/poq_drape_32.json loaded and stepped 60 frames (the mesh on the sphere), once for
+/// the process; null with `error` set when it cannot be.
+const embra::World* draped_32(std::string& error) {
+  static std::unique_ptr<embra::World> world;
+  static std::string failed;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    const std::string dir = std::string(EMBRA_SOURCE_DIR) + "/examples/large";
+    std::string text;
+    try {
+      if (!embra::io::read_regular_file(dir + "/poq_drape_32.json", int64_t{1} << 24, text, failed))
+        throw std::runtime_error(failed);
+      embra::io::SceneMeta meta;
+      world = embra::io::load_scene(text, dir, meta);
+      for (int f = 0; f < 60; ++f) world->step();
+    } catch (const std::exception& e) {
+      world.reset();
+      failed = std::string("examples/large/poq_drape_32.json: ") + e.what();
+    }
+  }
+  error = failed;
+  return world.get();
+}
+
+/// What the live server reads of the 32 x 32 drape besides its step, ms a call: 0 the panel
+/// metrics (measure_panels, every frame), 1 the 64 worst constraints and 2 the groups' conflicts
+/// (the `fights` message, every tenth frame).
+void drape_diagnostics(benchmark::State& state) {
+  std::string error;
+  const embra::World* w = draped_32(error);
+  if (w == nullptr) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const int64_t what = state.range(0);
+  for (auto _ : state) {
+    if (what == 0) benchmark::DoNotOptimize(embra::measure_panels(w->panel_layouts().front(), w->positions()));
+    if (what == 1) benchmark::DoNotOptimize(w->worst_constraints(64));
+    if (what == 2) benchmark::DoNotOptimize(w->group_conflicts());
+  }
+  state.SetLabel(what == 0 ? "measure_panels" : what == 1 ? "worst_constraints(64)" : "group_conflicts");
+}
+
 BENCHMARK(drape)
     ->ArgNames({"n", "corners", "substeps", "iterations", "chebyshev", "threads"})
     ->Args({4, 0, 60, 2, 0, 1})
@@ -123,5 +169,7 @@ BENCHMARK(drape_example)
     ->Args({32, 2})
     ->Iterations(20)
     ->Unit(benchmark::kMillisecond);
+
+BENCHMARK(drape_diagnostics)->ArgNames({"what"})->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
