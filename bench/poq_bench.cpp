@@ -78,30 +78,38 @@ void drape(benchmark::State& state) {
   run_drape(state, static_cast<int>(state.range(0)), static_cast<embra::PanelCorners>(state.range(1)), s);
 }
 
+/// examples/large/poq_drape_<n>.json as embra's scene loader builds it; throws with the file's
+/// path and what is wrong when it cannot be read or built.
+std::unique_ptr<embra::World> load_example(int n) {
+  const std::string dir = std::string(EMBRA_SOURCE_DIR) + "/examples/large";
+  const std::string path = dir + "/poq_drape_" + std::to_string(n) + ".json";
+  std::string text, error;
+  try {
+    if (!embra::io::read_regular_file(path, int64_t{1} << 24, text, error)) throw std::runtime_error(error);
+    embra::io::SceneMeta meta;
+    auto world = embra::io::load_scene(text, dir, meta);
+    if (world->panel_layouts().size() != 1) throw std::runtime_error("expected one panel mesh");
+    return world;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
 /// examples/large/poq_drape_<n>.json's mesh (shared corners) at its own solver settings, as
 /// embra's scene loader reads them from the file.
 void drape_example(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const std::string dir = std::string(EMBRA_SOURCE_DIR) + "/examples/large";
-  const std::string path = dir + "/poq_drape_" + std::to_string(n) + ".json";
-  std::string text, error;
-  if (!embra::io::read_regular_file(path, int64_t{1} << 24, text, error)) {
-    state.SkipWithError((path + ": " + error).c_str());
-    return;
-  }
   embra::Settings s;
   embra::PanelCorners corners = embra::PanelCorners::welded;
   embra::PanelPrecision precision = embra::PanelPrecision::full;
   try {
-    embra::io::SceneMeta meta;
-    const auto world = embra::io::load_scene(text, dir, meta);
+    const auto world = load_example(n);
     s = world->settings();
-    if (world->panel_layouts().size() != 1) throw std::runtime_error("expected one panel mesh");
     const embra::PanelLayout& l = world->panel_layouts().front();
     corners = l.shared ? embra::PanelCorners::shared : embra::PanelCorners::welded;
     precision = l.single ? embra::PanelPrecision::single : embra::PanelPrecision::full;
   } catch (const std::exception& e) {
-    state.SkipWithError((path + ": " + e.what()).c_str());
+    state.SkipWithError(e.what());
     return;
   }
   s.threads = static_cast<int32_t>(state.range(1));
@@ -109,27 +117,20 @@ void drape_example(benchmark::State& state) {
   state.counters["single"] = precision == embra::PanelPrecision::single;
 }
 
-/// examples/large/poq_drape_32.json loaded and stepped 60 frames (the mesh on the sphere), once for
-/// the process; null with `error` set when it cannot be.
+/// examples/large/poq_drape_32.json stepped 60 frames (the mesh on the sphere), once for the
+/// process; null with `error` set when it cannot be built.
 const embra::World* draped_32(std::string& error) {
-  static std::unique_ptr<embra::World> world;
   static std::string failed;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    const std::string dir = std::string(EMBRA_SOURCE_DIR) + "/examples/large";
-    std::string text;
+  static const std::unique_ptr<embra::World> world = []() -> std::unique_ptr<embra::World> {
     try {
-      if (!embra::io::read_regular_file(dir + "/poq_drape_32.json", int64_t{1} << 24, text, failed))
-        throw std::runtime_error(failed);
-      embra::io::SceneMeta meta;
-      world = embra::io::load_scene(text, dir, meta);
-      for (int f = 0; f < 60; ++f) world->step();
+      auto w = load_example(32);
+      for (int f = 0; f < 60; ++f) w->step();
+      return w;
     } catch (const std::exception& e) {
-      world.reset();
-      failed = std::string("examples/large/poq_drape_32.json: ") + e.what();
+      failed = e.what();
+      return nullptr;
     }
-  }
+  }();
   error = failed;
   return world.get();
 }

@@ -49,6 +49,7 @@ void each_constraint(ThreadPool& pool, const Group& g, const std::vector<Vec3>& 
 }  // namespace
 
 std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
+  if (count == 0) return {};
   const double h = settings_.dt / settings_.substeps;
   const double inv_h2 = 1.0 / (h * h);
   // Ranked by largest violation x force first, then the larger residual, then the projection order
@@ -70,7 +71,6 @@ std::vector<ConstraintResidual> World::worst_constraints(size_t count) const {
   size_t order = 0;
   auto offer = [&](double residual, double violation, double force, auto&& record) {
     Ranked r{violation * force, residual, order++, {}};
-    if (count == 0) return;
     if (kept.size() == count) {
       if (!before(r, kept.front())) return;
       std::pop_heap(kept.begin(), kept.end(), before);
