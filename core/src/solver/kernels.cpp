@@ -53,13 +53,17 @@ EMBRA_ALWAYS_INLINE auto distance_step(const lanes::V3<T>& p0, const lanes::V3<T
   const T c = len - r;
   const T denom = w0 + w1 + alpha;
   auto ok = (len > tiny<T>()) & (denom > 0.0);
-  T dl = (-c - alpha * lam) / denom;
+  const T num = -c - alpha * lam;
+  T dl = num / denom;
+  T s;  // dl / len: grad C = +-(x0 - x1) / len
   if constexpr (kTether) {
     ok = ok & ((c > 0.0) | (lam != 0.0));  // a slack tether with no pull left does nothing
     const T sum = lam + dl;
     dl = select(0.0 < sum, splat<T>(0.0), sum) - lam;  // std::min(lambda + dl, 0) - lambda: pull only
+    s = dl / len;
+  } else {
+    s = num / (denom * len);  // beside dl's division, not after it: the row's chain one division shorter
   }
-  const T s = dl / len;  // grad C = +-(x0 - x1) / len
   s0 = w0 * s;
   s1 = w1 * s;
   lam_new = lam + dl;
@@ -188,37 +192,47 @@ EMBRA_ALWAYS_INLINE void dihedral_block(const int32_t* ids, const double* rest, 
 /// One row of quad planarity (kPlanarity: signed distance between the diagonals of (x0, x1, x2,
 /// x3)) or plane offset (signed distance of x0 from the plane of (x1, x2, x3)) = rest, from its
 /// operands: the function and gradients of eval_quad_planarity / eval_plane_offset
-/// (constraint_math.hpp), written out flat, giving the gradients g and the multiplier's change dl;
-/// returns the lanes where it applies. Shared by the passes and the islands (the same bits). Both
-/// are C = s . u with u = n / |n|, n = a x b; with q = (s - C u) / |n| the gradient along a is b x q
-/// and along b is q x a.
+/// (constraint_math.hpp), giving the gradients g and the multiplier's change dl; returns the lanes
+/// where it applies. Shared by the passes and the islands (the same bits). Both are C = s . u with
+/// u = n / |n|, n = a x b; with q = (s - C u) / |n| the gradient along a is b x q and along b is
+/// q x a. a, b and q all lie across u, so both are multiples of u: b x q = beta u and q x a = gamma u
+/// with (Binet-Cauchy)
+///
+///   beta = ((a.b)(b.s) - (a.s)(b.b)) / |n|^2,   gamma = ((a.s)(a.b) - (a.a)(b.s)) / |n|^2,
+///
+/// so every gradient is c_k u: dl from the four scalars c_k, the moves along u. The dot products
+/// are independent of one another and of the root: a row's chain of dependent operations is about
+/// two thirds of the vector form's.
 template <class T, bool kPlanarity>
 EMBRA_ALWAYS_INLINE auto offset_step(const lanes::V3<T> p[4], const T wk[4], T r, T lam, T alpha, lanes::V3<T> g[4],
                                      T& dl) {
   using namespace lanes;
   const V3<T> a = kPlanarity ? p[2] - p[0] : p[2] - p[1];
-  const V3<T> b = kPlanarity ? p[3] - p[1] : p[3] - p[1];
+  const V3<T> b = p[3] - p[1];
   const V3<T> s = kPlanarity ? p[1] - p[0] : p[0] - p[1];
   const V3<T> n = cross(a, b);
-  const T m = lanes::sqrt(dot(n, n));
+  const T nn = dot(n, n), sn = dot(s, n);
+  const T ab = dot(a, b), as = dot(a, s), bs = dot(b, s), aa = dot(a, a), bb = dot(b, b);
+  const T m = lanes::sqrt(nn);
   const auto valid = m > tiny<T>();
-  const T inv_m = 1.0f / m;  // one division, not six: the block is bound by its divider
+  const T inv_m = 1.0f / m;  // one division for u, C and 1 / |n|^2: the block is bound by its divider
+  const T inv_nn = inv_m * inv_m;
   const V3<T> u = inv_m * n;
-  const T value = dot(s, u);
-  const V3<T> t = s - value * u;
-  const V3<T> q = inv_m * t;
-  const V3<T> ga = cross(b, q), gb = cross(q, a);
-  if constexpr (kPlanarity) {
-    g[0] = -u - ga;
-    g[1] = u - gb;
-  } else {
-    g[0] = u;
-    g[1] = -((u + ga) + gb);
+  const T value = sn * inv_m;
+  const T beta = (ab * bs - as * bb) * inv_nn, gamma = (as * ab - aa * bs) * inv_nn;
+  T c[4];
+  if constexpr (kPlanarity) {  // grad = {-u - beta u, u - gamma u, beta u, gamma u}
+    c[0] = -(1.0f + beta);
+    c[1] = 1.0f - gamma;
+  } else {  // grad = {u, -(u + beta u + gamma u), beta u, gamma u}
+    c[0] = splat<T>(1.0f);
+    c[1] = -((1.0f + beta) + gamma);
   }
-  g[2] = ga;
-  g[3] = gb;
-  T denom = alpha;
-  for (int k = 0; k < 4; ++k) denom = denom + wk[k] * dot(g[k], g[k]);
+  c[2] = beta;
+  c[3] = gamma;
+  for (int k = 0; k < 4; ++k) g[k] = c[k] * u;
+  const T denom =
+      ((wk[0] * (c[0] * c[0]) + wk[1] * (c[1] * c[1])) + (wk[2] * (c[2] * c[2]) + wk[3] * (c[3] * c[3]))) + alpha;
   dl = (-(value - r) - alpha * lam) / denom;
   return valid & (denom > 0.0);
 }
