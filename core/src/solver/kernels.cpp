@@ -213,28 +213,31 @@ EMBRA_ALWAYS_INLINE auto offset_step(const lanes::V3<T> p[4], const T wk[4], T r
   const V3<T> n = cross(a, b);
   const T nn = dot(n, n), sn = dot(s, n);
   const T ab = dot(a, b), as = dot(a, s), bs = dot(b, s), aa = dot(a, a), bb = dot(b, b);
+  // The coefficients times |n|^2 (k), and the denominator sum w_k c_k^2 + alpha times |n|^4 (e),
+  // wait for neither the root nor the division: the row's chain runs through its value alone.
+  const T bk = ab * bs - as * bb, ck = as * ab - aa * bs;  // beta |n|^2, gamma |n|^2
+  T k[4];
+  if constexpr (kPlanarity) {  // grad = {-u - beta u, u - gamma u, beta u, gamma u}
+    k[0] = -(nn + bk);
+    k[1] = nn - ck;
+  } else {  // grad = {u, -(u + beta u + gamma u), beta u, gamma u}
+    k[0] = nn;
+    k[1] = -((nn + bk) + ck);
+  }
+  k[2] = bk;
+  k[3] = ck;
+  const T nn2 = nn * nn;
+  const T e =
+      ((wk[0] * (k[0] * k[0]) + wk[1] * (k[1] * k[1])) + (wk[2] * (k[2] * k[2]) + wk[3] * (k[3] * k[3]))) + alpha * nn2;
   const T m = lanes::sqrt(nn);
   const auto valid = m > tiny<T>();
   const T inv_m = 1.0f / m;  // one division for u, C and 1 / |n|^2: the block is bound by its divider
   const T inv_nn = inv_m * inv_m;
   const V3<T> u = inv_m * n;
   const T value = sn * inv_m;
-  const T beta = (ab * bs - as * bb) * inv_nn, gamma = (as * ab - aa * bs) * inv_nn;
-  T c[4];
-  if constexpr (kPlanarity) {  // grad = {-u - beta u, u - gamma u, beta u, gamma u}
-    c[0] = -(1.0f + beta);
-    c[1] = 1.0f - gamma;
-  } else {  // grad = {u, -(u + beta u + gamma u), beta u, gamma u}
-    c[0] = splat<T>(1.0f);
-    c[1] = -((1.0f + beta) + gamma);
-  }
-  c[2] = beta;
-  c[3] = gamma;
-  for (int k = 0; k < 4; ++k) g[k] = c[k] * u;
-  const T denom =
-      ((wk[0] * (c[0] * c[0]) + wk[1] * (c[1] * c[1])) + (wk[2] * (c[2] * c[2]) + wk[3] * (c[3] * c[3]))) + alpha;
-  dl = (-(value - r) - alpha * lam) / denom;
-  return valid & (denom > 0.0);
+  for (int j = 0; j < 4; ++j) g[j] = (k[j] * inv_nn) * u;
+  dl = ((-(value - r) - alpha * lam) * nn2) / e;
+  return valid & (e > 0.0);
 }
 
 /// Quad planarity or plane offset (offset_step) of a block of constraints.
