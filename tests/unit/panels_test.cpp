@@ -263,55 +263,65 @@ TEST(PanelMesh, ConicalMeshReadsZeroAndStays) {
 }
 
 // Rows in single precision (PanelPrecision::single) hold a panel mesh as full precision does, to
-// about the float's rounding of a panel's size, wherever the mesh lies: each panel is projected
-// relative to its first corner, so 10 km from the origin (where a float's step is 1 mm) is as exact
-// as at it. The conical band above with shared corners (the offset quads exist, so every metric
-// can reach zero), every particle moved off it by up to 1 mm, gravity off and damping 5/s, 120
-// frames of 20 substeps x 4 iterations: each precision and place ends with the panels planar, at
-// their thickness and mitred, and at rest.
+// about the float's rounding of a panel's size, wherever the mesh lies and whatever its size: each
+// panel is projected relative to its first corner, so 10 km from the origin (where a float's step is
+// 1 mm) is as exact as at it, and a row's terms stay of the order of its normal's square, so panels
+// of 0.7 mm and of 700 m hold as the 0.7 m ones do (the figures scale with the size). The conical
+// band above with shared corners (the offset quads exist, so every metric can reach zero), every
+// particle moved off it by up to 1 mm (times the scale), gravity off and damping 5/s, 120 frames of
+// 20 substeps x 4 iterations: each precision, place and size ends with the panels planar, at their
+// thickness and mitred, and at rest.
 TEST(PanelMesh, SinglePrecisionRowsHoldThePanelsAnywhere) {
   std::vector<double> pos;
   std::vector<int32_t> quads;
   conical_band(pos, quads);
-  for (const double far : {0.0, 1e4})
-    for (const PanelPrecision precision : {PanelPrecision::full, PanelPrecision::single}) {
-      const bool single = precision == PanelPrecision::single;
-      const std::string name = std::string(single ? "single" : "full") + (far > 0.0 ? "_10km" : "_origin");
-      SCOPED_TRACE(name);
-      std::vector<double> placed = pos;
-      for (double& c : placed) c += far;
-      World w(test::settings(20, 4, Vec3::Zero(), 5.0));
-      PanelMeshDesc d;
-      d.positions = placed;
-      d.quads = quads;
-      d.thickness = 0.05;
-      d.corners = PanelCorners::shared;
-      d.precision = precision;
-      const Id body = build_panel_mesh(w, d);
-      const PanelLayout& l = *w.panel_layout(body);
-      EXPECT_EQ(l.single, single);
-      std::vector<double> moved(3 * static_cast<size_t>(w.particle_count()));
-      for (size_t i = 0; i < moved.size(); ++i)
-        moved[i] =
-            w.positions()[i / 3][static_cast<int>(i % 3)] + 1e-3 * std::sin(12.9898 * static_cast<double>(i) + 1.0);
-      w.set_positions(0, moved);
-      EXPECT_GT(report_panels(measure_panels(l, w.positions()), Tolerances{}).thickness.max, 1e-4);
-      for (int f = 0; f < 120; ++f) w.step();
-      const PanelReport r = report_panels(measure_panels(l, w.positions()), Tolerances{});
-      test::record_panel_report(name + "_", r);
-      RecordProperty(name + "_max_speed", test::sci(w.report().max_speed));
-      // Single: within a few float steps of the largest panel side (0.8 m), as far from the origin
-      // as at it (measured 1.2-1.4e-7 m corner distance, 5.6-6.7e-8 thickness, 1.1-1.3e-7 miter, at
-      // 1.2-1.8e-4 m/s); the same few steps over a substep bound the speed. Full: 300 times finer
-      // (4.1e-10, 8.8e-11, 2.0e-10, still settling at 3.3e-6 m/s after 120 frames).
-      const double step = 0.8 * std::numeric_limits<float>::epsilon();  // 9.5e-8 m
-      const double length = single ? 4 * step : 4 * step / 100;
-      EXPECT_LT(r.planarity_top.max, single ? 1e-12 : 1e-15);
-      EXPECT_LT(r.corner_distance_top.max, length);
-      EXPECT_LT(r.thickness.max, length);
-      EXPECT_LT(r.miter.max, length);
-      EXPECT_LT(w.report().max_speed, single ? 4 * step * 20 * 60 : 1e-5);
-    }
+  struct Case {
+    double far, scale;
+    PanelPrecision precision;
+    const char* name;
+  };
+  for (const Case& c :
+       {Case{0.0, 1.0, PanelPrecision::full, "full_origin"}, Case{0.0, 1.0, PanelPrecision::single, "single_origin"},
+        Case{1e4, 1.0, PanelPrecision::full, "full_10km"}, Case{1e4, 1.0, PanelPrecision::single, "single_10km"},
+        Case{0.0, 1e-3, PanelPrecision::single, "single_mm"}, Case{0.0, 1e3, PanelPrecision::single, "single_km"}}) {
+    const bool single = c.precision == PanelPrecision::single;
+    const std::string name = c.name;
+    SCOPED_TRACE(name);
+    std::vector<double> placed = pos;
+    for (double& x : placed) x = c.scale * x + c.far;
+    World w(test::settings(20, 4, Vec3::Zero(), 5.0));
+    PanelMeshDesc d;
+    d.positions = placed;
+    d.quads = quads;
+    d.thickness = 0.05 * c.scale;
+    d.corners = PanelCorners::shared;
+    d.precision = c.precision;
+    const Id body = build_panel_mesh(w, d);
+    const PanelLayout& l = *w.panel_layout(body);
+    EXPECT_EQ(l.single, single);
+    std::vector<double> moved(3 * static_cast<size_t>(w.particle_count()));
+    for (size_t i = 0; i < moved.size(); ++i)
+      moved[i] = w.positions()[i / 3][static_cast<int>(i % 3)] +
+                 1e-3 * c.scale * std::sin(12.9898 * static_cast<double>(i) + 1.0);
+    w.set_positions(0, moved);
+    EXPECT_GT(report_panels(measure_panels(l, w.positions()), Tolerances{}).thickness.max, 1e-4 * c.scale);
+    for (int f = 0; f < 120; ++f) w.step();
+    const PanelReport r = report_panels(measure_panels(l, w.positions()), Tolerances{});
+    test::record_panel_report(name + "_", r);
+    RecordProperty(name + "_max_speed", test::sci(w.report().max_speed));
+    // Single: within a few float steps of the largest panel side (0.8 m), as far from the origin
+    // as at it (measured 1.2-1.4e-7 m corner distance, 5.6-6.7e-8 thickness, 1.1-1.3e-7 miter, at
+    // 1.2-1.8e-4 m/s; the mm and km bands the same times their scale); the same few steps over a
+    // substep bound the speed. Full: 300 times finer (4.1e-10, 8.8e-11, 2.0e-10, still settling at
+    // 3.3e-6 m/s after 120 frames). Planarity (1 - n1 . n2) has no length.
+    const double step = 0.8 * c.scale * std::numeric_limits<float>::epsilon();  // 9.5e-8 m at scale 1
+    const double length = single ? 4 * step : 4 * step / 100;
+    EXPECT_LT(r.planarity_top.max, single ? 1e-12 : 1e-15);
+    EXPECT_LT(r.corner_distance_top.max, length);
+    EXPECT_LT(r.thickness.max, length);
+    EXPECT_LT(r.miter.max, length);
+    EXPECT_LT(w.report().max_speed, single ? 4 * step * 20 * 60 : 1e-5);
+  }
 }
 
 // A 3 x 2 grid with corners shared: one top and one bottom particle per mesh vertex (12 each), the

@@ -1325,16 +1325,14 @@ enum {
                                       corners' moves summed from zero within a projection, then added to
                                       the double positions; twice the lanes a vector instruction holds.
                                       The 32 x 32 drape (examples/large/poq_drape_32.json) takes 40 %
-                                      less time a frame (27.8 ms against 47.1, embra run), and meets every target of its
-                                      tolerance document from frame 180 (178 in full precision). A corner resolves to
+                                      less time a frame (27.6 ms against 44.5, embra run), and meets every target of its
+                                      tolerance document from frame 183 (178 in full precision). A corner resolves to
                                       about 6e-8 of its panel's size (the float's rounding), so a mesh at rest is still
                                       only to about that over a substep: at frame 300 the 32 x 32 drape
-                                      (0.1 m panels, 50 substeps a frame) moves at 1.1e-4 m/s and the
-                                      4 x 4 paper drape (0.8 m, 60) at 5.5e-4, against 2.1e-5 and 5.5e-6
-                                      in full precision. Panels under about 0.013 mm a side lose digits
-                                      in floats (a row's squared coefficients, of the order of |n|^4, fall
-                                      below a float's smallest normal number) and their rows stop applying under about
-                                      0.002 mm: such panels need full precision. For large meshes of small panels, where
+                                      (0.1 m panels, 50 substeps a frame) moves at 8.1e-5 m/s and the
+                                      4 x 4 paper drape (0.8 m, 60) at 5.0e-4, against 2.1e-5 and 5.5e-6
+                                      in full precision, the same relative to the panels' size from 0.7 mm
+                                      to 700 m panels. For large meshes of small panels, where
                                       the rows are most of a frame and settle_speed is well above that */
 };
 

@@ -88,6 +88,16 @@ constexpr Elem<T> tiny() {
     return 1e-30f;
 }
 
+/// The smallest squared length a row divides by: 1e-300 in doubles, 1e-37 in floats (its reciprocal
+/// finite: a float reaches 3.4e38).
+template <class T>
+constexpr Elem<T> tiny_square() {
+  if constexpr (std::is_same_v<Elem<T>, double>)
+    return 1e-300;
+  else
+    return 1e-37f;
+}
+
 template <class T>
 EMBRA_ALWAYS_INLINE T splat(Elem<T> s) {
   Elem<T> a[Lanes<T>::count];
