@@ -1494,11 +1494,12 @@ class Builder {
     return particles;
   }
 
-  /// A point load on each of its particles, added to what earlier loads put there.
+  /// A point load on each of its particles, added to what earlier loads put there. A particle's
+  /// first load is taken as written, so a saved world's -0.0 loads back as -0.0 (0.0 + -0.0 is 0.0).
   void load(World& w, const json& l, const std::string& at) {
     const Vec3 force = vec3(l["force"]);
     for (int32_t i : particles_of(w, l, at)) {
-      const Vec3 sum = w.loads()[i] + force;
+      const Vec3 sum = w.loads()[i].isZero() ? force : Vec3(w.loads()[i] + force);
       guard(at + "/force", [&] {
         w.set_loads(i, std::span<const double>(sum.data(), 3));
         return 0;
