@@ -664,6 +664,7 @@ World::FrameStart World::frame_start() const {
     f.collider_rotation.push_back(c.desc.rotation);
   }
   for (const BodyInfo& b : bodies_) f.rest_scale.push_back({b.rest_scale, b.rest_scale_u, b.rest_scale_v});
+  for (const Group& g : groups_) f.tether_lambda.push_back(g.tethers.lambda);
   f.gravity = settings_.gravity;
   return f;
 }
@@ -709,6 +710,15 @@ void World::restore(const FrameStart& f) {
         }
     }
     g.contacts.clear();
+  }
+  // The tethers' multipliers are read where the solve left them (saved and reported): back to the
+  // frame's start, or to zero where the frame rebuilt the solver with other tethers.
+  for (size_t slot = 0; slot < groups_.size(); ++slot) {
+    std::vector<double>& lambda = groups_[slot].tethers.lambda;
+    if (slot < f.tether_lambda.size() && f.tether_lambda[slot].size() == lambda.size())
+      lambda = f.tether_lambda[slot];
+    else
+      std::fill(lambda.begin(), lambda.end(), 0.0);
   }
   if (settings_.contact_group.index < groups_.size()) groups_[settings_.contact_group.index].contacts = f.contacts;
   face_contacts_ = f.face_contacts;

@@ -1022,6 +1022,7 @@ class World {
     std::vector<Vec3> collider_position;
     std::vector<Eigen::Quaterniond> collider_rotation;
     std::vector<std::array<double, 3>> rest_scale;
+    std::vector<std::vector<double>> tether_lambda;  // per group slot: the automatic tethers' multipliers
     Vec3 gravity = Vec3::Zero();
   };
   FrameStart frame_start() const;
