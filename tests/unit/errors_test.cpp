@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -280,6 +281,33 @@ TEST(Errors, NumericalFailureRestoresTheWorld) {
   w.set_positions(first + 1, std::vector<double>{1, 0, 0, 2, 0, 0});
   w.step();
   EXPECT_EQ(w.report().frame, 2);
+}
+
+// The automatic tethers' multipliers are state a save writes and the reactions read: a cancelled
+// frame leaves them as the last completed frame did (each substep resets them before projecting).
+TEST(Errors, CancelledStepKeepsTheTethersMultipliers) {
+  Settings s = test::settings(1, 1, Vec3(0, 0, -9.81));  // one pass a frame: the cloth stretches
+  s.realign_passes = 1;                                  // the tethers keep multipliers (for the realignment) only then
+  World w(s);
+  const test::Grid g = test::make_grid(9, 9, 0.05, Vec3::Zero());
+  BodyDesc d;
+  d.positions = g.positions;
+  d.triangles = g.triangles;
+  d.generate = generate_stretch;  // inextensible (the default material): tethers to the pins
+  const Id body = w.create_body(d);
+  const int32_t first = w.body(body).first_particle;
+  test::hard_pin(w, first + g.index(0, 0), Vec3(0, 0, 0));
+  test::hard_pin(w, first + g.index(8, 0), Vec3(0.4, 0, 0));
+  for (int f = 0; f < 30; ++f) w.step();  // hanging: the far corners' tethers taut
+  const StaticsState before = w.statics_state();
+  ASSERT_EQ(before.tethers.size(), 1u);  // the stretch group's
+  std::atomic<bool> cancel{true};
+  StepControl control;
+  control.cancel = &cancel;
+  expect_refused(w, ErrorCode::cancelled, "cancelled step", [&] { w.step(control); });
+  const StaticsState after = w.statics_state();
+  ASSERT_EQ(after.tethers.size(), 1u);
+  EXPECT_EQ(after.tethers[0].lambda, before.tethers[0].lambda);
 }
 
 }  // namespace
