@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace embra {
@@ -73,6 +74,105 @@ TEST(Tethers, WithOneTetherAParticleTheTautChainSags) {
   std::printf("64 links: off the line by %.3g m with one tether a particle, %.3g m with two\n", one.off_line,
               two.off_line);
   EXPECT_GT(one.off_line, 1e3 * two.off_line);
+}
+
+/// A sheet's body (no constraints generated): `positions` 3 per vertex, `triangles` 3 per triangle.
+const BodyInfo& sheet(World& w, const std::vector<double>& positions, const std::vector<int32_t>& triangles) {
+  BodyDesc d;
+  d.positions = positions;
+  d.triangles = triangles;
+  return w.body(w.create_body(d));
+}
+
+/// The grid `g` turned about (1, 2, 3) by 0.7 rad and moved by (0.3, -0.2, 0.5): a flat sheet in a
+/// tilted plane whose coordinates are rounded.
+std::vector<double> tilted(const test::Grid& g) {
+  const Eigen::AngleAxisd turn(0.7, Vec3(1, 2, 3).normalized());
+  std::vector<double> out;
+  for (size_t i = 0; i < g.positions.size(); i += 3) {
+    const Vec3 p = turn * Vec3(g.positions[i], g.positions[i + 1], g.positions[i + 2]) + Vec3(0.3, -0.2, 0.5);
+    out.insert(out.end(), {p.x(), p.y(), p.z()});
+  }
+  return out;
+}
+
+// On a flat sheet that covers its convex hull (a cloth grid, flat or in a tilted plane) the shortest
+// path over the surface between two points is the straight line: every tether's rest length is the
+// distance between its ends, and the attachments skip the straight links' walks over the triangles
+// with the same result to the bit as the walks give.
+TEST(Tethers, OnAFlatConvexSheetEveryRestLengthIsTheStraightDistance) {
+  Settings s;
+  s.tethers = 0;
+  World w(s);
+  const test::Grid g = test::make_grid(33, 21, 0.03, Vec3(-0.5, -0.3, 0.2));
+  std::vector<int32_t> one_diagonal;  // each quad split along the same diagonal (the benchmark's cloth)
+  for (int j = 0; j + 1 < g.ny; ++j)
+    for (int i = 0; i + 1 < g.nx; ++i)
+      one_diagonal.insert(one_diagonal.end(), {g.index(i, j), g.index(i + 1, j), g.index(i + 1, j + 1), g.index(i, j),
+                                               g.index(i + 1, j + 1), g.index(i, j + 1)});
+  const std::vector<std::pair<std::vector<double>, std::vector<int32_t>>> sheets{
+      {g.positions, g.triangles}, {g.positions, one_diagonal}, {tilted(g), g.triangles}};
+  for (size_t k = 0; k < sheets.size(); ++k) {
+    const BodyInfo& b = sheet(w, sheets[k].first, sheets[k].second);
+    const int32_t f = b.first_particle;
+    const std::vector<int32_t> anchors{f + g.index(0, 0), f + g.index(g.nx - 1, 0), f + g.index(12, 9)};
+    const std::vector<Attachment> skipped = long_range_attachments(b, anchors, 2);
+    const std::vector<Attachment> walked = long_range_attachments(b, anchors, 2, true);
+    ASSERT_EQ(skipped.size(), walked.size()) << "sheet " << k;
+    ASSERT_EQ(skipped.size(), 2 * (b.rest_positions.size() - anchors.size()) + anchors.size()) << "sheet " << k;
+    double worst = 0.0;
+    for (size_t i = 0; i < skipped.size(); ++i) {
+      EXPECT_EQ(skipped[i].particle, walked[i].particle) << "sheet " << k << ", attachment " << i;
+      EXPECT_EQ(skipped[i].anchor, walked[i].anchor) << "sheet " << k << ", attachment " << i;
+      EXPECT_EQ(skipped[i].rest, walked[i].rest) << "sheet " << k << ", attachment " << i;
+      const double straight =
+          (b.rest_positions[skipped[i].particle - f] - b.rest_positions[skipped[i].anchor - f]).norm();
+      worst = std::max(worst, std::abs(skipped[i].rest - straight) / straight);
+    }
+    EXPECT_LT(worst, 1e-12) << "sheet " << k;  // a sum of straight links along one line
+  }
+}
+
+// A flat L-shaped sheet is not convex: from the tip of one arm to the tip of the other the straight
+// line leaves the sheet, and the shortest path over it bends at the inner corner: |anchor - corner| +
+// |corner - point| (1 m here, against 0.71 m straight). The tether is no shorter than that.
+TEST(Tethers, AroundTheInnerCornerOfAnLShapedSheetTheRestLengthGoesAroundIt) {
+  Settings s;
+  s.tethers = 0;
+  World w(s);
+  const int n = 21;
+  const double dx = 0.05;
+  const test::Grid g = test::make_grid(n, n, dx, Vec3::Zero());
+  std::vector<int32_t> tris;  // the grid without its upper right quarter
+  for (size_t t = 0; t < g.triangles.size(); t += 3) {
+    bool out = true;
+    for (int c = 0; c < 3; ++c) {
+      const int32_t v = g.triangles[t + c];
+      out = out && v % n >= n / 2 && v / n >= n / 2;
+    }
+    if (!out)
+      tris.insert(tris.end(), g.triangles.begin() + static_cast<ptrdiff_t>(t),
+                  g.triangles.begin() + static_cast<ptrdiff_t>(t) + 3);
+  }
+  const BodyInfo& b = sheet(w, g.positions, tris);
+  const int32_t f = b.first_particle, anchor = g.index(n - 1, n / 2), point = g.index(n / 2, n - 1),
+                corner = g.index(n / 2, n / 2);
+  const std::vector<int32_t> anchors{f + anchor};
+  const std::vector<Attachment> links = long_range_attachments(b, anchors, 1);
+  std::vector<uint8_t> used(b.rest_positions.size(), 0);  // the removed quarter's inner vertices are left alone
+  for (int32_t v : tris) used[v] = 1;
+  EXPECT_EQ(links.size(), static_cast<size_t>(std::count(used.begin(), used.end(), 1)) - 1);
+  const auto at = [&](int32_t v) { return b.rest_positions[v]; };
+  const double around = (at(anchor) - at(corner)).norm() + (at(corner) - at(point)).norm();
+  const double straight = (at(anchor) - at(point)).norm();
+  for (const Attachment& l : links)
+    if (l.particle == f + point) {
+      std::printf("L-shaped sheet: the far arm's tip held at %.6f m; around the corner %.6f, straight %.6f\n", l.rest,
+                  around, straight);
+      EXPECT_GE(l.rest, around * (1.0 - 1e-12));
+      EXPECT_LT(l.rest, 1.01 * around);
+      EXPECT_GT(l.rest, 1.1 * straight);
+    }
 }
 
 }  // namespace

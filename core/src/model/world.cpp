@@ -973,6 +973,7 @@ class RestSurface {
         if (across_[other] == -1 && other / 3 != static_cast<int32_t>(t)) {
           across_[other] = static_cast<int32_t>(t);
           across_[3 * t + k] = other / 3;
+          opposed_ = opposed_ && tri_[other] == b;  // the two triangles run the edge both ways
         } else {
           across_[other] = -2;
           across_[3 * t + k] = -2;
@@ -982,6 +983,81 @@ class RestSurface {
 
   size_t size() const { return p_.size(); }
   const Vec3& at(int32_t v) const { return p_[v]; }
+
+  /// Whether the rest shape is one flat sheet covering the convex hull of its vertices once: every
+  /// vertex in one plane (to 1e-15 of the shape's size), every triangle turning the same way in it
+  /// and every interior edge run both ways (a consistently oriented sheet, no fold), each boundary
+  /// edge on the hull's boundary (so no hole), and the triangles' areas adding up to the hull's (to
+  /// 1e-9: so it is covered once). On such a sheet every straight segment between two vertices
+  /// lies on it: straight() holds for every pair, without its walk.
+  bool flat_convex() const {
+    const size_t nt = tri_.size() / 3;
+    if (nt == 0 || !opposed_) return false;
+    // The plane: the normal of the largest triangle, through the first vertex.
+    Vec3 normal = Vec3::Zero();
+    double largest = 0.0;
+    for (size_t t = 0; t < nt; ++t) {
+      const Vec3 n = (p_[tri_[3 * t + 1]] - p_[tri_[3 * t]]).cross(p_[tri_[3 * t + 2]] - p_[tri_[3 * t]]);
+      if (n.squaredNorm() > largest) largest = n.squaredNorm(), normal = n;
+    }
+    if (!(largest > 0.0)) return false;
+    normal.normalize();
+    const Vec3 o = p_[0];
+    double size = 0.0;
+    for (const Vec3& q : p_) size = std::max(size, (q - o).norm());
+    const double flat_tol = 1e-15 * size;
+    for (const Vec3& q : p_)
+      if (!(std::abs(normal.dot(q - o)) <= flat_tol)) return false;
+    // Plane coordinates, then the hull (Andrew's monotone chain, collinear points left out).
+    const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
+    std::vector<Eigen::Vector2d> q(p_.size());
+    for (size_t i = 0; i < p_.size(); ++i) q[i] = {u.dot(p_[i] - o), v.dot(p_[i] - o)};
+    auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+      return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    };
+    double area = 0.0, sign = 0.0;
+    for (size_t t = 0; t < nt; ++t) {
+      const double a = cross2(q[tri_[3 * t]], q[tri_[3 * t + 1]], q[tri_[3 * t + 2]]);
+      if (a == 0.0 || (sign != 0.0 && (a > 0.0) != (sign > 0.0))) return false;
+      sign = a;
+      area += std::abs(a);
+    }
+    std::vector<int32_t> order(q.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(),
+              [&](int32_t a, int32_t b) { return q[a].x() != q[b].x() ? q[a].x() < q[b].x() : q[a].y() < q[b].y(); });
+    std::vector<int32_t> hull;
+    for (int pass = 0; pass < 2; ++pass) {
+      const size_t floor = hull.size();
+      for (int32_t i : order) {
+        while (hull.size() >= floor + 2 && cross2(q[hull[hull.size() - 2]], q[hull.back()], q[i]) <= 0.0)
+          hull.pop_back();
+        hull.push_back(i);
+      }
+      hull.pop_back();
+      std::reverse(order.begin(), order.end());
+    }
+    if (hull.size() < 3) return false;
+    double hull_area = 0.0;
+    for (size_t i = 1; i + 1 < hull.size(); ++i) hull_area += cross2(q[hull[0]], q[hull[i]], q[hull[i + 1]]);
+    if (!(std::abs(area - hull_area) <= 1e-9 * hull_area)) return false;
+    // Every boundary edge along one of the hull's edges.
+    const double line_tol = 1e-9 * size;
+    for (size_t e = 0; e < tri_.size(); ++e) {
+      if (across_[e] != -1) continue;
+      const Eigen::Vector2d& a = q[tri_[e]];
+      const Eigen::Vector2d& b = q[tri_[e - e % 3 + (e + 1) % 3]];
+      bool on = false;
+      for (size_t h = 0; h < hull.size() && !on; ++h) {
+        const Eigen::Vector2d& h0 = q[hull[h]];
+        const Eigen::Vector2d& h1 = q[hull[(h + 1) % hull.size()]];
+        const double len = (h1 - h0).norm();
+        on = std::abs(cross2(h0, h1, a)) <= line_tol * len && std::abs(cross2(h0, h1, b)) <= line_tol * len;
+      }
+      if (!on) return false;
+    }
+    return true;
+  }
   std::span<const int32_t> neighbours(int32_t v) const {
     return {nbr_.data() + nbr_start_[v], nbr_.data() + nbr_start_[v + 1]};
   }
@@ -1086,6 +1162,7 @@ class RestSurface {
  private:
   const std::vector<Vec3>& p_;
   std::vector<int32_t> nbr_start_, nbr_, tri_, vt_start_, vt_, across_;
+  bool opposed_ = true;  // every interior edge run one way by one triangle, the other way by the other
 };
 
 /// Clears a solver array's chains (Settings::chain_solve): its distances run in their pass.
@@ -1383,10 +1460,14 @@ void order_island_rows(Group& g) {
 
 }  // namespace
 
-std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors, int32_t k) {
+std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors, int32_t k,
+                                               bool walk_always) {
   std::vector<Attachment> out;
   if (k <= 0 || anchors.empty()) return out;
   const RestSurface surface(body);
+  // A straight link's walk crosses every triangle between its ends: on a fine flat sheet the walks
+  // are most of the cost (n^3 on an n x n grid). A flat, convex sheet has every link on it.
+  const bool all_straight = !walk_always && surface.flat_convex();
   const int32_t first = body.first_particle;
   const size_t nv = surface.size();
   // Up to k labels per vertex (source, distance, parent), settled in increasing distance: a
@@ -1423,7 +1504,7 @@ std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<c
     queue.pop();
     const int32_t v = e.vertex, s = e.source;
     if (count[v] >= k || find(v, s)) continue;
-    if (e.parent != v && !surface.straight(e.parent, v)) {
+    if (e.parent != v && !all_straight && !surface.straight(e.parent, v)) {
       // The straight link leaves the surface: come from the best settled neighbour instead.
       double best = std::numeric_limits<double>::infinity();
       int32_t from = -1;

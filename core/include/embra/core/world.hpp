@@ -671,9 +671,12 @@ struct Attachment {
 /// shape (edges, and straight lines across coplanar triangles). A rest length is the length of a
 /// path over the surface, so it is never shorter than the geodesic distance: a tether never holds
 /// back a shape the body can take without stretching, and on a flat piece it is the straight-line
-/// distance. Deterministic; cost about that of a Dijkstra search per anchor.
+/// distance. Deterministic. A straight link is checked by a walk over the triangles it crosses,
+/// except on a flat sheet that covers the convex hull of its vertices once (every link lies on it):
+/// there the cost is that of a Dijkstra search per anchor. `walk_always`: walk every link even
+/// there (the tests compare the two).
 std::vector<Attachment> long_range_attachments(const BodyInfo& body, std::span<const int32_t> anchors,
-                                               int32_t per_particle);
+                                               int32_t per_particle, bool walk_always = false);
 
 /// A panel mesh (core/include/embra/core/panels.hpp): a body whose particles are its panels' corners.
 /// Welded (`shared` false): 8 per panel in panel order, the top quad's corners 0-3, then the bottom
