@@ -141,27 +141,25 @@ TEST(Tethers, AroundTheInnerCornerOfAnLShapedSheetTheRestLengthGoesAroundIt) {
   s.tethers = 0;
   World w(s);
   const int n = 21;
-  const double dx = 0.05;
-  const test::Grid g = test::make_grid(n, n, dx, Vec3::Zero());
-  std::vector<int32_t> tris;  // the grid without its upper right quarter
-  for (size_t t = 0; t < g.triangles.size(); t += 3) {
-    bool out = true;
-    for (int c = 0; c < 3; ++c) {
-      const int32_t v = g.triangles[t + c];
-      out = out && v % n >= n / 2 && v / n >= n / 2;
+  const test::Grid g = test::make_grid(n, n, 0.05, Vec3::Zero());
+  // The grid without its upper right quarter, its vertices renumbered (none left off the sheet).
+  const auto kept = [&](int32_t v) { return v % n <= n / 2 || v / n <= n / 2; };
+  std::vector<int32_t> index(g.positions.size() / 3, -1), tris;
+  std::vector<double> xyz;
+  for (int32_t v = 0; v < static_cast<int32_t>(index.size()); ++v)
+    if (kept(v)) {
+      index[v] = static_cast<int32_t>(xyz.size() / 3);
+      xyz.insert(xyz.end(), g.positions.begin() + 3 * v, g.positions.begin() + 3 * v + 3);
     }
-    if (!out)
-      tris.insert(tris.end(), g.triangles.begin() + static_cast<ptrdiff_t>(t),
-                  g.triangles.begin() + static_cast<ptrdiff_t>(t) + 3);
-  }
-  const BodyInfo& b = sheet(w, g.positions, tris);
-  const int32_t f = b.first_particle, anchor = g.index(n - 1, n / 2), point = g.index(n / 2, n - 1),
-                corner = g.index(n / 2, n / 2);
+  for (size_t t = 0; t < g.triangles.size(); t += 3)
+    if (kept(g.triangles[t]) && kept(g.triangles[t + 1]) && kept(g.triangles[t + 2]))
+      for (int c = 0; c < 3; ++c) tris.push_back(index[g.triangles[t + c]]);
+  const BodyInfo& b = sheet(w, xyz, tris);
+  const int32_t f = b.first_particle, anchor = index[g.index(n - 1, n / 2)], point = index[g.index(n / 2, n - 1)],
+                corner = index[g.index(n / 2, n / 2)];
   const std::vector<int32_t> anchors{f + anchor};
   const std::vector<Attachment> links = long_range_attachments(b, anchors, 1);
-  std::vector<uint8_t> used(b.rest_positions.size(), 0);  // the removed quarter's inner vertices are left alone
-  for (int32_t v : tris) used[v] = 1;
-  EXPECT_EQ(links.size(), static_cast<size_t>(std::count(used.begin(), used.end(), 1)) - 1);
+  EXPECT_EQ(links.size(), b.rest_positions.size() - 1);
   const auto at = [&](int32_t v) { return b.rest_positions[v]; };
   const double around = (at(anchor) - at(corner)).norm() + (at(corner) - at(point)).norm();
   const double straight = (at(anchor) - at(point)).norm();

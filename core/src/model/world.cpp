@@ -985,14 +985,17 @@ class RestSurface {
   const Vec3& at(int32_t v) const { return p_[v]; }
 
   /// Whether the rest shape is one flat sheet covering the convex hull of its vertices once: every
-  /// vertex in one plane (to 1e-15 of the shape's size), every triangle turning the same way in it
-  /// and every interior edge run both ways (a consistently oriented sheet, no fold), each boundary
-  /// edge on the hull's boundary (so no hole), and the triangles' areas adding up to the hull's (to
-  /// 1e-9: so it is covered once). On such a sheet every straight segment between two vertices
+  /// vertex on a triangle and in one plane (to 1e-15 of the shape's size), every triangle turning
+  /// the same way in it and every interior edge run both ways (a consistently oriented sheet, no
+  /// fold), each boundary edge on the hull's boundary (so no hole), and the triangles' areas adding
+  /// up to the hull's (to 1e-9: so it is covered once). On such a sheet every straight segment between two vertices
   /// lies on it: straight() holds for every pair, without its walk.
   bool flat_convex() const {
     const size_t nt = tri_.size() / 3;
     if (nt == 0 || !opposed_) return false;
+    // A vertex of edges only (a bar hanging off the sheet) is reached over its edges, not across.
+    for (size_t v = 0; v < p_.size(); ++v)
+      if (vt_start_[v] == vt_start_[v + 1]) return false;
     // The plane: the normal of the largest triangle, through the first vertex.
     Vec3 normal = Vec3::Zero();
     double largest = 0.0;
