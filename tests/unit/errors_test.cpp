@@ -286,8 +286,10 @@ TEST(Errors, NumericalFailureRestoresTheWorld) {
 // The automatic tethers' multipliers are state a save writes and the reactions read: a cancelled
 // frame leaves them as the last completed frame did (each substep resets them before projecting).
 TEST(Errors, CancelledStepKeepsTheTethersMultipliers) {
-  Settings s = test::settings(1, 1, Vec3(0, 0, -9.81));  // one pass a frame: the cloth stretches
-  s.realign_passes = 1;                                  // the tethers keep multipliers (for the realignment) only then
+  // One pass a frame, so the cloth stretches; the tethers keep multipliers (for the realignment)
+  // only with realignment passes.
+  Settings s = test::settings(1, 1, Vec3(0, 0, -9.81));
+  s.realign_passes = 1;
   World w(s);
   const test::Grid g = test::make_grid(9, 9, 0.05, Vec3::Zero());
   BodyDesc d;

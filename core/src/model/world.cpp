@@ -988,8 +988,8 @@ class RestSurface {
   /// vertex on a triangle and in one plane (to 1e-15 of the shape's size), every triangle turning
   /// the same way in it and every interior edge run both ways (a consistently oriented sheet, no
   /// fold), each boundary edge on the hull's boundary (so no hole), and the triangles' areas adding
-  /// up to the hull's (to 1e-9: so it is covered once). On such a sheet every straight segment between two vertices
-  /// lies on it: straight() holds for every pair, without its walk.
+  /// up to the hull's (to 1e-9: so it is covered once). On such a sheet every straight segment
+  /// between two vertices lies on it: straight() holds for every pair, without its walk.
   bool flat_convex() const {
     const size_t nt = tri_.size() / 3;
     if (nt == 0 || !opposed_) return false;
@@ -1049,7 +1049,7 @@ class RestSurface {
     for (size_t e = 0; e < tri_.size(); ++e) {
       if (across_[e] != -1) continue;
       const Eigen::Vector2d& a = q[tri_[e]];
-      const Eigen::Vector2d& b = q[tri_[e - e % 3 + (e + 1) % 3]];
+      const Eigen::Vector2d& b = q[tri_[3 * (e / 3) + (e % 3 + 1) % 3]];  // edge e runs tri[k] -> tri[k + 1]
       bool on = false;
       for (size_t h = 0; h < hull.size() && !on; ++h) {
         const Eigen::Vector2d& h0 = q[hull[h]];
