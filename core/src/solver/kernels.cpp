@@ -921,8 +921,8 @@ EMBRA_ALWAYS_INLINE void chain_bundle(SolverArray& a, size_t c0, int count, doub
     }
     for (int32_t k = 0; k < m[l]; ++k) a.lambda[E[l][k]] += rhs[N * k + l];
     for (int32_t j = 0; j <= m[l]; ++j) {
+      if (w_j[N * j + l] == 0.0) continue;  // the inverse mass as the forward sweep read it
       const int32_t q = P[l][j];
-      if (w[q] == 0.0) continue;
       double* xq = x + 3 * static_cast<int64_t>(q);
       for (int d = 0; d < 3; ++d) xq[d] = moved[3 * N * j + d * N + l];
     }
