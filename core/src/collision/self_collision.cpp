@@ -375,6 +375,10 @@ int cubic_roots(double d0, double d1, double d2, double d3, double roots[3]) {
   if (!(scale > 0.0) || !std::isfinite(scale)) return 0;  // identically coplanar: no single time
   auto f = [&](double t) { return ((d3 * t + d2) * t + d1) * t + d0; };
   const double tiny = 1e-13 * scale;
+  // |f| >= |d0| - |d1| - |d2| - |d3| on [0, 1]: beyond 2 tiny, every f evaluated below (Horner's
+  // rounding is under 1e-15 scale) keeps d0's sign and clears tiny, so no piece yields a root. Most
+  // pairs near contact stay on one side of the plane in a substep; this skips their pieces.
+  if (std::abs(d0) - (std::abs(d1) + std::abs(d2) + std::abs(d3)) > 2.0 * tiny) return 0;
   double cuts[4] = {0.0, 0.0, 0.0, 1.0};
   int nc = 1;
   // critical points: 3 d3 t^2 + 2 d2 t + d1 = 0
