@@ -1410,10 +1410,18 @@ IslandPlan build_islands(const Group& g, size_t particle_count, const std::vecto
   return plan_islands(g, particle_count, islands, colour_start, single);
 }
 
-/// Puts a group's solver array of `kind` in `order` (entry j becomes the row that was order[j]; a
-/// permutation of a group's rows, built before any other index of them is kept) and returns each old
-/// row's new place.
-std::vector<int32_t> reorder_rows(SolverArray& a, Kind kind, const std::vector<int32_t>& order) {
+/// Puts a group's solver array of `kind` in a new order within each colour (whose rows share no
+/// particle, so any order projects the same): by key(row), ascending, ties in the present order; the
+/// last colour keeps its order where its rows may share particles (projected in order). Built before
+/// any other index of the rows is kept; returns each old row's new place.
+template <class Key>
+std::vector<int32_t> reorder_rows(SolverArray& a, Kind kind, Key&& key) {
+  std::vector<int32_t> order(a.size());
+  std::iota(order.begin(), order.end(), 0);
+  const size_t colours = a.colours() - (a.shared_tail ? 1 : 0);
+  for (size_t c = 0; c < colours; ++c)
+    std::stable_sort(order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
+                     [&](int32_t u, int32_t v) { return key(u) < key(v); });
   const int n = arity(kind), per = multipliers(kind);
   SolverArray sorted = a;
   std::vector<int32_t> new_of(a.size());
@@ -1431,23 +1439,17 @@ std::vector<int32_t> reorder_rows(SolverArray& a, Kind kind, const std::vector<i
   return new_of;
 }
 
-/// A distance array's rows in memory in the order its chains take them: within each colour (whose
-/// rows share no particle, so any order projects the same), by their places in the chains
-/// (SolverArray::chain_edge). A chain step reads each link's rest length, compliance and multiplier
-/// and writes the multiplier; in colour order alone consecutive links lie far apart, and on the
-/// 256 x 256 cloth (4.7 MB of them) those reads missed the caches in every link.
+/// A distance array's rows in memory in the order its chains take them: within each colour, by their
+/// places in the chains (SolverArray::chain_edge). A chain step reads each link's rest length, compliance and
+/// multiplier and writes the multiplier; in colour order alone consecutive links lie far apart, and on the 256 x 256
+/// cloth (4.7 MB of them) those reads missed the caches in every link.
 void order_chain_rows(SolverArray& a) {
   if (a.chain_start.empty()) return;
   std::vector<int32_t> place(a.size());
   for (size_t k = 0; k < a.chain_edge.size(); ++k)
     place[static_cast<size_t>(a.chain_edge[k])] = static_cast<int32_t>(k);
-  std::vector<int32_t> order(a.size());
-  std::iota(order.begin(), order.end(), 0);
-  const size_t colours = a.colours() - (a.shared_tail ? 1 : 0);
-  for (size_t c = 0; c < colours; ++c)
-    std::sort(order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
-              [&](int32_t u, int32_t v) { return place[static_cast<size_t>(u)] < place[static_cast<size_t>(v)]; });
-  const std::vector<int32_t> new_of = reorder_rows(a, Kind::distance, order);
+  const std::vector<int32_t> new_of =
+      reorder_rows(a, Kind::distance, [&](int32_t row) { return place[static_cast<size_t>(row)]; });
   for (int32_t& e : a.chain_edge) e = new_of[static_cast<size_t>(e)];
 }
 
@@ -1473,15 +1475,8 @@ void order_island_rows(Group& g) {
           if (shape.kind[static_cast<size_t>(st)] == kr)
             place[static_cast<size_t>(shape.row[static_cast<size_t>(is * shape.steps + st)])] = item.place;
     }
-    std::vector<int32_t> order(a.size());
-    std::iota(order.begin(), order.end(), 0);
-    // The last colour keeps its order where its rows may share particles (projected in order).
-    const size_t colours = a.colours() - (a.shared_tail ? 1 : 0);
-    for (size_t c = 0; c < colours; ++c)
-      std::stable_sort(
-          order.begin() + a.colour_start[c], order.begin() + a.colour_start[c + 1],
-          [&](int32_t u, int32_t v) { return place[static_cast<size_t>(u)] < place[static_cast<size_t>(v)]; });
-    const std::vector<int32_t> new_of = reorder_rows(a, IslandPlan::kRowKind[kr], order);
+    const std::vector<int32_t> new_of =
+        reorder_rows(a, IslandPlan::kRowKind[kr], [&](int32_t row) { return place[static_cast<size_t>(row)]; });
     for (IslandPlan::Shape& shape : plan.shapes)
       for (size_t r = 0; r < shape.row.size(); ++r)
         if (shape.kind[r % static_cast<size_t>(shape.steps)] == kr)
