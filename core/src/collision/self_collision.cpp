@@ -745,16 +745,17 @@ struct SelfCollisionScratch {
   std::vector<uint8_t> changed, tri_changed, edge_changed, outside;
   std::vector<uint8_t> item_changed;                                // per item: holds a changed primitive
   std::vector<int32_t> changed_tris, changed_edges, changed_items;  // the marks' lists
-  std::vector<int32_t> groups;                          // the groups of kQueryGroup items holding a changed item
-  std::vector<Box> swept_point, swept_tri, swept_edge;  // this substep's swept bounds
-  std::vector<Box> moved;                               // per particle: its start and end, not grown
-  std::vector<double> motion;                           // per particle: |x - x_prev| in this substep
-  std::vector<double> shift;  // per particle: how far x_prev is from the last substep's (inf: unknown)
-  // Per triangle and edge: the largest motion and shift of its vertices.
-  struct Moves {
+  std::vector<int32_t> groups;  // the groups of kQueryGroup items holding a changed item
+  std::vector<Box> moved;       // per particle: its start and end, not grown
+  std::vector<double> motion;   // per particle: |x - x_prev| in this substep
+  std::vector<double> shift;    // per particle: how far x_prev is from the last substep's (inf: unknown)
+  // Per particle, triangle and edge: this substep's swept bounds and the largest motion and shift of
+  // its vertices, in one cache line (a kept pair's filter reads both for each side).
+  struct alignas(64) Swept {
+    Box box;
     double motion, shift;
   };
-  std::vector<Moves> tri_moves, edge_moves;
+  std::vector<Swept> swept_point, swept_tri, swept_edge;
   std::vector<double> part_scale;  // per part of the pool: the largest coordinate magnitude seen
   std::vector<int32_t> near;       // the kept pairs whose distance is measured in this substep
   // One list per thread of the pool: candidate pairs, contacts (gather).
@@ -1150,18 +1151,6 @@ template <class F>
   b.lo.array() -= g;
   b.hi.array() += g;
   return b;
-}
-
-/// Whether two swept bounds do not overlap: then the pair is no contact in this substep. Each bound
-/// holds its vertices' start and end positions grown by their largest half thickness, so the start
-/// positions are apart along the most separating axis by at least that separation plus the two
-/// growths; `gap` (the distance less the thickness) is raised to that less the thickness, `slack`
-/// being the two growths less the thickness.
-bool apart_by(const Box& a, const Box& b, double slack, double& gap) {
-  const double along = (b.lo - a.hi).cwiseMax(a.lo - b.hi).maxCoeff();
-  if (!(along > 0.0)) return false;
-  gap = std::max(gap, along + slack);
-  return true;
 }
 
 /// Finds ix.near_at_rest_pt and near_at_rest_ee for the primitives of `s` and the bodies' rest
@@ -1562,9 +1551,10 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
     for (size_t k = begin; k < end; ++k) {
       const int32_t i = s.points[k];
       s.moved[i] = box_of({x0[i], x1[i]}, 0.0);
-      s.swept_point[i] = {s.moved[i].lo.array() - grow_of(i), s.moved[i].hi.array() + grow_of(i)};
       s.motion[i] = (x1[i] - x0[i]).norm();
       s.shift[i] = started ? (x0[i] - ix.start[i]).norm() : std::numeric_limits<double>::infinity();
+      s.swept_point[i] = {
+          {s.moved[i].lo.array() - grow_of(i), s.moved[i].hi.array() + grow_of(i)}, s.motion[i], s.shift[i]};
       scale = std::max({scale, x0[i].cwiseAbs().maxCoeff(), x1[i].cwiseAbs().maxCoeff()});
       if (started) scale = std::max(scale, ix.start[i].cwiseAbs().maxCoeff());
     }
@@ -1582,69 +1572,68 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   auto swept = [&](std::initializer_list<int32_t> ids) {
     return grown_union(ids, r, [&](int32_t i) -> const Box& { return s.moved[i]; });
   };
-  auto moves = [&](std::initializer_list<int32_t> ids) {
-    Scratch::Moves mv{0.0, 0.0};
-    for (int32_t i : ids) mv = {std::max(mv.motion, m[i]), std::max(mv.shift, s.shift[i])};
-    return mv;
+  auto swept_moves = [&](std::initializer_list<int32_t> ids) {
+    Scratch::Swept sw{swept(ids), 0.0, 0.0};
+    for (int32_t i : ids) sw.motion = std::max(sw.motion, m[i]), sw.shift = std::max(sw.shift, s.shift[i]);
+    return sw;
   };
   s.swept_tri.resize(nt);
-  s.tri_moves.resize(nt);
   each(nt, [&](size_t t) {
     const int32_t* v = &s.tris[3 * t];
-    s.swept_tri[t] = swept({v[0], v[1], v[2]});
-    s.tri_moves[t] = moves({v[0], v[1], v[2]});
+    s.swept_tri[t] = swept_moves({v[0], v[1], v[2]});
   });
   s.swept_edge.resize(ne);
-  s.edge_moves.resize(ne);
   each(ne, [&](size_t e) {
     const int32_t* v = &s.edges[2 * e];
-    s.swept_edge[e] = swept({v[0], v[1]});
-    s.edge_moves[e] = moves({v[0], v[1]});
+    s.swept_edge[e] = swept_moves({v[0], v[1]});
   });
 
   // s.near: the pairs whose gap, lowered by their two sides' shifts, does not clear their motion
-  // (the others have d0 >= thk + motion below); first(id) and second(id) are a side's moves.
-  // (a range at a time, the arrays read through local pointers: a kept pair is a few instructions)
-  auto near_pairs = [&](const std::vector<int32_t>& pairs, std::vector<double>& gaps, auto&& first, auto&& second) {
+  // (the others have d0 >= thk + motion below) and whose swept bounds overlap; first and second:
+  // the two sides' Swept arrays. Bounds that do not overlap are apart along some axis by `along`:
+  // each is grown by its vertices' largest half thickness, which together are at least the pair's
+  // thickness (a sum or mean of half thicknesses, or kMinGap), so the pair stays more than its
+  // thickness apart through the substep and its distance less its thickness is at least `along`,
+  // which raises the gap. (A range at a time, the arrays read through local pointers: a kept pair is
+  // a few instructions and a cache line for each side.)
+  auto near_pairs = [&](const std::vector<int32_t>& pairs, std::vector<double>& gaps,
+                        const std::vector<Scratch::Swept>& first, const std::vector<Scratch::Swept>& second) {
     s.near.clear();
     in.pool->collect(0, gaps.size(), kContactGrain, s.part_pairs, s.near,
-                     [&, first, second](size_t begin, size_t end, std::vector<int32_t>& near) {
+                     [&](size_t begin, size_t end, std::vector<int32_t>& near) {
                        const int32_t* ids = pairs.data();
                        double* gap = gaps.data();
+                       const Scratch::Swept* sa = first.data();
+                       const Scratch::Swept* sb = second.data();
                        const double tol = tolerance;
                        for (size_t pair = begin; pair < end; ++pair) {
-                         const Scratch::Moves a = first(ids[2 * pair]), b = second(ids[2 * pair + 1]);
+                         const Scratch::Swept &a = sa[ids[2 * pair]], &b = sb[ids[2 * pair + 1]];
                          gap[pair] -= a.shift + b.shift;
-                         if (gap[pair] < a.motion + b.motion + tol) near.push_back(static_cast<int32_t>(pair));
+                         if (!(gap[pair] < a.motion + b.motion + tol)) continue;
+                         const double along = (b.box.lo - a.box.hi).cwiseMax(a.box.lo - b.box.hi).maxCoeff();
+                         if (along > 0.0)
+                           gap[pair] = std::max(gap[pair], along);
+                         else
+                           near.push_back(static_cast<int32_t>(pair));
                        }
                      });
   };
-  auto tri_moves = [tm = s.tri_moves.data()](int32_t t) { return tm[t]; };
-  auto edge_moves = [em = s.edge_moves.data()](int32_t e) { return em[e]; };
 
   // Point against triangle: the pairs near enough, then their contacts.
-  near_pairs(
-      cache.point_triangle, cache.point_triangle_gap,
-      [motion = m.data(), shift = s.shift.data()](int32_t p) {
-        return Scratch::Moves{motion[p], shift[p]};
-      },
-      tri_moves);
+  near_pairs(cache.point_triangle, cache.point_triangle_gap, s.swept_point, s.swept_tri);
   gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
     const size_t pair = static_cast<size_t>(s.near[k]);
     const int32_t p = cache.point_triangle[2 * pair], t = cache.point_triangle[2 * pair + 1];
-    const Scratch::Moves& tm = s.tri_moves[static_cast<size_t>(t)];
-    const double motion = m[p] + tm.motion;
+    const Scratch::Swept& st = s.swept_tri[static_cast<size_t>(t)];
+    const double motion = m[p] + st.motion;
     double& gap = cache.point_triangle_gap[pair];
     const int32_t* v = &s.tris[3 * static_cast<size_t>(t)];
     const double thk = std::max(r[p] + (r[v[0]] + r[v[1]] + r[v[2]]) / 3.0, kMinGap);
     double bary[3];
-    if (apart_by(s.swept_point[p], s.swept_tri[t],
-                 grow_of(p) + std::max({grow_of(v[0]), grow_of(v[1]), grow_of(v[2])}) - thk, gap))
-      return;
     const double d0 = point_triangle_distance(x0[p], x0[v[0]], x0[v[1]], x0[v[2]], bary);
     gap = d0 - thk;
     if (d0 >= thk + motion) return;
-    if (!s.swept_point[p].overlaps(s.swept_tri[t])) return;  // (non-finite bounds)
+    if (!s.swept_point[p].box.overlaps(st.box)) return;  // (non-finite bounds)
     double toi;
     const Vec3 tri_n = (x0[v[1]] - x0[v[0]]).cross(x0[v[2]] - x0[v[0]]);
     Vec3 side = x0[p] - (bary[0] * x0[v[0]] + bary[1] * x0[v[1]] + bary[2] * x0[v[2]]);
@@ -1671,24 +1660,21 @@ void find_contacts(const Input& in, std::vector<SelfContact>& out) {
   const size_t point_triangle_contacts = out.size();
 
   // Edge against edge, the same way.
-  near_pairs(cache.edge_edge, cache.edge_edge_gap, edge_moves, edge_moves);
+  near_pairs(cache.edge_edge, cache.edge_edge_gap, s.swept_edge, s.swept_edge);
   gather(*in.pool, s.near.size(), kContactGrain, s.part_contacts, out, [&](size_t k, std::vector<SelfContact>& found) {
     const size_t pair = static_cast<size_t>(s.near[k]);
     const size_t ea = static_cast<size_t>(cache.edge_edge[2 * pair]);
     const size_t eb = static_cast<size_t>(cache.edge_edge[2 * pair + 1]);
-    const Scratch::Moves &ma = s.edge_moves[ea], &mb = s.edge_moves[eb];
-    const double motion = ma.motion + mb.motion;
+    const Scratch::Swept &swa = s.swept_edge[ea], &swb = s.swept_edge[eb];
+    const double motion = swa.motion + swb.motion;
     double& gap = cache.edge_edge_gap[pair];
     const int32_t a0 = s.edges[2 * ea], a1 = s.edges[2 * ea + 1], b0 = s.edges[2 * eb], b1 = s.edges[2 * eb + 1];
     const double thk = std::max(0.5 * (r[a0] + r[a1] + r[b0] + r[b1]), kMinGap);
     double sa, tb;
-    if (apart_by(s.swept_edge[ea], s.swept_edge[eb],
-                 std::max(grow_of(a0), grow_of(a1)) + std::max(grow_of(b0), grow_of(b1)) - thk, gap))
-      return;
     const double d0 = edge_edge_distance(x0[a0], x0[a1], x0[b0], x0[b1], sa, tb);
     gap = d0 - thk;
     if (d0 >= thk + motion) return;
-    if (!s.swept_edge[ea].overlaps(s.swept_edge[eb])) return;  // (non-finite bounds)
+    if (!swa.box.overlaps(swb.box)) return;  // (non-finite bounds)
     const Vec3 cross = (x0[a1] - x0[a0]).cross(x0[b1] - x0[b0]);
     Vec3 side = lerp(x0[a0], x0[a1], sa) - lerp(x0[b0], x0[b1], tb);
     Vec3 primary = side;
