@@ -750,7 +750,8 @@ struct SelfCollisionScratch {
   std::vector<double> motion;   // per particle: |x - x_prev| in this substep
   std::vector<double> shift;    // per particle: how far x_prev is from the last substep's (inf: unknown)
   // Per particle, triangle and edge: this substep's swept bounds and the largest motion and shift of
-  // its vertices, in one cache line (a kept pair's filter reads both for each side).
+  // its vertices, in one cache line (a kept pair's filter reads both for each side). A particle's
+  // motion and shift are also kept dense above, for the passes over the primitives' vertices.
   struct alignas(64) Swept {
     Box box;
     double motion, shift;
