@@ -4,9 +4,10 @@
 #
 # usage: bash scripts/bench_compare.sh COMMIT [FILTER] [RUNS]
 #   COMMIT  the commit to compare with (built in a temporary git worktree, removed afterwards)
-#   FILTER  a --benchmark_filter selecting one benchmark (default BM_Cloth/128)
+#   FILTER  a --benchmark_filter, selecting one benchmark or several (default BM_Cloth/128)
 #   RUNS    runs of each binary, alternating (default 6)
-# Prints each binary's ms_per_frame (or ms_per_substep) values, sorted.
+# Prints, for each benchmark the filter selects, each binary's figures, sorted: its ms_per_frame or
+# ms_per_substep counter, or else its real time in ms.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ]; then
@@ -26,19 +27,40 @@ git worktree add --detach "$old" "$commit" >/dev/null 2>&1
 cmake -S "$old" -B "$old/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$old/build" --target embra_bench -j "$jobs" >/dev/null
 
-# One figure per run: the benchmark's ms_per_frame or ms_per_substep counter.
+# One run of each selected benchmark: "name figure" lines.
 measure() {
-  "$1" --benchmark_filter="$filter" 2>/dev/null | sed -nE 's/.*ms_per_(frame|substep)=([0-9.]+).*/\2/p' | head -1
+  "$1" --benchmark_filter="$filter" --benchmark_format=json 2>/dev/null | python3 -c '
+import json, sys
+units = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+for b in json.load(sys.stdin)["benchmarks"]:
+    ms = b.get("ms_per_frame", b.get("ms_per_substep"))
+    if ms is None:
+        ms = b["real_time"] * units[b["time_unit"]]
+    print(b["name"], ms)
+'
 }
-declare -a a b
+a=$(mktemp) b=$(mktemp)
+trap 'rm -f "$a" "$b"; git worktree remove --force "$old" >/dev/null 2>&1 || rm -rf "$old"' EXIT
 for _ in $(seq "$runs"); do
-  a+=("$(measure "$old/build/bench/embra_bench")")
-  b+=("$(measure build/bench/embra_bench)")
+  measure "$old/build/bench/embra_bench" >>"$a"
+  measure build/bench/embra_bench >>"$b"
 done
-if [ -z "${a[0]}" ] || [ -z "${b[0]}" ]; then
-  echo "no ms_per_frame or ms_per_substep figure from '$filter'" >&2
+if [ ! -s "$a" ] || [ ! -s "$b" ]; then
+  echo "no benchmark selected by '$filter'" >&2
   exit 1
 fi
 echo "$filter, $runs runs each, alternating (ms, sorted):"
-echo "  ${commit:0:7}:   $(printf '%s\n' "${a[@]}" | sort -g | tr '\n' ' ')"
-echo "  this tree: $(printf '%s\n' "${b[@]}" | sort -g | tr '\n' ' ')"
+python3 - "$a" "$b" "${commit:0:7}" <<'PY'
+import sys
+def read(path):
+    runs = {}
+    for line in open(path):
+        name, ms = line.rsplit(" ", 1)
+        runs.setdefault(name, []).append(float(ms))
+    return runs
+old, new = read(sys.argv[1]), read(sys.argv[2])
+for name in new:
+    print(name)
+    for label, runs in ((sys.argv[3] + ":  ", old), ("this tree:", new)):
+        print("  " + label, " ".join(f"{v:.4g}" for v in sorted(runs.get(name, []))))
+PY
