@@ -21,8 +21,8 @@ case $runs in '' | *[!0-9]*) echo "RUNS must be a positive integer" >&2; exit 2 
 jobs=$(nproc 2>/dev/null || echo 2)
 
 bash scripts/build.sh >/dev/null
-old=$(mktemp -d)
-trap 'git worktree remove --force "$old" >/dev/null 2>&1 || rm -rf "$old"' EXIT
+old=$(mktemp -d) a=$(mktemp) b=$(mktemp)
+trap 'rm -f "$a" "$b"; git worktree remove --force "$old" >/dev/null 2>&1 || rm -rf "$old"' EXIT
 git worktree add --detach "$old" "$commit" >/dev/null 2>&1
 cmake -S "$old" -B "$old/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$old/build" --target embra_bench -j "$jobs" >/dev/null
@@ -39,8 +39,6 @@ for b in json.load(sys.stdin)["benchmarks"]:
     print(b["name"], ms)
 '
 }
-a=$(mktemp) b=$(mktemp)
-trap 'rm -f "$a" "$b"; git worktree remove --force "$old" >/dev/null 2>&1 || rm -rf "$old"' EXIT
 for _ in $(seq "$runs"); do
   measure "$old/build/bench/embra_bench" >>"$a"
   measure build/bench/embra_bench >>"$b"
